@@ -1,0 +1,193 @@
+//! Eigenvalues of a real square matrix: balancing, then the real Schur form.
+//!
+//! Balancing (Parlett & Reinsch; LAPACK `xGEBAL` with job 'S') scales A by a diagonal D of powers
+//! of two, D⁻¹AD, so that each row and column have comparable norms. The scaling is exact in
+//! floating point and leaves the eigenvalues unchanged, but it makes the Schur iteration much
+//! more accurate for models like the missile autopilot, whose entries span 10⁻³ … 10⁴.
+
+use nalgebra::{Complex, DMatrix, Schur};
+
+use crate::error::{LtiError, Result};
+
+/// A complex number in double precision.
+pub type C64 = Complex<f64>;
+
+/// D⁻¹ A D with D a diagonal of powers of two (Parlett–Reinsch balancing).
+pub fn balance(a: &DMatrix<f64>) -> DMatrix<f64> {
+    let n = a.nrows();
+    let mut b = a.clone();
+    let mut converged = false;
+    while !converged {
+        converged = true;
+        for i in 0..n {
+            let mut c = 0.0;
+            let mut r = 0.0;
+            for j in 0..n {
+                if j != i {
+                    c += b[(j, i)].abs();
+                    r += b[(i, j)].abs();
+                }
+            }
+            if c == 0.0 || r == 0.0 {
+                continue;
+            }
+            let s = c + r;
+            let mut f = 1.0;
+            let mut g = r / 2.0;
+            while c < g {
+                f *= 2.0;
+                c *= 4.0;
+            }
+            g = r * 2.0;
+            while c >= g {
+                f /= 2.0;
+                c /= 4.0;
+            }
+            if (c + r) / f < 0.95 * s {
+                converged = false;
+                for j in 0..n {
+                    b[(j, i)] *= f;
+                    b[(i, j)] /= f;
+                }
+            }
+        }
+    }
+    b
+}
+
+/// Eigenvalues of a real square matrix, sorted by (real part, imaginary part).
+pub fn eigenvalues(a: &DMatrix<f64>) -> Result<Vec<C64>> {
+    let n = a.nrows();
+    if n != a.ncols() {
+        return Err(LtiError::Dimension(format!("eigenvalues of a {}×{} matrix", n, a.ncols())));
+    }
+    if n == 0 {
+        return Ok(Vec::new());
+    }
+    if a.iter().any(|x| !x.is_finite()) {
+        return Err(LtiError::NoConvergence("eigenvalues of a non-finite matrix"));
+    }
+    let schur = Schur::try_new(balance(a), f64::EPSILON, 1000 * n)
+        .ok_or(LtiError::NoConvergence("Schur decomposition"))?;
+    let mut ev: Vec<C64> = schur.complex_eigenvalues().iter().copied().collect();
+    // A real matrix has exactly conjugate pairs; make them so bit for bit.
+    for e in ev.iter_mut() {
+        if e.im.abs() <= 8.0 * f64::EPSILON * e.re.abs() {
+            e.im = 0.0;
+        }
+    }
+    sort(&mut ev);
+    Ok(ev)
+}
+
+/// Sorts by real part, then imaginary part (the reference data's convention).
+pub fn sort(v: &mut [C64]) {
+    v.sort_by(|a, b| a.re.total_cmp(&b.re).then(a.im.total_cmp(&b.im)));
+}
+
+/// Largest real part (the spectral abscissa): the decay rate of a continuous system.
+pub fn spectral_abscissa(ev: &[C64]) -> f64 {
+    ev.iter().map(|e| e.re).fold(f64::NEG_INFINITY, f64::max)
+}
+
+/// Largest modulus (the spectral radius): the decay factor of a discrete system.
+pub fn spectral_radius(ev: &[C64]) -> f64 {
+    ev.iter().map(|e| e.norm()).fold(0.0, f64::max)
+}
+
+/// Distance between two eigenvalue multisets: each requested value is matched to the nearest
+/// unused achieved value; returns the largest |a − r| / max(1, |r|).
+pub fn match_error(requested: &[C64], achieved: &[C64]) -> f64 {
+    if requested.len() != achieved.len() {
+        return f64::INFINITY;
+    }
+    let mut used = vec![false; achieved.len()];
+    let mut worst: f64 = 0.0;
+    for r in requested {
+        let mut best = None;
+        let mut best_d = f64::INFINITY;
+        for (i, a) in achieved.iter().enumerate() {
+            let d = (a - r).norm();
+            if !used[i] && d < best_d {
+                best_d = d;
+                best = Some(i);
+            }
+        }
+        match best {
+            Some(i) => {
+                used[i] = true;
+                worst = worst.max(best_d / r.norm().max(1.0));
+            }
+            None => return f64::INFINITY,
+        }
+    }
+    worst
+}
+
+/// "−1, −2 ± 3j" style formatting of an eigenvalue list (one member per conjugate pair).
+pub fn format_list(v: &[C64]) -> String {
+    let mut out = Vec::new();
+    for e in v {
+        if e.im < 0.0 && v.iter().any(|o| o.re == e.re && o.im == -e.im) {
+            continue;
+        }
+        out.push(format_one(*e, true));
+    }
+    out.join(", ")
+}
+
+/// One eigenvalue; with `pair`, a complex value is shown as "re ± j·|im|".
+pub fn format_one(e: C64, pair: bool) -> String {
+    if e.im == 0.0 {
+        format!("{}", sig(e.re))
+    } else if pair {
+        format!("{} ± j{}", sig(e.re), sig(e.im.abs()))
+    } else if e.im > 0.0 {
+        format!("{} + j{}", sig(e.re), sig(e.im))
+    } else {
+        format!("{} - j{}", sig(e.re), sig(-e.im))
+    }
+}
+
+/// Six significant digits, trailing zeros trimmed.
+pub fn sig(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let mag = x.abs().log10().floor() as i32;
+    if (-3..7).contains(&mag) {
+        let s = format!("{:.*}", (5 - mag).max(0) as usize, x);
+        if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s }
+    } else {
+        format!("{x:.5e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn companion_roots() {
+        // s³ + 6s² + 11s + 6 = (s+1)(s+2)(s+3)
+        let a = DMatrix::from_row_slice(3, 3, &[0.0, 1.0, 0.0, 0.0, 0.0, 1.0, -6.0, -11.0, -6.0]);
+        let ev = eigenvalues(&a).unwrap();
+        let want = [C64::new(-3.0, 0.0), C64::new(-2.0, 0.0), C64::new(-1.0, 0.0)];
+        assert!(match_error(&want, &ev) < 1e-12);
+    }
+
+    #[test]
+    fn balancing_keeps_eigenvalues() {
+        let a = DMatrix::from_row_slice(2, 2, &[1.0, 1e6, 1e-6, 2.0]);
+        let b = balance(&a);
+        let (ea, eb) = (eigenvalues(&a).unwrap(), eigenvalues(&b).unwrap());
+        assert!(match_error(&ea, &eb) < 1e-13);
+        assert!(b[(0, 1)].abs() < 1e3);
+    }
+
+    #[test]
+    fn formatting() {
+        let v = [C64::new(-84.2607, -127.9594), C64::new(-84.2607, 127.9594), C64::new(-1.0, 0.0)];
+        assert_eq!(format_list(&v), "-84.2607 ± j127.959, -1");
+    }
+}

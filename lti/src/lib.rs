@@ -1,0 +1,31 @@
+//! Linear time-invariant system math for observer design: no I/O, no allocation-sensitive
+//! code paths — the design-time half of the toolkit.
+//!
+//! * [`pinv`], [`subspace`], [`householder`], [`eig`] — the numerical core;
+//! * [`staircase`] — controllable / observable splits, controllability and observability matrices;
+//! * [`zeros`] — invariant zeros that decide whether an unknown-input observer exists;
+//! * [`lyapunov`] — continuous and discrete Lyapunov equations (decay-rate certificates);
+//! * [`place`] — eigenvalue assignment (Tits–Yang, KNV0, MATLAB-compatible, Ackermann);
+//! * [`discretize`] — exact zero-order-hold sampling by the matrix exponential;
+//! * [`signal`] — the known-input and disturbance signals of a scenario.
+
+pub mod discretize;
+pub mod eig;
+pub mod error;
+pub mod householder;
+pub mod lyapunov;
+pub mod pinv;
+pub mod place;
+pub mod poles;
+pub mod signal;
+pub mod staircase;
+pub mod subspace;
+pub mod zeros;
+
+pub use eig::C64;
+pub use error::{LtiError, Result};
+pub use nalgebra::DMatrix;
+pub use poles::{PoleSpec, Poles};
+
+/// A real matrix.
+pub type Mat = nalgebra::DMatrix<f64>;
