@@ -6,7 +6,7 @@
 //! * [`zeros`] — invariant zeros that decide whether an unknown-input observer exists;
 //! * [`lyapunov`] — continuous and discrete Lyapunov equations (decay-rate certificates);
 //! * [`place`] — eigenvalue assignment (Tits–Yang, KNV0, MATLAB-compatible, Ackermann);
-//! * [`discretize`] — exact zero-order-hold sampling by the matrix exponential;
+//! * [`model`], [`discretize`] — the plant model and its exact zero-order-hold sampling;
 //! * [`signal`] — the known-input and disturbance signals of a scenario.
 
 pub mod discretize;
@@ -14,6 +14,7 @@ pub mod eig;
 pub mod error;
 pub mod householder;
 pub mod lyapunov;
+pub mod model;
 pub mod pinv;
 pub mod place;
 pub mod poles;
@@ -25,6 +26,7 @@ pub mod zeros;
 pub use eig::C64;
 pub use error::{LtiError, Result};
 pub use nalgebra::DMatrix;
+pub use model::{Discrete, Model};
 pub use poles::{PoleSpec, Poles};
 
 /// A real matrix.

@@ -1,1 +1,10 @@
-// placeholder
+//! The observer component: designs (pure math), the sampled-data step function, and the thin
+//! process shell that runs it in lockstep with the plant.
+
+pub mod design;
+#[cfg(feature = "lmi")]
+mod lmi;
+pub mod runtime;
+
+pub use design::{design, Designed, DesignError, Report, Spec};
+pub use runtime::{LinearObserver, ObserverState};

@@ -1,0 +1,69 @@
+//! The plant model every design starts from:
+//!
+//! ```text
+//! ẋ = A x + B u + E w,     y = C x + D v,
+//! ```
+//!
+//! u known, w unknown (state disturbance, "unknown input"), v unknown (measurement disturbance).
+//! E and D may have no columns.
+
+use nalgebra::DMatrix;
+
+use crate::discretize::zoh;
+
+/// A continuous-time LTI plant with unknown inputs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    /// State matrix, n×n.
+    pub a: DMatrix<f64>,
+    /// Known-input matrix, n×l.
+    pub b: DMatrix<f64>,
+    /// Output matrix, p×n.
+    pub c: DMatrix<f64>,
+    /// Unknown-input distribution, n×q (q may be 0).
+    pub e: DMatrix<f64>,
+    /// Measurement-disturbance distribution, p×r (r may be 0).
+    pub d: DMatrix<f64>,
+}
+
+/// The exact zero-order-hold sampling of a [`Model`] with period dt:
+/// x_{k+1} = A_d x_k + B_d u_k + E_d w_k, y_k = C x_k + D v_k, for u and w held over the step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Discrete {
+    /// e^{A dt}.
+    pub a: DMatrix<f64>,
+    /// ∫₀^dt e^{As} ds B.
+    pub b: DMatrix<f64>,
+    /// C (unchanged).
+    pub c: DMatrix<f64>,
+    /// ∫₀^dt e^{As} ds E.
+    pub e: DMatrix<f64>,
+    /// D (unchanged).
+    pub d: DMatrix<f64>,
+    /// The sample period.
+    pub dt: f64,
+}
+
+impl Model {
+    /// Number of states.
+    pub fn n(&self) -> usize {
+        self.a.nrows()
+    }
+
+    /// Number of outputs.
+    pub fn p(&self) -> usize {
+        self.c.nrows()
+    }
+
+    /// Number of known inputs.
+    pub fn l(&self) -> usize {
+        self.b.ncols()
+    }
+
+    /// Exact sampling with period dt.
+    pub fn discretize(&self, dt: f64) -> Discrete {
+        let (a, b) = zoh(&self.a, &self.b, dt);
+        let (_, e) = zoh(&self.a, &self.e, dt);
+        Discrete { a, b, c: self.c.clone(), e, d: self.d.clone(), dt }
+    }
+}

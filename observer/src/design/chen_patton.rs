@@ -1,0 +1,98 @@
+//! Chen & Patton's unknown-input decoupling observer (seed 002, eqs. 2–8):
+//!
+//! ```text
+//! ż = F z + T B u + K y,   x̂ = z + H y,
+//! H = E (CE)⁺,  T = I − HC,  F = TA − K₁C,  K₂ = F H,  K = K₁ + K₂.
+//! ```
+//!
+//! With these, ė = F e whatever w is (E − HCE = 0 kills it). It exists iff rank CE = rank E and
+//! (TA, C) is detectable; the unobservable modes of (TA, C) are the invariant zeros of (A, E, C)
+//! and stay in F. K₁ places the observable part (staircase) and the fixed modes are reported.
+//!
+//! Sampled counterpart: the same formulas on (A_d, B_d, E_d) with poles e^{p·dt}; then
+//! T_d E_d = 0 exactly, so a disturbance held over each step is rejected at every sample.
+
+use lti::eig::format_list;
+use lti::place::Method;
+use lti::pinv::{pinv, rank};
+use lti::zeros::decoupling;
+use lti::{Mat, Model, Poles, C64};
+
+use super::{eig, eq_detail, place_detectable, require_stable, Checks, Designed, DesignError, Domain, Report};
+use crate::runtime::LinearObserver;
+
+const KIND: &str = "chen-patton-uio";
+
+/// H, T, K₁, K₂, F for one domain.
+pub(super) struct Core {
+    pub h: Mat,
+    pub t: Mat,
+    pub k1: Mat,
+    pub k2: Mat,
+    pub f: Mat,
+    pub fixed: Vec<C64>,
+}
+
+pub(super) fn core(
+    a: &Mat,
+    c: &Mat,
+    e: &Mat,
+    poles: &Poles,
+    method: Method,
+    domain: Domain,
+    checks: &mut Checks,
+) -> Result<Core, DesignError> {
+    let n = a.nrows();
+    let ce = c * e;
+    let (r_ce, r_e) = (rank(&ce), rank(e));
+    checks.require("rank(CE) = rank(E)", r_ce == r_e, eq_detail(r_ce, r_e))?;
+    let zeros = decoupling(a, e, c, &Mat::zeros(c.nrows(), 0)).map_err(|err| checks.error("invariant zeros", err.to_string()))?;
+    let unstable: Vec<C64> = zeros.zeros.iter().copied().filter(|&z| !domain.stable(z)).collect();
+    checks.require(
+        "invariant zeros of (A, E, C) stable",
+        unstable.is_empty(),
+        if zeros.zeros.is_empty() {
+            "none".to_string()
+        } else if unstable.is_empty() {
+            format_list(&zeros.zeros)
+        } else {
+            format!("unstable zero(s) {}", format_list(&unstable))
+        },
+    )?;
+    let h = e * pinv(&ce);
+    let t = Mat::identity(n, n) - &h * c;
+    let ta = &t * a;
+    let (k1, fixed) = place_detectable(checks, &ta, c, &domain.poles(poles), method, "(TA, C)", domain)?;
+    let f = &ta - &k1 * c;
+    require_stable(checks, "F = TA − K1C stable", &eig(&f), domain)?;
+    let k2 = &f * &h;
+    Ok(Core { h, t, k1, k2, f, fixed })
+}
+
+pub(super) fn design(model: &Model, poles: &Poles, method: Method, dt: f64) -> Result<Designed, DesignError> {
+    let mut checks = Checks::new(KIND);
+    let ct = core(&model.a, &model.c, &model.e, poles, method, Domain::Continuous, &mut checks)?;
+    let dm = model.discretize(dt);
+    let mut sampled = Checks::sampled(KIND, dt);
+    let d = core(&dm.a, &dm.c, &dm.e, poles, method, Domain::Discrete(dt), &mut sampled)?;
+    let n = model.n();
+    let runtime = LinearObserver::new(&d.f, &(&d.t * &dm.b), &(&d.k1 + &d.k2), &Mat::identity(n, n), &d.h);
+    Ok(Designed {
+        report: Report {
+            kind: KIND,
+            conditions: checks.into_list(),
+            poles: eig(&ct.f),
+            discrete_poles: eig(&d.f),
+            fixed_modes: ct.fixed,
+            matrices: vec![
+                ("H".into(), ct.h),
+                ("T".into(), ct.t),
+                ("K1".into(), ct.k1),
+                ("K2".into(), ct.k2),
+                ("F".into(), ct.f),
+            ],
+            notes: vec![],
+        },
+        runtime,
+    })
+}

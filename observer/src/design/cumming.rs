@@ -1,0 +1,94 @@
+//! Cumming's reduced-order observer (1969; seed 003 eqs. 7–14). H completes C to an invertible
+//! [C; H], and [E F] = [C; H]⁻¹ gives x = Ey + Fz with z = Hx. Then
+//!
+//! ```text
+//! q̇ = (HAF − KCAF) q + (HAFK + HAE − KCAFK − KCAE) y + (HB − KCB) u     (eq. 12)
+//! x̂ = F q + (E + FK) y                                                   (eq. 14)
+//! ```
+//!
+//! with error ė = (HAF − KCAF)e; it needs (HAF, CAF) observable. By default H = Lᵀ with L the
+//! Das–Ghosal basis of ker C; for C = [I 0] that makes E = Cᵍ, F = L, H = Lᵍ and the two
+//! observers coincide, as the seed-003 paper concludes.
+//!
+//! Sampled counterpart: the same equations with A_d, B_d (as for Das–Ghosal).
+
+use lti::place::Method;
+use lti::pinv::rank;
+use lti::{Mat, Model, Poles, C64};
+
+use super::das_ghosal::independent_columns_of_complement;
+use super::{eig, eq_detail, place_detectable, require_stable, Checks, Designed, DesignError, Domain, Report};
+use crate::runtime::LinearObserver;
+
+const KIND: &str = "cumming";
+
+struct Core {
+    e: Mat,
+    f: Mat,
+    k: Mat,
+    fo: Mat,
+    ky: Mat,
+    ku: Mat,
+    fixed: Vec<C64>,
+}
+
+#[allow(clippy::too_many_arguments)]
+fn core(a: &Mat, b: &Mat, c: &Mat, h: &Mat, poles: &Poles, method: Method, domain: Domain, checks: &mut Checks) -> Result<Core, DesignError> {
+    let n = a.nrows();
+    let p = c.nrows();
+    let mut ch = Mat::zeros(n, n);
+    ch.rows_mut(0, p).copy_from(c);
+    ch.rows_mut(p, n - p).copy_from(h);
+    let r = rank(&ch);
+    checks.require("[C; H] invertible", r == n, format!("rank {}", eq_detail(r, n)))?;
+    let inv = ch.try_inverse().ok_or_else(|| checks.error("[C; H] invertible", "singular"))?;
+    let e = inv.columns(0, p).into_owned();
+    let f = inv.columns(p, n - p).into_owned();
+    let haf = h * a * &f;
+    let caf = c * a * &f;
+    let (k, fixed) = place_detectable(checks, &haf, &caf, &domain.poles(poles), method, "(HAF, CAF)", domain)?;
+    let fo = &haf - &k * &caf;
+    require_stable(checks, "HAF − KCAF stable", &eig(&fo), domain)?;
+    let ky = &fo * &k + h * a * &e - &k * c * a * &e;
+    let ku = h * b - &k * c * b;
+    Ok(Core { e, f, k, fo, ky, ku, fixed })
+}
+
+pub(super) fn design(model: &Model, poles: &Poles, method: Method, h: Option<&Mat>, dt: f64) -> Result<Designed, DesignError> {
+    let mut checks = Checks::new(KIND);
+    let (n, p) = (model.n(), model.p());
+    let h = match h {
+        Some(h) if h.shape() != (n - p, n) => {
+            return Err(checks.error("H", format!("is {}×{}, must be {}×{}", h.nrows(), h.ncols(), n - p, n)));
+        }
+        Some(h) => h.clone(),
+        None => independent_columns_of_complement(&model.c).transpose(),
+    };
+    if h.nrows() != n - p {
+        return Err(checks.error("C", format!("must have full row rank {p} for Cumming's observer")));
+    }
+    let ct = core(&model.a, &model.b, &model.c, &h, poles, method, Domain::Continuous, &mut checks)?;
+    let dm = model.discretize(dt);
+    let mut sampled = Checks::sampled(KIND, dt);
+    let d = core(&dm.a, &dm.b, &dm.c, &h, poles, method, Domain::Discrete(dt), &mut sampled)?;
+    let q = &d.e + &d.f * &d.k;
+    let runtime = LinearObserver::new(&d.fo, &d.ku, &d.ky, &d.f, &q);
+    Ok(Designed {
+        report: Report {
+            kind: KIND,
+            conditions: checks.into_list(),
+            poles: eig(&ct.fo),
+            discrete_poles: eig(&d.fo),
+            fixed_modes: ct.fixed,
+            matrices: vec![
+                ("H".into(), h),
+                ("E".into(), ct.e),
+                ("F".into(), ct.f),
+                ("K".into(), ct.k),
+                ("HAF-KCAF".into(), ct.fo),
+            ],
+            notes: vec![],
+        },
+        runtime,
+    })
+}

@@ -1,0 +1,158 @@
+//! Das & Ghosal's reduced-order observer (1981) and its unknown-input form (seed 000,
+//! eqs. 14–23). With Cᵍ the Moore–Penrose inverse and L the independent columns of I − CᵍC
+//! (so LLᵍ = I − CᵍC, eq. 11), every state is x = Cᵍy + Lh (eq. 14) and
+//!
+//! ```text
+//! q̇ = (LᵍAL − KCAL) q + [(LᵍAL − KCAL)K + LᵍACᵍ − KCACᵍ] y + (LᵍB − KCB) u     (eq. 23)
+//! x̂ = L q + (Cᵍ + LK) y                                                         (eq. 19)
+//! ```
+//!
+//! with error dynamics F = LᵍAL − KCAL, of order n − rank C. The unknown input enters the error
+//! through LᵍE_d − KCE_d (eq. 17); it vanishes for
+//!
+//! ```text
+//! K = (LᵍE_d)(CE_d)ᵍ + H (I − CE_d(CE_d)ᵍ)                                       (eq. 22)
+//! ```
+//!
+//! which exists iff LᵍE_d − LᵍE_d(CE_d)ᵍ(CE_d) = 0 (eq. 21 as corrected: the printed operand
+//! order does not conform). H is free: given, or chosen here so that F has the requested poles,
+//! F = (LᵍAL − K₀CAL) − H·ΠCAL with K₀ = (LᵍE_d)(CE_d)ᵍ, Π = I − CE_d(CE_d)ᵍ.
+//!
+//! Sampled counterpart: x_{k+1} = A_d x_k + …, y_{k+1} − CA_dCᵍy_k − CB_du_k = CA_dLh_k + CE_dw_k
+//! plays the role of ẏ, and the same equations hold with (A_d, B_d, E_d): q_{k+1} = F_d q_k + …,
+//! x̂_k = Lq_k + (Cᵍ + LK_d)y_k.
+
+use lti::place::Method;
+use lti::pinv::{pinv, rank};
+use lti::{Mat, Model, Poles, C64};
+
+use super::{eig, place_detectable, require_stable, Checks, Designed, DesignError, Domain, Report};
+use crate::runtime::LinearObserver;
+
+/// How K is chosen.
+#[derive(Debug, Clone)]
+pub(super) enum Gain {
+    /// Place eig(F) at these (continuous) poles.
+    Poles(Poles, Method),
+    /// The UIO's free matrix H of eq. 22.
+    Free(Mat),
+}
+
+/// The independent columns of I − CᵍC, left to right: a basis L of ker C with LLᵍ = I − CᵍC.
+pub fn independent_columns_of_complement(c: &Mat) -> Mat {
+    let n = c.ncols();
+    let p = Mat::identity(n, n) - pinv(c) * c;
+    let mut cols: Vec<nalgebra::DVector<f64>> = Vec::new();
+    for j in 0..n {
+        let mut trial: Vec<_> = cols.clone();
+        trial.push(p.column(j).into_owned());
+        if rank(&Mat::from_columns(&trial)) == trial.len() {
+            cols = trial;
+        }
+    }
+    if cols.is_empty() { Mat::zeros(n, 0) } else { Mat::from_columns(&cols) }
+}
+
+/// The design in one domain.
+pub(super) struct Core {
+    pub cg: Mat,
+    pub l: Mat,
+    pub lg: Mat,
+    pub k: Mat,
+    pub f: Mat,
+    /// y-gain of eq. 23: FK + LᵍACᵍ − KCACᵍ.
+    pub ky: Mat,
+    /// u-gain of eq. 23: LᵍB − KCB.
+    pub ku: Mat,
+    pub fixed: Vec<C64>,
+    pub notes: Vec<String>,
+}
+
+#[allow(clippy::too_many_arguments)]
+pub(super) fn core(
+    a: &Mat,
+    b: &Mat,
+    c: &Mat,
+    e: &Mat,
+    gain: &Gain,
+    uio: bool,
+    domain: Domain,
+    checks: &mut Checks,
+) -> Result<Core, DesignError> {
+    let cg = pinv(c);
+    let l = independent_columns_of_complement(c);
+    let lg = pinv(&l);
+    let r = l.ncols();
+    let lgal = &lg * a * &l;
+    let cal = c * a * &l;
+    let mut notes = Vec::new();
+    let (k, fixed) = if uio {
+        let ced = c * e;
+        let ced_g = pinv(&ced);
+        let lge = &lg * e;
+        let res21 = &lge - &lge * &ced_g * &ced;
+        let scale = lge.amax().max(1.0);
+        checks.require(
+            "LgEd − LgEd(CEd)g(CEd) = 0 (eq. 21)",
+            res21.amax() <= 1e-10 * scale,
+            format!("max |residual| = {:.3e}", res21.amax()),
+        )?;
+        let k0 = &lge * &ced_g;
+        let pi = Mat::identity(c.nrows(), c.nrows()) - &ced * &ced_g;
+        let (h, fixed) = match gain {
+            Gain::Free(h) => {
+                if h.shape() != (r, c.nrows()) {
+                    return Err(checks.error("H", format!("is {}×{}, must be {}×{}", h.nrows(), h.ncols(), r, c.nrows())));
+                }
+                (h.clone(), Vec::new())
+            }
+            Gain::Poles(poles, method) => {
+                let at = &lgal - &k0 * &cal;
+                let ct = &pi * &cal;
+                notes.push("H placed on the pair (LgAL − K0·CAL, Π·CAL)".to_string());
+                place_detectable(checks, &at, &ct, &domain.poles(poles), *method, "(LgAL − K0CAL, ΠCAL)", domain)?
+            }
+        };
+        let k = k0 + h * pi;
+        let res20 = &lge - &k * &ced;
+        checks.require("LgEd − KCEd = 0 (eq. 20)", res20.amax() <= 1e-10 * scale, format!("max |residual| = {:.3e}", res20.amax()))?;
+        (k, fixed)
+    } else {
+        match gain {
+            Gain::Poles(poles, method) => place_detectable(checks, &lgal, &cal, &domain.poles(poles), *method, "(LgAL, CAL)", domain)?,
+            Gain::Free(_) => return Err(checks.error("H", "only the unknown-input form takes H")),
+        }
+    };
+    let f = &lgal - &k * &cal;
+    require_stable(checks, "F = LgAL − KCAL stable", &eig(&f), domain)?;
+    let ky = &f * &k + &lg * a * &cg - &k * c * a * &cg;
+    let ku = &lg * b - &k * c * b;
+    Ok(Core { cg, l, lg, k, f, ky, ku, fixed, notes })
+}
+
+pub(super) fn design(model: &Model, gain: Gain, uio: bool, dt: f64) -> Result<Designed, DesignError> {
+    let kind = if uio { "das-ghosal-uio" } else { "das-ghosal" };
+    let mut checks = Checks::new(kind);
+    let ct = core(&model.a, &model.b, &model.c, &model.e, &gain, uio, Domain::Continuous, &mut checks)?;
+    let dm = model.discretize(dt);
+    let mut sampled = Checks::sampled(kind, dt);
+    let d = core(&dm.a, &dm.b, &dm.c, &dm.e, &gain, uio, Domain::Discrete(dt), &mut sampled)?;
+    let q = &d.cg + &d.l * &d.k;
+    let runtime = LinearObserver::new(&d.f, &d.ku, &d.ky, &d.l, &q);
+    let mut notes = ct.notes;
+    if let Gain::Free(_) = gain {
+        notes.push("H given: the sampled observer uses the same H, so its poles are close to, not equal to, e^{p·dt}".into());
+    }
+    Ok(Designed {
+        report: Report {
+            kind,
+            conditions: checks.into_list(),
+            poles: eig(&ct.f),
+            discrete_poles: eig(&d.f),
+            fixed_modes: ct.fixed,
+            matrices: vec![("L".into(), ct.l), ("Lg".into(), ct.lg), ("K".into(), ct.k), ("F".into(), ct.f)],
+            notes,
+        },
+        runtime,
+    })
+}

@@ -1,0 +1,57 @@
+//! Full-order observer by the generalized inverse (seed 001, eqs. 10–17). From x = Cᵍy + h and
+//! ẏ = CAh + CACᵍy + CBu (eq. 14), Luenberger's construction on the pair (A, CA) gives
+//!
+//! ```text
+//! q̇ = (A − KCA) q + (B − KCB) u + (AK − KCAK) y,     x̂ = q + K y,      (eqs. 16–17)
+//! ```
+//!
+//! with error ė = (A − KCA)e: it needs (A, CA) observable (true when (A, C) is observable and A
+//! is non-singular, the paper's lemma).
+//!
+//! Sampled counterpart: with y_{k+1} − CB_du_k = CA_d x_k in place of ẏ, the estimator
+//! ξ_{k+1} = A_dξ_k + B_du_k + K(y_{k+1} − CB_du_k − CA_dξ_k) and q_k = ξ_k − Ky_k give the same
+//! equations with A_d, B_d: q_{k+1} = (A_d − KCA_d)q_k + (B_d − KCB_d)u_k + (A_d − KCA_d)K y_k.
+
+use lti::place::Method;
+use lti::pinv::rank;
+use lti::{Mat, Model, Poles};
+
+use super::{eig, place_detectable, require_stable, Checks, Designed, DesignError, Domain, Report};
+use crate::runtime::LinearObserver;
+
+const KIND: &str = "gi-full-order";
+
+fn core(a: &Mat, c: &Mat, poles: &Poles, method: Method, domain: Domain, checks: &mut Checks) -> Result<(Mat, Mat, Vec<lti::C64>), DesignError> {
+    let ca = c * a;
+    let (k, fixed) = place_detectable(checks, a, &ca, &domain.poles(poles), method, "(A, CA)", domain)?;
+    let f = a - &k * &ca;
+    require_stable(checks, "F = A − KCA stable", &eig(&f), domain)?;
+    Ok((k, f, fixed))
+}
+
+pub(super) fn design(model: &Model, poles: &Poles, method: Method, dt: f64) -> Result<Designed, DesignError> {
+    let mut checks = Checks::new(KIND);
+    let n = model.n();
+    let ra = rank(&model.a);
+    checks.require("A non-singular", true, format!("rank(A) = {ra} of {n}"))?;
+    checks.list_last_mut().ok = ra == n; // informative: (A, CA) observability is what is required
+    let (k, f, fixed) = core(&model.a, &model.c, poles, method, Domain::Continuous, &mut checks)?;
+    let dm = model.discretize(dt);
+    let mut sampled = Checks::sampled(KIND, dt);
+    let (kd, fd, _) = core(&dm.a, &dm.c, poles, method, Domain::Discrete(dt), &mut sampled)?;
+    let g = &dm.b - &kd * &dm.c * &dm.b;
+    let ky = &fd * &kd;
+    let runtime = LinearObserver::new(&fd, &g, &ky, &Mat::identity(n, n), &kd);
+    Ok(Designed {
+        report: Report {
+            kind: KIND,
+            conditions: checks.into_list(),
+            poles: eig(&f),
+            discrete_poles: eig(&fd),
+            fixed_modes: fixed,
+            matrices: vec![("K".into(), k), ("F".into(), f)],
+            notes: vec![],
+        },
+        runtime,
+    })
+}

@@ -1,0 +1,230 @@
+//! Hui & Żak's projection unknown-input observer with a measurement disturbance (seed 004):
+//!
+//! ```text
+//! ẋ = Ax + B₁u₁ + B₂u₂,   y = Cx + Dv        (u₂, v unknown)
+//! M = [B₂ 0][CB₂ D]⁺,     A₁ = (I − MC)A      ((I − MC)B₂ = 0, MD = 0)
+//! ż = (I − MC)(Az + AMy + B₁u₁) + L(y − Cx̂),   x̂ = z + My,   LD = 0
+//! ė = (A₁ − LC) e
+//! ```
+//!
+//! LD = 0 forces L = L̃N with N spanning the left null space of D, so the error dynamics are
+//! A₁ − L̃(NC): the unobservable modes of (A₁, NC) — the invariant zeros of (A, B₂, C, D) — are
+//! fixed, and only the observable part can be placed.
+//!
+//! Two design paths:
+//! * [`Path::Placement`] (default, pure Rust): place the free poles on (A₁, NC), then certify the
+//!   decay rate α with a Lyapunov function: P solves (A₁ − LC + α/2·I)ᵀP + P(A₁ − LC + α/2·I) = −I,
+//!   scaled so P ⪰ 0.01I, and Y = PL satisfies the paper's LMI
+//!   A₁ᵀP + PA₁ − CᵀYᵀ − YC + αP ⪯ 0, YD = 0.
+//! * [`Path::Lmi`] (cargo feature `lmi`): the paper's LMI solved as a semidefinite feasibility
+//!   problem with Clarabel; L = P⁻¹Y.
+//!
+//! Sampled counterpart: the same projection on (A_d, B₁d, B₂d): with x̂_k = z_k + M_d y_k,
+//! z_{k+1} = (I − M_dC)(A_d x̂_k + B₁d u₁) + L_d(y_k − Cx̂_k) gives e_{k+1} = (A₁d − L_dC)e_k;
+//! its decay is certified by the discrete Lyapunov equation for (A₁d − L_dC)/ρ, ρ = e^{−α·dt/2}.
+
+use lti::eig::{format_list, sig};
+use lti::lyapunov;
+use lti::place::Method;
+use lti::zeros::decoupling;
+use lti::{Mat, Model, PoleSpec, Poles, C64};
+
+use super::{eig, eq_detail, place_detectable, require_stable, Checks, Designed, DesignError, Domain, Report};
+use crate::runtime::LinearObserver;
+
+const KIND: &str = "hui-zak-uio";
+
+/// How L is found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Path {
+    /// Pole placement on the admissible structure plus a Lyapunov certificate.
+    Placement,
+    /// The paper's LMI, solved with Clarabel (feature `lmi`).
+    Lmi,
+}
+
+/// Whether this build can solve the LMI.
+pub fn lmi_available() -> bool {
+    cfg!(feature = "lmi")
+}
+
+/// The LMI's solution.
+#[derive(Debug, Clone)]
+pub struct LmiSolution {
+    /// P = Pᵀ ⪰ 0.01 I.
+    pub p: Mat,
+    /// Y with YD = 0.
+    pub y: Mat,
+}
+
+struct Core {
+    m: Mat,
+    a1: Mat,
+    l: Mat,
+    acl: Mat,
+    fixed: Vec<C64>,
+}
+
+/// Free poles when none are given: each real, at least twice as fast as the slowest fixed mode,
+/// faster than the decay rate, and no slower than −1.
+fn default_poles(count: usize, fixed: &[C64], decay: f64) -> Poles {
+    let slowest = fixed.iter().map(|z| z.re.abs()).fold(0.0, f64::max);
+    let base = (2.0 * slowest).max(decay).max(1.0);
+    Poles::new((0..count).map(|i| PoleSpec::Real(-base * (1.0 + 0.1 * i as f64)))).expect("finite")
+}
+
+#[allow(clippy::too_many_arguments)]
+fn core(
+    a: &Mat,
+    c: &Mat,
+    b2: &Mat,
+    d: &Mat,
+    decay: f64,
+    poles: Option<&Poles>,
+    method: Method,
+    lmi_l: Option<&Mat>,
+    domain: Domain,
+    checks: &mut Checks,
+) -> Result<Core, DesignError> {
+    let n = a.nrows();
+    let dec = decoupling(a, b2, c, d).map_err(|e| checks.error("decoupling", e.to_string()))?;
+    checks.require("rank[CB2 D] = rank(B2) + rank(D)", dec.matching(), eq_detail(dec.rank_ced, dec.rank_e_plus_d))?;
+    let m = dec.m.clone();
+    let proj = Mat::identity(n, n) - &m * c;
+    let res_b2 = (&proj * b2).amax();
+    let res_md = (&m * d).amax();
+    checks.require("(I − MC)B2 = 0, MD = 0", res_b2 <= 1e-10 && res_md <= 1e-10, format!("max |(I − MC)B2| = {res_b2:.1e}, max |MD| = {res_md:.1e}"))?;
+    let fixed = dec.zeros.clone();
+    let unstable: Vec<C64> = fixed.iter().copied().filter(|&z| !domain.stable(z)).collect();
+    checks.require(
+        "invariant zeros of (A, B2, C, D) stable",
+        unstable.is_empty(),
+        if fixed.is_empty() { "none".into() } else if unstable.is_empty() { format_list(&fixed) } else { format!("unstable zero(s) {}", format_list(&unstable)) },
+    )?;
+    let nc = &dec.n * c;
+    let l = match lmi_l {
+        Some(l) => l.clone(),
+        None => {
+            let free = dec.staircase.no;
+            let continuous_poles = match poles {
+                Some(p) => p.clone(),
+                None => default_poles(free, &fixed, decay),
+            };
+            let (lt, _) = place_detectable(checks, &dec.a1, &nc, &domain.poles(&continuous_poles), method, "(A1, NC)", domain)?;
+            lt * &dec.n
+        }
+    };
+    let res_ld = (&l * d).amax();
+    checks.require("LD = 0", res_ld <= 1e-9 * l.amax().max(1.0), format!("max |LD| = {res_ld:.1e}"))?;
+    let acl = &dec.a1 - &l * c;
+    require_stable(checks, "A1 − LC stable", &eig(&acl), domain)?;
+    Ok(Core { m, a1: dec.a1, l, acl, fixed })
+}
+
+/// The decay-rate certificate of the continuous design: P ⪰ 0.01I with
+/// A_clᵀP + PA_cl + αP = −cI ⪯ 0. Returns P and the largest eigenvalue of the LMI's left side.
+fn certificate(acl: &Mat, decay: f64) -> Result<(Mat, f64), String> {
+    let n = acl.nrows();
+    let shifted = acl + Mat::identity(n, n) * (decay / 2.0);
+    let p = lyapunov::continuous(&shifted, &Mat::identity(n, n)).map_err(|e| e.to_string())?;
+    let lmin = lyapunov::min_eigenvalue(&p);
+    if lmin <= 0.0 {
+        return Err(format!("no Lyapunov certificate: λmin(P) = {}", sig(lmin)));
+    }
+    let p = &p * (0.01 / lmin).max(1.0);
+    let lhs = acl.transpose() * &p + &p * acl + &p * decay;
+    let worst = lhs.symmetric_eigen().eigenvalues.max();
+    Ok((p, worst))
+}
+
+/// The sampled decay certificate: P ≻ 0 with A_dᵀPA_d − ρ²P ⪯ 0; returns ρ and λmax of the left side.
+fn discrete_certificate(acl_d: &Mat, decay: f64, dt: f64) -> Result<(f64, f64), String> {
+    let n = acl_d.nrows();
+    let rho = (-decay * dt / 2.0).exp();
+    let p = lyapunov::discrete(&(acl_d / rho), &Mat::identity(n, n)).map_err(|e| e.to_string())?;
+    if lyapunov::min_eigenvalue(&p) <= 0.0 {
+        return Err("no discrete Lyapunov certificate".into());
+    }
+    let lhs = acl_d.transpose() * &p * acl_d - &p * (rho * rho);
+    Ok((rho, lhs.symmetric_eigen().eigenvalues.max()))
+}
+
+pub(super) fn design(model: &Model, decay: f64, poles: Option<&Poles>, method: Method, path: Path, dt: f64) -> Result<Designed, DesignError> {
+    let mut checks = Checks::new(KIND);
+    if !(decay >= 0.0 && decay.is_finite()) {
+        return Err(checks.error("decay", format!("{decay} must be finite and ≥ 0")));
+    }
+    let (b2, d) = (&model.e, &model.d);
+    let mut notes = Vec::new();
+    let lmi = match path {
+        Path::Placement => None,
+        Path::Lmi => Some(solve_lmi(model, decay, &mut checks)?),
+    };
+    let lmi_l = lmi.as_ref().map(|s| s.p.clone().lu().solve(&s.y).expect("P ≻ 0 is invertible"));
+    let ct = core(&model.a, &model.c, b2, d, decay, poles, method, lmi_l.as_ref(), Domain::Continuous, &mut checks)?;
+    let poles_c = eig(&ct.acl);
+    let slowest = poles_c.iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
+    checks.require(
+        &format!("decay rate {decay}: every Re λ(A1 − LC) < −{}", decay / 2.0),
+        slowest < -decay / 2.0,
+        format!("slowest Re λ = {}", sig(slowest)),
+    )?;
+    let p = match &lmi {
+        Some(s) => {
+            notes.push("L = P⁻¹Y from the LMI solved with Clarabel".into());
+            s.p.clone()
+        }
+        None => {
+            let (p, worst) = certificate(&ct.acl, decay).map_err(|e| checks.error("Lyapunov certificate", e))?;
+            checks.require(
+                "A1ᵀP + PA1 − CᵀYᵀ − YC + αP ⪯ 0, P ⪰ 0.01I (Y = PL)",
+                worst <= 1e-9 * p.amax(),
+                format!("λmax = {}, λmin(P) = {}", sig(worst), sig(lyapunov::min_eigenvalue(&p))),
+            )?;
+            p
+        }
+    };
+
+    // Sampled: the LMI path keeps the LMI's continuous poles, mapped to e^{p·dt}.
+    let dm = model.discretize(dt);
+    let mut sampled = Checks::sampled(KIND, dt);
+    let free_poles = match (&lmi, poles) {
+        (Some(_), _) => {
+            let free: Vec<C64> = poles_c.iter().copied().filter(|z| !ct.fixed.iter().any(|f| (f - z).norm() < 1e-6 * f.norm().max(1.0))).collect();
+            Some(Poles::from_values(&free).map_err(|e| sampled.error("poles", e.to_string()))?)
+        }
+        (None, p) => p.cloned(),
+    };
+    let d_core = core(&dm.a, &dm.c, &dm.e, d, decay, free_poles.as_ref(), method, None, Domain::Discrete(dt), &mut sampled)?;
+    let (rho, worst_d) = discrete_certificate(&d_core.acl, decay, dt).map_err(|e| sampled.error("Lyapunov certificate", e))?;
+    notes.push(format!("sampled decay certificate: ρ = e^(−α·dt/2) = {}, λmax(AᵀPA − ρ²P) = {}", sig(rho), sig(worst_d)));
+    let n = model.n();
+    let proj = Mat::identity(n, n) - &d_core.m * &dm.c;
+    let f = &d_core.acl;
+    let k = &d_core.a1 * &d_core.m + &d_core.l * (Mat::identity(model.p(), model.p()) - &dm.c * &d_core.m);
+    let g = &proj * &dm.b;
+    let runtime = LinearObserver::new(f, &g, &k, &Mat::identity(n, n), &d_core.m);
+    Ok(Designed {
+        report: Report {
+            kind: KIND,
+            conditions: checks.into_list(),
+            poles: poles_c,
+            discrete_poles: eig(f),
+            fixed_modes: ct.fixed,
+            matrices: vec![("M".into(), ct.m), ("A1".into(), ct.a1), ("L".into(), ct.l), ("P".into(), p)],
+            notes,
+        },
+        runtime,
+    })
+}
+
+#[cfg(feature = "lmi")]
+fn solve_lmi(model: &Model, decay: f64, checks: &mut Checks) -> Result<LmiSolution, DesignError> {
+    let dec = decoupling(&model.a, &model.e, &model.c, &model.d).map_err(|e| checks.error("decoupling", e.to_string()))?;
+    crate::lmi::solve(&dec.a1, &model.c, &model.d, decay).map_err(|e| checks.error("LMI", e))
+}
+
+#[cfg(not(feature = "lmi"))]
+fn solve_lmi(_: &Model, _: f64, checks: &mut Checks) -> Result<LmiSolution, DesignError> {
+    Err(checks.error("LMI", "this build has no LMI solver: rebuild with `--features observer/lmi` (needs a system BLAS/LAPACK)"))
+}

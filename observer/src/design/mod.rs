@@ -1,0 +1,281 @@
+//! Observer designs, one file per family, each with the paper's continuous-time form (for the
+//! design report and the printed numbers) and its sampled-data counterpart (what the observer
+//! process runs).
+//!
+//! Every design is computed by one function of the model matrices, called twice: on (A, B, E)
+//! with the requested poles p, and on the exact sampling (A_d, B_d, E_d) with poles e^{p·dt}.
+//! Decoupling conditions such as TE = 0 then hold for the sampled plant exactly, so a
+//! piecewise-constant unknown input leaves no error at the samples; a merely discretised
+//! continuous observer would leave one of order dt.
+//!
+//! All sampled designs reduce to one runtime form ([`LinearObserver`]):
+//! z_{k+1} = F z_k + G u_k + K y_k, x̂_k = P z_k + Q y_k.
+
+mod chen_patton;
+mod cumming;
+mod das_ghosal;
+mod gi_full_order;
+mod hui_zak;
+mod luenberger;
+
+use lti::eig::{eigenvalues, format_list, format_one};
+use lti::place::{place_observer, Method};
+use lti::staircase::observability_staircase;
+use lti::{Mat, Model, Poles, C64};
+
+use crate::runtime::LinearObserver;
+
+pub use hui_zak::{lmi_available, LmiSolution, Path};
+
+/// Which observer, with its free parameters.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Spec {
+    /// Full-order Luenberger observer: x̂˙ = Ax̂ + Bu + L(y − Cx̂).
+    Luenberger { poles: Poles, placement: Method },
+    /// Chen & Patton's unknown-input decoupling observer (seed 002).
+    ChenPatton { poles: Poles, placement: Method },
+    /// Das & Ghosal reduced-order observer (seed 003).
+    DasGhosal { poles: Poles, placement: Method },
+    /// Das & Ghosal reduced-order unknown-input observer (seed 000): either H given, or poles.
+    DasGhosalUio { h: Option<Mat>, poles: Option<Poles>, placement: Method },
+    /// Full-order observer by the generalized inverse (seed 001).
+    GiFullOrder { poles: Poles, placement: Method },
+    /// Cumming's reduced-order observer (seed 003); H completes C to an invertible [C; H].
+    Cumming { poles: Poles, placement: Method, h: Option<Mat> },
+    /// Hui & Żak's projection unknown-input observer (seed 004).
+    HuiZak { decay: f64, poles: Option<Poles>, placement: Method, path: Path },
+}
+
+impl Spec {
+    /// The scenario name of this kind.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Spec::Luenberger { .. } => "luenberger",
+            Spec::ChenPatton { .. } => "chen-patton-uio",
+            Spec::DasGhosal { .. } => "das-ghosal",
+            Spec::DasGhosalUio { .. } => "das-ghosal-uio",
+            Spec::GiFullOrder { .. } => "gi-full-order",
+            Spec::Cumming { .. } => "cumming",
+            Spec::HuiZak { .. } => "hui-zak-uio",
+        }
+    }
+
+    /// True for designs that reject the unknown inputs.
+    pub fn decouples(&self) -> bool {
+        matches!(self, Spec::ChenPatton { .. } | Spec::DasGhosalUio { .. } | Spec::HuiZak { .. })
+    }
+}
+
+/// One existence condition, evaluated.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Condition {
+    /// What is checked, as the paper writes it, e.g. "rank(CE) = rank(E)".
+    pub name: String,
+    /// Whether it holds.
+    pub ok: bool,
+    /// The values behind the verdict, e.g. "1 = 1".
+    pub detail: String,
+}
+
+/// What a design computed: conditions, the paper's matrices, eigenvalues.
+#[derive(Debug, Clone)]
+pub struct Report {
+    /// Scenario kind.
+    pub kind: &'static str,
+    /// Every condition evaluated, in order.
+    pub conditions: Vec<Condition>,
+    /// The continuous-time design matrices under the papers' names.
+    pub matrices: Vec<(String, Mat)>,
+    /// Continuous-time error-dynamics eigenvalues, sorted.
+    pub poles: Vec<C64>,
+    /// Eigenvalues of the sampled observer's F, sorted.
+    pub discrete_poles: Vec<C64>,
+    /// Modes no admissible gain can move (invariant zeros, unobservable modes).
+    pub fixed_modes: Vec<C64>,
+    /// Further facts worth showing (certificates, choices made).
+    pub notes: Vec<String>,
+}
+
+/// A finished design: its report and the sampled observer to run.
+#[derive(Debug, Clone)]
+pub struct Designed {
+    /// The design report.
+    pub report: Report,
+    /// The sampled-data observer.
+    pub runtime: LinearObserver,
+}
+
+/// A condition that fails, with everything evaluated up to it.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error("{kind}: {condition} does not hold: {detail}")]
+pub struct DesignError {
+    /// Scenario kind.
+    pub kind: &'static str,
+    /// The failing condition's name.
+    pub condition: String,
+    /// Why.
+    pub detail: String,
+    /// All conditions evaluated, the failing one last.
+    pub conditions: Vec<Condition>,
+}
+
+/// Continuous or sampled: decides what "stable" means and how poles map.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Domain {
+    /// s-plane: stable means Re s < 0.
+    Continuous,
+    /// z-plane with period dt: stable means |z| < 1.
+    Discrete(f64),
+}
+
+impl Domain {
+    /// Whether an eigenvalue is asymptotically stable here, with a margin for rounding: a mode
+    /// computed as −1e−17 is marginal (an integrator), not stable.
+    pub fn stable(self, z: C64) -> bool {
+        match self {
+            Domain::Continuous => z.re < -1e-10 * z.norm().max(1.0),
+            Domain::Discrete(_) => z.norm() < 1.0 - 1e-13,
+        }
+    }
+
+    /// The requested continuous poles, mapped to this domain.
+    pub fn poles(self, p: &Poles) -> Poles {
+        match self {
+            Domain::Continuous => p.clone(),
+            Domain::Discrete(dt) => p.to_discrete(dt),
+        }
+    }
+}
+
+/// Collects conditions; a failing required one ends the design with a [`DesignError`].
+pub(crate) struct Checks {
+    kind: &'static str,
+    prefix: String,
+    list: Vec<Condition>,
+}
+
+impl Checks {
+    pub(crate) fn new(kind: &'static str) -> Self {
+        Self { kind, prefix: String::new(), list: Vec::new() }
+    }
+
+    /// Checks of the sampled design: names are prefixed so an error says which design failed.
+    pub(crate) fn sampled(kind: &'static str, dt: f64) -> Self {
+        Self { kind, prefix: format!("sampled design (dt = {dt}): "), list: Vec::new() }
+    }
+
+    /// Records a condition that must hold.
+    pub(crate) fn require(&mut self, name: &str, ok: bool, detail: impl Into<String>) -> Result<(), DesignError> {
+        let detail = detail.into();
+        let name = format!("{}{name}", self.prefix);
+        self.list.push(Condition { name: name.clone(), ok, detail: detail.clone() });
+        if ok { Ok(()) } else { Err(DesignError { kind: self.kind, condition: name, detail, conditions: self.list.clone() }) }
+    }
+
+    /// An error for `name`, carrying the conditions so far.
+    pub(crate) fn error(&self, name: &str, detail: impl Into<String>) -> DesignError {
+        let condition = format!("{}{name}", self.prefix);
+        DesignError { kind: self.kind, condition, detail: detail.into(), conditions: self.list.clone() }
+    }
+
+    /// The last recorded condition (to record an informative verdict that does not stop the design).
+    pub(crate) fn list_last_mut(&mut self) -> &mut Condition {
+        self.list.last_mut().expect("a condition was recorded")
+    }
+
+    pub(crate) fn into_list(self) -> Vec<Condition> {
+        self.list
+    }
+}
+
+/// An observer gain for the pair (A, C) placing `poles` on its observable part; the
+/// unobservable modes stay where they are and are returned as fixed modes.
+///
+/// With the staircase Qᵀ A Q = [[A_o, 0], [A₂₁, A_u]], C Q = [C_o, 0], the gain L = Q [L_o; 0]
+/// gives Qᵀ(A − LC)Q = [[A_o − L_oC_o, 0], [A₂₁, A_u]]: eig = eig(A_o − L_oC_o) ∪ eig(A_u).
+pub(crate) fn place_detectable(
+    checks: &mut Checks,
+    a: &Mat,
+    c: &Mat,
+    poles: &Poles,
+    method: Method,
+    pair: &str,
+    domain: Domain,
+) -> Result<(Mat, Vec<C64>), DesignError> {
+    let n = a.nrows();
+    let stairs = observability_staircase(a, c);
+    let fixed = stairs.unobservable_modes().map_err(|e| checks.error(pair, e.to_string()))?;
+    if stairs.no == n {
+        let placed = place_observer(a, c, poles, method).map_err(|e| checks.error("pole placement", e.to_string()))?;
+        return Ok((placed.gain, Vec::new()));
+    }
+    let what = if domain == Domain::Continuous { "Re < 0" } else { "|z| < 1" };
+    let unstable: Vec<C64> = fixed.iter().copied().filter(|&z| !domain.stable(z)).collect();
+    checks.require(
+        &format!("{pair} detectable"),
+        unstable.is_empty(),
+        if unstable.is_empty() {
+            format!("unobservable modes {} have {what}", format_list(&fixed))
+        } else {
+            format!("unobservable mode(s) {} not stable", format_list(&unstable))
+        },
+    )?;
+    if poles.len() != stairs.no {
+        return Err(checks.error(
+            "poles",
+            format!(
+                "{pair} has {} fixed mode(s) {}; give {} pole(s) for the observable part, {} given",
+                n - stairs.no,
+                format_list(&fixed),
+                stairs.no,
+                poles.len()
+            ),
+        ));
+    }
+    let (ao, co) = stairs.observable_part();
+    let placed = place_observer(&ao, &co, poles, method).map_err(|e| checks.error("pole placement", e.to_string()))?;
+    let l = stairs.q.columns(0, stairs.no) * placed.gain;
+    Ok((l, fixed))
+}
+
+/// Sorted eigenvalues (design matrices are small and finite; failure is a bug upstream).
+pub(crate) fn eig(m: &Mat) -> Vec<C64> {
+    eigenvalues(m).unwrap_or_default()
+}
+
+/// "rank X = r" style details.
+pub(crate) fn eq_detail(a: usize, b: usize) -> String {
+    format!("{a} {} {b}", if a == b { "=" } else { "≠" })
+}
+
+/// Checks that every eigenvalue is stable in `domain`.
+pub(crate) fn require_stable(checks: &mut Checks, name: &str, ev: &[C64], domain: Domain) -> Result<(), DesignError> {
+    let bad: Vec<String> = ev.iter().filter(|&&z| !domain.stable(z)).map(|&z| format_one(z, true)).collect();
+    if bad.is_empty() {
+        checks.require(name, true, format_list(ev))
+    } else {
+        checks.require(name, false, format!("unstable eigenvalue(s) {}", bad.join(", ")))
+    }
+}
+
+/// Designs the observer for `model`, sampled with period `dt`.
+pub fn design(model: &Model, spec: &Spec, dt: f64) -> Result<Designed, DesignError> {
+    match spec {
+        Spec::Luenberger { poles, placement } => luenberger::design(model, poles, *placement, dt),
+        Spec::ChenPatton { poles, placement } => chen_patton::design(model, poles, *placement, dt),
+        Spec::DasGhosal { poles, placement } => das_ghosal::design(model, das_ghosal::Gain::Poles(poles.clone(), *placement), false, dt),
+        Spec::DasGhosalUio { h, poles, placement } => {
+            let gain = match (h, poles) {
+                (Some(h), _) => das_ghosal::Gain::Free(h.clone()),
+                (None, Some(p)) => das_ghosal::Gain::Poles(p.clone(), *placement),
+                (None, None) => {
+                    return Err(Checks::new("das-ghosal-uio").error("H or poles", "give H = [[…]] or poles = […]"));
+                }
+            };
+            das_ghosal::design(model, gain, true, dt)
+        }
+        Spec::GiFullOrder { poles, placement } => gi_full_order::design(model, poles, *placement, dt),
+        Spec::Cumming { poles, placement, h } => cumming::design(model, poles, *placement, h.as_ref(), dt),
+        Spec::HuiZak { decay, poles, placement, path } => hui_zak::design(model, *decay, poles.as_ref(), *placement, *path, dt),
+    }
+}

@@ -1,0 +1,161 @@
+//! The sampled-data observer every design reduces to, as a step function.
+//!
+//! ```text
+//! z_{k+1} = F z_k + G u_k + K y_k,      x̂_k = P z_k + Q y_k,      z_0 = 0.
+//! ```
+//!
+//! At step k the observer is given y_k and u_{k−1} (the input the plant held over the last
+//! step): it first advances z_{k−1} → z_k with the stored y_{k−1}, then forms x̂_k. All buffers are
+//! allocated at construction; `step` does not allocate.
+
+use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
+
+/// A dense matrix in a serialisable, row-major form.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MatData {
+    /// Number of rows.
+    pub rows: usize,
+    /// Number of columns.
+    pub cols: usize,
+    /// Entries, row by row.
+    pub data: Vec<f64>,
+}
+
+impl From<&DMatrix<f64>> for MatData {
+    fn from(m: &DMatrix<f64>) -> Self {
+        let data = (0..m.nrows()).flat_map(|i| m.row(i).iter().copied().collect::<Vec<_>>()).collect();
+        MatData { rows: m.nrows(), cols: m.ncols(), data }
+    }
+}
+
+impl From<&MatData> for DMatrix<f64> {
+    fn from(m: &MatData) -> Self {
+        DMatrix::from_row_slice(m.rows, m.cols, &m.data)
+    }
+}
+
+/// The matrices of a sampled observer (what the launcher sends to an observer process).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LinearObserver {
+    /// F, r×r.
+    pub f: MatData,
+    /// G, r×l.
+    pub g: MatData,
+    /// K, r×p.
+    pub k: MatData,
+    /// P, n×r.
+    pub p: MatData,
+    /// Q, n×p.
+    pub q: MatData,
+}
+
+impl LinearObserver {
+    /// From the five matrices.
+    pub fn new(f: &DMatrix<f64>, g: &DMatrix<f64>, k: &DMatrix<f64>, p: &DMatrix<f64>, q: &DMatrix<f64>) -> Self {
+        Self { f: f.into(), g: g.into(), k: k.into(), p: p.into(), q: q.into() }
+    }
+
+    /// Observer order r (size of z).
+    pub fn order(&self) -> usize {
+        self.f.rows
+    }
+
+    /// Number of estimated states n.
+    pub fn states(&self) -> usize {
+        self.p.rows
+    }
+
+    /// Number of outputs p.
+    pub fn outputs(&self) -> usize {
+        self.k.cols
+    }
+
+    /// Number of known inputs l.
+    pub fn inputs(&self) -> usize {
+        self.g.cols
+    }
+
+    /// Checks that the five matrices conform.
+    pub fn check(&self) -> Result<(), String> {
+        let r = self.f.rows;
+        let ok = self.f.cols == r
+            && self.g.rows == r
+            && self.k.rows == r
+            && self.p.cols == r
+            && self.q.rows == self.p.rows
+            && self.q.cols == self.k.cols
+            && [&self.f, &self.g, &self.k, &self.p, &self.q].iter().all(|m| m.data.len() == m.rows * m.cols);
+        if ok { Ok(()) } else { Err("observer matrices do not conform".into()) }
+    }
+
+    /// A runnable instance with zero initial state.
+    pub fn instantiate(&self) -> ObserverState {
+        let r = self.order();
+        ObserverState {
+            f: (&self.f).into(),
+            g: (&self.g).into(),
+            k: (&self.k).into(),
+            p: (&self.p).into(),
+            q: (&self.q).into(),
+            z: DVector::zeros(r),
+            z_next: DVector::zeros(r),
+            y: DVector::zeros(self.outputs()),
+            y_prev: DVector::zeros(self.outputs()),
+            u_prev: DVector::zeros(self.inputs()),
+            xhat: DVector::zeros(self.states()),
+            started: false,
+        }
+    }
+}
+
+/// A running observer: matrices and preallocated state.
+#[derive(Debug, Clone)]
+pub struct ObserverState {
+    f: DMatrix<f64>,
+    g: DMatrix<f64>,
+    k: DMatrix<f64>,
+    p: DMatrix<f64>,
+    q: DMatrix<f64>,
+    z: DVector<f64>,
+    z_next: DVector<f64>,
+    y: DVector<f64>,
+    y_prev: DVector<f64>,
+    u_prev: DVector<f64>,
+    xhat: DVector<f64>,
+    started: bool,
+}
+
+impl ObserverState {
+    /// One step: takes y_k and u_{k−1}, returns x̂_k.
+    pub fn step(&mut self, y: &[f64], u_prev: &[f64]) -> &[f64] {
+        self.y.as_mut_slice().copy_from_slice(y);
+        if self.started {
+            self.u_prev.as_mut_slice().copy_from_slice(u_prev);
+            self.z_next.gemv(1.0, &self.f, &self.z, 0.0);
+            self.z_next.gemv(1.0, &self.g, &self.u_prev, 1.0);
+            self.z_next.gemv(1.0, &self.k, &self.y_prev, 1.0);
+            std::mem::swap(&mut self.z, &mut self.z_next);
+        }
+        self.started = true;
+        self.xhat.gemv(1.0, &self.p, &self.z, 0.0);
+        self.xhat.gemv(1.0, &self.q, &self.y, 1.0);
+        std::mem::swap(&mut self.y, &mut self.y_prev);
+        self.xhat.as_slice()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn first_step_uses_zero_state_then_advances() {
+        // z⁺ = 0.5 z + u + y, x̂ = z + 2y.
+        let one = |v: f64| DMatrix::from_element(1, 1, v);
+        let obs = LinearObserver::new(&one(0.5), &one(1.0), &one(1.0), &one(1.0), &one(2.0));
+        let mut s = obs.instantiate();
+        assert_eq!(s.step(&[3.0], &[0.0]), &[6.0]); // z0 = 0
+        assert_eq!(s.step(&[1.0], &[10.0]), &[15.0]); // z1 = 0 + 10 + 3 = 13, x̂ = 13 + 2
+    }
+}
