@@ -1,1 +1,38 @@
-// placeholder
+//! The lockstep transport: sample types, service names and the per-step protocol over iceoryx2
+//! publish–subscribe, shared by the plant, observer and controller processes and the launcher.
+//!
+//! ## Protocol
+//!
+//! Every run has its own iceoryx2 prefix and root directory ([`RunSpace`]), so runs never meet.
+//! Each component publishes one [`Sample`] per step on its own service and waits for exactly the
+//! samples of the same step from the services it reads:
+//!
+//! ```text
+//! plant:       publish y_k ─▶ wait x̂_k of every observer, and u_k of the controller ─▶ x_{k+1}
+//! observer i:  wait y_k    ─▶ x̂_k = step(y_k, u_{k−1}) ─▶ publish x̂_k
+//! controller:  wait x̂_k of its observer ─▶ u_k = r_k − G x̂_k ─▶ publish u_k
+//! ```
+//!
+//! A sample whose step counter is not the one expected is an error ([`LockstepError::Step`]).
+//! No first sample is lost: components create all their ports, report "ready" to the launcher,
+//! and publish only after the launcher's "go", when every subscriber already exists.
+//! The launcher records every sample from its own subscribers, whose large buffers and the
+//! publishers' retry-until-delivered back-pressure mean no sample is ever dropped.
+
+mod clock;
+mod error;
+mod handshake;
+mod layout;
+mod port;
+mod run;
+mod sample;
+mod wait;
+
+pub use clock::now_ns;
+pub use error::LockstepError;
+pub use handshake::{die_with_parent, parse_launch, ready_then_wait_for_go, Launch, EXIT_USAGE};
+pub use layout::PlantLayout;
+pub use port::{Bus, Inlet, Outlet, Reader, RECORDER_BUFFER};
+pub use run::{cleanup_dead_runs, RunSpace, RUNS_DIR_ENV};
+pub use sample::{Header, Sample, MAX_VALUES};
+pub use wait::Wait;

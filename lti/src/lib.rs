@@ -26,7 +26,7 @@ pub mod zeros;
 pub use eig::C64;
 pub use error::{LtiError, Result};
 pub use nalgebra::DMatrix;
-pub use model::{Discrete, Model};
+pub use model::{Discrete, MatData, Model};
 pub use poles::{PoleSpec, Poles};
 
 /// A real matrix.

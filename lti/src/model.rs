@@ -8,6 +8,7 @@
 //! E and D may have no columns.
 
 use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
 
 use crate::discretize::zoh;
 
@@ -67,3 +68,28 @@ impl Model {
         Discrete { a, b, c: self.c.clone(), e, d: self.d.clone(), dt }
     }
 }
+
+/// A dense matrix in a serialisable, row-major form.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MatData {
+    /// Number of rows.
+    pub rows: usize,
+    /// Number of columns.
+    pub cols: usize,
+    /// Entries, row by row.
+    pub data: Vec<f64>,
+}
+
+impl From<&DMatrix<f64>> for MatData {
+    fn from(m: &DMatrix<f64>) -> Self {
+        let data = (0..m.nrows()).flat_map(|i| m.row(i).iter().copied().collect::<Vec<_>>()).collect();
+        MatData { rows: m.nrows(), cols: m.ncols(), data }
+    }
+}
+
+impl From<&MatData> for DMatrix<f64> {
+    fn from(m: &MatData) -> Self {
+        DMatrix::from_row_slice(m.rows, m.cols, &m.data)
+    }
+}
+

@@ -7,6 +7,9 @@
 
 use serde::{Deserialize, Serialize};
 
+/// Relative tolerance (in steps) within which a switching time counts as falling on a sample.
+pub const SAMPLE_NUDGE: f64 = 1e-9;
+
 /// A scalar signal as a scenario describes it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
@@ -95,6 +98,13 @@ impl Signal {
     /// s(t).
     pub fn value(&self, t: f64) -> f64 {
         self.sine_at(t) + self.held(t)
+    }
+
+    /// The value a sampler sees at t_k = k·dt: the sine at t_k and the held part just after
+    /// t_k, so that a switch scheduled at t_k (but computed a rounding error later) counts as
+    /// already made — the same convention the plant's step splitting uses.
+    pub fn sample(&self, t: f64, dt: f64) -> f64 {
+        self.sine_at(t) + self.held(t + SAMPLE_NUDGE * dt)
     }
 
     /// The sinusoidal part: (amplitude, ω in rad/s, phase), if any.

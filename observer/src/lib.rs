@@ -5,6 +5,7 @@ pub mod design;
 #[cfg(feature = "lmi")]
 mod lmi;
 pub mod runtime;
+pub mod shell;
 
 pub use design::{design, Designed, DesignError, Report, Spec};
 pub use runtime::{LinearObserver, ObserverState};

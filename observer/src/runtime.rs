@@ -8,32 +8,9 @@
 //! step): it first advances z_{k−1} → z_k with the stored y_{k−1}, then forms x̂_k. All buffers are
 //! allocated at construction; `step` does not allocate.
 
+use lti::MatData;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
-
-/// A dense matrix in a serialisable, row-major form.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct MatData {
-    /// Number of rows.
-    pub rows: usize,
-    /// Number of columns.
-    pub cols: usize,
-    /// Entries, row by row.
-    pub data: Vec<f64>,
-}
-
-impl From<&DMatrix<f64>> for MatData {
-    fn from(m: &DMatrix<f64>) -> Self {
-        let data = (0..m.nrows()).flat_map(|i| m.row(i).iter().copied().collect::<Vec<_>>()).collect();
-        MatData { rows: m.nrows(), cols: m.ncols(), data }
-    }
-}
-
-impl From<&MatData> for DMatrix<f64> {
-    fn from(m: &MatData) -> Self {
-        DMatrix::from_row_slice(m.rows, m.cols, &m.data)
-    }
-}
 
 /// The matrices of a sampled observer (what the launcher sends to an observer process).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -1,1 +1,9 @@
-// placeholder
+//! The plant component: an exact sampled-data integrator of ẋ = Ax + Bu + Ew, y = Cx + Dv
+//! ([`Plant`], a pure step function) and the process shell that runs it in lockstep.
+
+mod config;
+mod plant;
+pub mod shell;
+
+pub use config::{PlantConfig, PlantRun};
+pub use plant::{Divergence, Plant};

@@ -1,0 +1,72 @@
+//! State-feedback design: G placed (any method of [`lti::place`]) or given, and the closed
+//! loop it makes, continuous eig(A − BG) and sampled eig(A_d − B_dG) (G is applied to samples
+//! held over each step). By the separation principle the loop with an observer has these
+//! eigenvalues plus the observer's.
+
+use lti::eig::{eigenvalues, format_list};
+use lti::place::{place, Method};
+use lti::{Mat, Model, Poles, C64};
+
+/// How G is obtained.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FeedbackSpec {
+    /// Place eig(A − BG).
+    Poles {
+        /// Continuous closed-loop poles.
+        poles: Poles,
+        /// Placement method.
+        placement: Method,
+    },
+    /// G given.
+    Gain(Mat),
+}
+
+/// A designed state feedback.
+#[derive(Debug, Clone)]
+pub struct FeedbackDesign {
+    /// G, l×n.
+    pub g: Mat,
+    /// eig(A − BG), sorted.
+    pub closed_loop: Vec<C64>,
+    /// eig(A_d − B_dG), sorted.
+    pub discrete_closed_loop: Vec<C64>,
+    /// The unstable continuous closed-loop eigenvalues (empty when stable).
+    pub unstable: Vec<C64>,
+}
+
+impl FeedbackDesign {
+    /// Whether the continuous and the sampled loops are both asymptotically stable.
+    pub fn stable(&self) -> bool {
+        self.unstable.is_empty() && self.discrete_closed_loop.iter().all(|z| z.norm() < 1.0)
+    }
+
+    /// "unstable closed loop: eig(A − BG) has +122.271" style description, if unstable.
+    pub fn instability(&self) -> Option<String> {
+        if !self.unstable.is_empty() {
+            Some(format!("unstable closed loop: eig(A − BG) has {}", format_list(&self.unstable)))
+        } else if !self.stable() {
+            let bad: Vec<C64> = self.discrete_closed_loop.iter().copied().filter(|z| z.norm() >= 1.0).collect();
+            Some(format!("unstable sampled closed loop: eig(A_d − B_dG) has {} (|z| ≥ 1): dt too coarse", format_list(&bad)))
+        } else {
+            None
+        }
+    }
+}
+
+/// Designs (or checks) G for `model` sampled with period dt.
+pub fn design(model: &Model, spec: &FeedbackSpec, dt: f64) -> Result<FeedbackDesign, String> {
+    let g = match spec {
+        FeedbackSpec::Poles { poles, placement } => place(&model.a, &model.b, poles, *placement).map_err(|e| e.to_string())?.gain,
+        FeedbackSpec::Gain(g) => {
+            if g.shape() != (model.l(), model.n()) {
+                return Err(format!("gain is {}×{}, must be {}×{}", g.nrows(), g.ncols(), model.l(), model.n()));
+            }
+            g.clone()
+        }
+    };
+    let closed_loop = eigenvalues(&(&model.a - &model.b * &g)).map_err(|e| e.to_string())?;
+    let dm = model.discretize(dt);
+    let discrete_closed_loop = eigenvalues(&(&dm.a - &dm.b * &g)).map_err(|e| e.to_string())?;
+    let unstable = closed_loop.iter().copied().filter(|z| z.re >= 0.0).collect();
+    Ok(FeedbackDesign { g, closed_loop, discrete_closed_loop, unstable })
+}

@@ -1,0 +1,249 @@
+//! Ports on the bus: an [`Outlet`] publishes one sample per step, an [`Inlet`] waits for the
+//! sample of a given step, a [`Reader`] drains everything (the launcher's recorder).
+
+use std::mem::MaybeUninit;
+use std::ptr::addr_of_mut;
+use std::time::Duration;
+
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::prelude::*;
+use iceoryx2::service::port_factory::publish_subscribe::PortFactory;
+
+use crate::clock::now_ns;
+use crate::error::LockstepError;
+use crate::run::RunSpace;
+use crate::sample::{Header, Sample, MAX_VALUES};
+use crate::wait::Wait;
+
+/// Buffer of the recorder's subscribers: how many steps the launcher may lag behind.
+pub const RECORDER_BUFFER: usize = 4096;
+/// Buffer of the lockstep subscribers (one sample is ever pending; two leave slack).
+const LOCKSTEP_BUFFER: usize = 2;
+
+/// A process's node on the run's bus.
+pub struct Bus {
+    node: Node<ipc::Service>,
+    wait: Wait,
+}
+
+impl Bus {
+    /// Joins the run's bus as `name` (a node name for diagnostics).
+    pub fn join(space: &RunSpace, name: &str, wait: Wait) -> Result<Self, LockstepError> {
+        let node = NodeBuilder::new()
+            .name(&NodeName::new(name).map_err(LockstepError::ipc)?)
+            .config(space.config())
+            .signal_handling_mode(SignalHandlingMode::Disabled)
+            .create::<ipc::Service>()
+            .map_err(LockstepError::ipc)?;
+        Ok(Self { node, wait })
+    }
+
+    /// The wait strategy in use.
+    pub fn wait(&self) -> Wait {
+        self.wait
+    }
+
+    fn service(&self, topic: &str) -> Result<PortFactory<ipc::Service, Sample, ()>, LockstepError> {
+        // Every port opens the service with the same settings, so any of them may create it.
+        self.node
+            .service_builder(&ServiceName::new(topic).map_err(LockstepError::ipc)?)
+            .publish_subscribe::<Sample>()
+            .max_publishers(1)
+            .max_subscribers(8)
+            .max_nodes(16)
+            .history_size(0)
+            .subscriber_max_buffer_size(RECORDER_BUFFER)
+            .enable_safe_overflow(false)
+            .open_or_create()
+            .map_err(LockstepError::ipc)
+    }
+
+    fn event(&self, topic: &str) -> Result<iceoryx2::service::port_factory::event::PortFactory<ipc::Service>, LockstepError> {
+        self.node
+            .service_builder(&ServiceName::new(&format!("{topic}/wake")).map_err(LockstepError::ipc)?)
+            .event()
+            .max_notifiers(1)
+            .max_listeners(8)
+            .max_nodes(16)
+            .open_or_create()
+            .map_err(LockstepError::ipc)
+    }
+
+    /// The publishing end of `topic`.
+    pub fn outlet(&self, topic: &str) -> Result<Outlet, LockstepError> {
+        let publisher = self
+            .service(topic)?
+            .publisher_builder()
+            .backpressure_strategy(BackpressureStrategy::RetryUntilDelivered)
+            .max_loaned_samples(1)
+            .create()
+            .map_err(LockstepError::ipc)?;
+        let notifier = if self.wait.needs_events() {
+            Some(self.event(topic)?.notifier_builder().create().map_err(LockstepError::ipc)?)
+        } else {
+            None
+        };
+        Ok(Outlet { publisher, notifier })
+    }
+
+    /// A lockstep reading end of `topic`.
+    pub fn inlet(&self, topic: &str) -> Result<Inlet, LockstepError> {
+        let subscriber = self.service(topic)?.subscriber_builder().buffer_size(LOCKSTEP_BUFFER).create().map_err(LockstepError::ipc)?;
+        let listener = if self.wait.needs_events() {
+            Some(self.event(topic)?.listener_builder().create().map_err(LockstepError::ipc)?)
+        } else {
+            None
+        };
+        Ok(Inlet { subscriber, listener, topic: topic.to_string(), wait: self.wait, timeout: Duration::from_secs(10) })
+    }
+
+    /// A recording end of `topic` that never makes the publisher drop a sample.
+    pub fn reader(&self, topic: &str) -> Result<Reader, LockstepError> {
+        let subscriber = self.service(topic)?.subscriber_builder().buffer_size(RECORDER_BUFFER).create().map_err(LockstepError::ipc)?;
+        Ok(Reader { subscriber, topic: topic.to_string() })
+    }
+}
+
+/// Publishes one sample per step.
+pub struct Outlet {
+    publisher: Publisher<ipc::Service, Sample, ()>,
+    notifier: Option<Notifier<ipc::Service>>,
+}
+
+impl Outlet {
+    /// Loans a sample, writes header and values in place, sends it; returns the send time.
+    pub fn send(&self, step: u64, sim_time: f64, taken_ns: u64, values: &[f64]) -> Result<u64, LockstepError> {
+        let n = values.len();
+        assert!(n <= MAX_VALUES, "sample of {n} values exceeds {MAX_VALUES}");
+        let mut sample = self.publisher.loan_uninit().map_err(LockstepError::ipc)?;
+        let p: &mut MaybeUninit<Sample> = sample.payload_mut();
+        let p = p.as_mut_ptr();
+        let sent_ns = now_ns();
+        // SAFETY: every field of the sample is written exactly once below, through raw
+        // pointers into the loaned shared-memory slot, before `assume_init`.
+        let sample = unsafe {
+            addr_of_mut!((*p).step).write(step);
+            addr_of_mut!((*p).sim_time).write(sim_time);
+            addr_of_mut!((*p).sent_ns).write(sent_ns);
+            addr_of_mut!((*p).taken_ns).write(taken_ns);
+            addr_of_mut!((*p).len).write(n as u32);
+            addr_of_mut!((*p).reserved).write(0);
+            let v = addr_of_mut!((*p).values) as *mut f64;
+            std::ptr::copy_nonoverlapping(values.as_ptr(), v, n);
+            std::ptr::write_bytes(v.add(n), 0, MAX_VALUES - n);
+            sample.assume_init()
+        };
+        sample.send().map_err(LockstepError::ipc)?;
+        if let Some(notifier) = &self.notifier {
+            notifier.notify().map_err(LockstepError::ipc)?;
+        }
+        Ok(sent_ns)
+    }
+}
+
+/// Waits for the sample of a given step.
+pub struct Inlet {
+    subscriber: Subscriber<ipc::Service, Sample, ()>,
+    listener: Option<Listener<ipc::Service>>,
+    topic: String,
+    wait: Wait,
+    timeout: Duration,
+}
+
+impl Inlet {
+    /// The service this inlet reads.
+    pub fn topic(&self) -> &str {
+        &self.topic
+    }
+
+    /// How long [`Inlet::wait_step`] waits before giving up.
+    pub fn set_timeout(&mut self, timeout: Duration) {
+        self.timeout = timeout;
+    }
+
+    /// Takes a pending sample, if any, checking its step and copying its values into `out`.
+    pub fn try_step(&self, step: u64, out: &mut [f64]) -> Result<Option<Header>, LockstepError> {
+        let Some(sample) = self.subscriber.receive().map_err(LockstepError::ipc)? else { return Ok(None) };
+        let received_ns = now_ns();
+        let s: &Sample = &sample;
+        if s.step != step {
+            return Err(LockstepError::Step { topic: self.topic.clone(), expected: step, got: s.step });
+        }
+        if s.len as usize != out.len() {
+            return Err(LockstepError::Length { topic: self.topic.clone(), expected: out.len(), got: s.len as usize });
+        }
+        out.copy_from_slice(&s.values[..out.len()]);
+        Ok(Some(Header { step: s.step, sim_time: s.sim_time, sent_ns: s.sent_ns, taken_ns: s.taken_ns, received_ns }))
+    }
+
+    /// Waits for the sample of `step`, copying its values into `out`.
+    pub fn wait_step(&self, step: u64, out: &mut [f64]) -> Result<Header, LockstepError> {
+        let start = now_ns();
+        let limit = self.timeout.as_nanos() as u64;
+        let mut polls: u32 = 0;
+        loop {
+            if let Some(h) = self.try_step(step, out)? {
+                return Ok(h);
+            }
+            polls = polls.wrapping_add(1);
+            match self.wait {
+                Wait::Yield => {
+                    std::thread::yield_now();
+                    if polls % 1024 == 0 && now_ns() - start > limit {
+                        return Err(self.timed_out(step));
+                    }
+                }
+                Wait::Block => self.block(start, limit, step)?,
+                Wait::SpinThenBlock(us) => {
+                    let elapsed = now_ns() - start;
+                    if elapsed < us as u64 * 1000 {
+                        std::thread::yield_now();
+                    } else {
+                        self.block(start, limit, step)?;
+                    }
+                }
+            }
+        }
+    }
+
+    fn block(&self, start: u64, limit: u64, step: u64) -> Result<(), LockstepError> {
+        let elapsed = now_ns() - start;
+        if elapsed > limit {
+            return Err(self.timed_out(step));
+        }
+        let listener = self.listener.as_ref().expect("blocking waits have a listener");
+        let slice = Duration::from_nanos((limit - elapsed).min(100_000_000));
+        listener.timed_wait(|_| {}, slice).map_err(LockstepError::ipc)?;
+        Ok(())
+    }
+
+    fn timed_out(&self, step: u64) -> LockstepError {
+        LockstepError::Timeout { topic: self.topic.clone(), step, secs: self.timeout.as_secs() }
+    }
+}
+
+/// Drains a service without blocking (the recorder).
+pub struct Reader {
+    subscriber: Subscriber<ipc::Service, Sample, ()>,
+    topic: String,
+}
+
+impl Reader {
+    /// The service this reader drains.
+    pub fn topic(&self) -> &str {
+        &self.topic
+    }
+
+    /// Calls `f` for every pending sample, in order; returns how many there were.
+    pub fn drain(&self, mut f: impl FnMut(&Sample)) -> Result<usize, LockstepError> {
+        let mut count = 0;
+        while let Some(sample) = self.subscriber.receive().map_err(LockstepError::ipc)? {
+            f(&sample);
+            count += 1;
+        }
+        Ok(count)
+    }
+}

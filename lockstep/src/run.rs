@@ -1,0 +1,156 @@
+//! One run's private corner of the machine: an iceoryx2 prefix, a root directory, and the
+//! component configurations, all removed when the run ends.
+//!
+//! Layout: `$UIO_RUNS_DIR/<id>/` (default `/tmp/uio-observers/<id>/`, mode 0700) holds
+//! `owner.pid` (the launcher's pid), one `<component>.json` per component, and `iox2/`, the
+//! iceoryx2 root path; shared memory lives in `/dev/shm/uio<id>_*`.
+
+use std::fs;
+use std::io::Write;
+use std::os::unix::fs::{DirBuilderExt, PermissionsExt};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU32, Ordering};
+
+use iceoryx2::prelude::*;
+use iceoryx2_bb_system_types::path::Path as IoxPath;
+
+use crate::error::LockstepError;
+
+/// Environment variable naming the directory that holds run directories.
+pub const RUNS_DIR_ENV: &str = "UIO_RUNS_DIR";
+
+const SHM_DIR: &str = "/dev/shm";
+
+/// A run's identity and its iceoryx2 configuration.
+#[derive(Debug, Clone)]
+pub struct RunSpace {
+    id: String,
+    dir: PathBuf,
+    config: Config,
+}
+
+fn runs_dir() -> PathBuf {
+    std::env::var_os(RUNS_DIR_ENV).map_or_else(|| PathBuf::from("/tmp/uio-observers"), PathBuf::from)
+}
+
+fn io(what: &str, path: &Path, e: std::io::Error) -> LockstepError {
+    LockstepError::Io(format!("{what} {}: {e}", path.display()))
+}
+
+impl RunSpace {
+    /// A new run owned by this process.
+    pub fn create() -> Result<Self, LockstepError> {
+        static COUNTER: AtomicU32 = AtomicU32::new(0);
+        let base = runs_dir();
+        fs::DirBuilder::new().recursive(true).mode(0o700).create(&base).map_err(|e| io("cannot create", &base, e))?;
+        let id = format!(
+            "{}x{}x{}",
+            std::process::id(),
+            COUNTER.fetch_add(1, Ordering::Relaxed),
+            crate::now_ns() % 1_000_000
+        );
+        let dir = base.join(&id);
+        fs::DirBuilder::new().mode(0o700).create(&dir).map_err(|e| io("cannot create", &dir, e))?;
+        fs::DirBuilder::new().mode(0o700).create(dir.join("iox2")).map_err(|e| io("cannot create", &dir, e))?;
+        let mut f = fs::File::create(dir.join("owner.pid")).map_err(|e| io("cannot write", &dir, e))?;
+        writeln!(f, "{}", std::process::id()).map_err(|e| io("cannot write", &dir, e))?;
+        Self::at(id, dir)
+    }
+
+    /// An existing run, as a component started by the launcher sees it.
+    pub fn open(id: &str) -> Result<Self, LockstepError> {
+        if id.is_empty() || !id.chars().all(|c| c.is_ascii_alphanumeric()) {
+            return Err(LockstepError::Io(format!("'{id}' is not a run id")));
+        }
+        let dir = runs_dir().join(id);
+        if !dir.join("owner.pid").is_file() {
+            return Err(LockstepError::Io(format!("no run '{id}' in {}", runs_dir().display())));
+        }
+        Self::at(id.to_string(), dir)
+    }
+
+    fn at(id: String, dir: PathBuf) -> Result<Self, LockstepError> {
+        let mut config = Config::global_config().clone();
+        config.global.prefix = FileName::new(format!("uio{id}_").as_bytes()).map_err(LockstepError::ipc)?;
+        let root = format!("{}/", dir.join("iox2").display());
+        config.global.set_root_path(&IoxPath::new(root.as_bytes()).map_err(LockstepError::ipc)?);
+        Ok(Self { id, dir, config })
+    }
+
+    /// The run id (alphanumeric).
+    pub fn id(&self) -> &str {
+        &self.id
+    }
+
+    /// The run directory.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// The iceoryx2 configuration with this run's prefix and root.
+    pub fn config(&self) -> &Config {
+        &self.config
+    }
+
+    /// Where a component's configuration is written.
+    pub fn config_path(&self, component: &str) -> PathBuf {
+        self.dir.join(format!("{component}.json"))
+    }
+
+    /// Writes a component configuration (owner-only permissions).
+    pub fn write_config(&self, component: &str, json: &str) -> Result<(), LockstepError> {
+        let path = self.config_path(component);
+        fs::write(&path, json).map_err(|e| io("cannot write", &path, e))?;
+        fs::set_permissions(&path, fs::Permissions::from_mode(0o600)).map_err(|e| io("cannot chmod", &path, e))
+    }
+
+    /// Reads a component configuration.
+    pub fn read_config(&self, component: &str) -> Result<String, LockstepError> {
+        let path = self.config_path(component);
+        fs::read_to_string(&path).map_err(|e| io("cannot read", &path, e))
+    }
+
+    /// The shared-memory files of this run that exist now.
+    pub fn shm_files(&self) -> Vec<PathBuf> {
+        shm_files_with_prefix(&format!("uio{}_", self.id))
+    }
+
+    /// Removes every file of the run: its shared memory and its directory.
+    pub fn remove(&self) {
+        for f in self.shm_files() {
+            let _ = fs::remove_file(f);
+        }
+        let _ = fs::remove_dir_all(&self.dir);
+    }
+}
+
+fn shm_files_with_prefix(prefix: &str) -> Vec<PathBuf> {
+    let Ok(entries) = fs::read_dir(SHM_DIR) else { return Vec::new() };
+    entries
+        .flatten()
+        .filter(|e| e.file_name().to_string_lossy().starts_with(prefix))
+        .map(|e| e.path())
+        .collect()
+}
+
+/// Removes what runs whose launcher has died left behind; returns how many were cleaned.
+pub fn cleanup_dead_runs() -> usize {
+    let Ok(entries) = fs::read_dir(runs_dir()) else { return 0 };
+    let mut cleaned = 0;
+    for entry in entries.flatten() {
+        let id = entry.file_name().to_string_lossy().to_string();
+        let owner = fs::read_to_string(entry.path().join("owner.pid")).ok().and_then(|s| s.trim().parse::<i32>().ok());
+        let alive = owner.is_some_and(|pid| {
+            // SAFETY: kill with signal 0 only checks for existence and permission.
+            unsafe { libc::kill(pid, 0) == 0 || *libc::__errno_location() == libc::EPERM }
+        });
+        if !alive {
+            for f in shm_files_with_prefix(&format!("uio{id}_")) {
+                let _ = fs::remove_file(f);
+            }
+            let _ = fs::remove_dir_all(entry.path());
+            cleaned += 1;
+        }
+    }
+    cleaned
+}

@@ -1,0 +1,275 @@
+//! Exact sampled-data integration of the plant over each step.
+//!
+//! Over a stretch [t₀, t₀ + h] in which u and the piecewise-constant parts c(t) of the
+//! disturbances are constant, each disturbance is w_i(t) = a_i sin(ω_i t + φ_i) + c_i, and the
+//! generator g_i = [sin(ω_i t + φ_i), cos(ω_i t + φ_i)] obeys ġ_i = [0 ω_i; −ω_i 0] g_i. With
+//! ξ = [u; c; g₁; …] the augmented input,
+//!
+//! ```text
+//! x(t₀ + h) = Φ_h x(t₀) + Γ_h ξ(t₀),    [Φ_h Γ_h] = top rows of exp([[A, G], [0, W]] h),
+//! G = [B, E, a₁E₁ e₁ᵀ, …],  W = blockdiag(0, 0, Ω₁, …)
+//! ```
+//!
+//! is exact: nothing inside the step is approximated. A step that contains a switching time of
+//! some c(t) is split there; its pieces' exponentials are computed once, at construction. The
+//! generator is re-evaluated from t at every step rather than propagated, so it cannot drift.
+
+use lockstep::PlantLayout;
+use lti::discretize::exp_upper;
+use lti::signal::{Signal, SAMPLE_NUDGE};
+use nalgebra::{DMatrix, DVector};
+
+use crate::config::PlantConfig;
+
+/// A stretch of a step with its transition matrices.
+#[derive(Debug, Clone)]
+struct Piece {
+    /// Offset of the stretch from t_k, s.
+    offset: f64,
+    /// Length, s.
+    h: f64,
+    phi: DMatrix<f64>,
+    gamma: DMatrix<f64>,
+}
+
+/// A state left its bound or became non-finite.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Divergence {
+    /// The step whose result diverged (x_{step+1}).
+    pub step: u64,
+    /// The signal, e.g. "x[2]".
+    pub signal: String,
+    /// Its value.
+    pub value: f64,
+    /// The bound it exceeded.
+    pub bound: f64,
+}
+
+impl std::fmt::Display for Divergence {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.value.is_finite() {
+            write!(f, "{} = {:.6e} left the bound ±{:.3e} at step {}", self.signal, self.value, self.bound, self.step + 1)
+        } else {
+            write!(f, "{} = {} at step {}", self.signal, self.value, self.step + 1)
+        }
+    }
+}
+
+/// The plant as a step function.
+#[derive(Debug, Clone)]
+pub struct Plant {
+    dt: f64,
+    bound: f64,
+    disturbances: Vec<Signal>,
+    measurement: Vec<Signal>,
+    inputs: Vec<Signal>,
+    /// (disturbance index, ω, φ) of each sinusoidal part.
+    sines: Vec<(usize, f64, f64)>,
+    c: DMatrix<f64>,
+    d: DMatrix<f64>,
+    full: Piece,
+    /// Steps split at switching times, sorted by step.
+    splits: Vec<(u64, Vec<Piece>)>,
+    next_split: usize,
+    layout: PlantLayout,
+    x: DVector<f64>,
+    x_next: DVector<f64>,
+    xi: DVector<f64>,
+    v: DVector<f64>,
+    y: DVector<f64>,
+    u_prev: Vec<f64>,
+    out: Vec<f64>,
+}
+
+impl Plant {
+    /// Precomputes the transition matrices; fails on inconsistent sizes.
+    pub fn new(cfg: &PlantConfig) -> Result<Self, String> {
+        let a: DMatrix<f64> = (&cfg.a).into();
+        let b: DMatrix<f64> = (&cfg.b).into();
+        let c: DMatrix<f64> = (&cfg.c).into();
+        let e: DMatrix<f64> = (&cfg.e).into();
+        let d: DMatrix<f64> = (&cfg.d).into();
+        let (n, l, q, p, r) = (a.nrows(), b.ncols(), e.ncols(), c.nrows(), d.ncols());
+        let consistent = a.ncols() == n
+            && b.nrows() == n
+            && e.nrows() == n
+            && c.ncols() == n
+            && d.nrows() == p
+            && cfg.x0.len() == n
+            && cfg.disturbances.len() == q
+            && cfg.measurement_disturbances.len() == r
+            && cfg.inputs.len() == l;
+        if !consistent {
+            return Err("plant configuration: matrix and signal sizes do not conform".into());
+        }
+        let sines: Vec<(usize, f64, f64)> = cfg
+            .disturbances
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| s.sine().map(|(_, w, ph)| (i, w, ph)))
+            .collect();
+        let m = l + q + 2 * sines.len();
+        let mut g = DMatrix::<f64>::zeros(n, m);
+        g.columns_mut(0, l).copy_from(&b);
+        g.columns_mut(l, q).copy_from(&e);
+        let mut w = DMatrix::<f64>::zeros(m, m);
+        for (j, &(i, omega, _)) in sines.iter().enumerate() {
+            let amp = cfg.disturbances[i].sine().map_or(0.0, |s| s.0);
+            let col = l + q + 2 * j;
+            g.set_column(col, &(e.column(i) * amp));
+            w[(col, col + 1)] = omega;
+            w[(col + 1, col)] = -omega;
+        }
+        let piece = |offset: f64, h: f64| {
+            let (phi, gamma) = exp_upper(&a, &g, &w, h);
+            Piece { offset, h, phi, gamma }
+        };
+        let full = piece(0.0, cfg.dt);
+        let splits = split_steps(cfg, &piece);
+        let layout = PlantLayout { n, p, q, r, l };
+        Ok(Self {
+            dt: cfg.dt,
+            bound: cfg.state_bound,
+            disturbances: cfg.disturbances.clone(),
+            measurement: cfg.measurement_disturbances.clone(),
+            inputs: cfg.inputs.clone(),
+            sines,
+            c,
+            d,
+            full,
+            splits,
+            next_split: 0,
+            layout,
+            x: DVector::from_column_slice(&cfg.x0),
+            x_next: DVector::zeros(n),
+            xi: DVector::zeros(m),
+            v: DVector::zeros(r),
+            y: DVector::zeros(p),
+            u_prev: vec![0.0; l],
+            out: vec![0.0; layout.len()],
+        })
+    }
+
+    /// Where each signal sits in [`Plant::sample`]'s output.
+    pub fn layout(&self) -> PlantLayout {
+        self.layout
+    }
+
+    /// t_k = k·dt.
+    pub fn time(&self, k: u64) -> f64 {
+        k as f64 * self.dt
+    }
+
+    /// The sample of step k: [x_k | y_k | w(t_k) | v(t_k) | r(t_k) | u_{k−1}].
+    pub fn sample(&mut self, k: u64) -> &[f64] {
+        let t = self.time(k);
+        let lay = self.layout;
+        for (i, s) in self.measurement.iter().enumerate() {
+            self.v[i] = s.sample(t, self.dt);
+        }
+        self.y.gemv(1.0, &self.c, &self.x, 0.0);
+        self.y.gemv(1.0, &self.d, &self.v, 1.0);
+        self.out[lay.x()].copy_from_slice(self.x.as_slice());
+        self.out[lay.y()].copy_from_slice(self.y.as_slice());
+        for (o, s) in self.out[lay.w()].iter_mut().zip(&self.disturbances) {
+            *o = s.sample(t, self.dt);
+        }
+        self.out[lay.v()].copy_from_slice(self.v.as_slice());
+        for (o, s) in self.out[lay.r()].iter_mut().zip(&self.inputs) {
+            *o = s.sample(t, self.dt);
+        }
+        self.out[lay.u_prev()].copy_from_slice(&self.u_prev);
+        &self.out
+    }
+
+    /// The input signals r(t_k) of the last [`Plant::sample`] (the open-loop u_k).
+    pub fn reference(&self) -> &[f64] {
+        &self.out[self.layout.r()]
+    }
+
+    /// x_k → x_{k+1} with u_k held over the step.
+    pub fn advance(&mut self, k: u64, u: &[f64]) -> Result<(), Divergence> {
+        let t = self.time(k);
+        self.u_prev.copy_from_slice(u);
+        let pieces: &[Piece] = match self.splits.get(self.next_split) {
+            Some((s, pieces)) if *s == k => {
+                self.next_split += 1;
+                pieces
+            }
+            _ => std::slice::from_ref(&self.full),
+        };
+        for piece in pieces {
+            integrate(piece, t, u, &self.disturbances, &self.sines, &mut self.xi, &mut self.x, &mut self.x_next);
+        }
+        for (i, &v) in self.x.iter().enumerate() {
+            if !v.is_finite() || v.abs() > self.bound {
+                return Err(Divergence { step: k, signal: format!("x[{i}]"), value: v, bound: self.bound });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// x ← Φ_h x + Γ_h ξ(t₀) for one piece starting at t_k + offset.
+#[allow(clippy::too_many_arguments)]
+fn integrate(
+    piece: &Piece,
+    tk: f64,
+    u: &[f64],
+    disturbances: &[Signal],
+    sines: &[(usize, f64, f64)],
+    xi: &mut DVector<f64>,
+    x: &mut DVector<f64>,
+    x_next: &mut DVector<f64>,
+) {
+    let t0 = tk + piece.offset;
+    let l = u.len();
+    let q = disturbances.len();
+    xi.as_mut_slice()[..l].copy_from_slice(u);
+    // c(t) is constant on the piece: read it at the middle, away from the switching instants.
+    let mid = t0 + 0.5 * piece.h;
+    for (i, s) in disturbances.iter().enumerate() {
+        xi[l + i] = s.held(mid);
+    }
+    for (j, &(_, omega, phase)) in sines.iter().enumerate() {
+        let theta = omega * t0 + phase;
+        xi[l + q + 2 * j] = theta.sin();
+        xi[l + q + 2 * j + 1] = theta.cos();
+    }
+    x_next.gemv(1.0, &piece.phi, x, 0.0);
+    x_next.gemv(1.0, &piece.gamma, xi, 1.0);
+    std::mem::swap(x, x_next);
+}
+
+/// The steps that contain a switching time strictly inside them, with their pieces.
+fn split_steps(cfg: &PlantConfig, piece: &dyn Fn(f64, f64) -> Piece) -> Vec<(u64, Vec<Piece>)> {
+    let dt = cfg.dt;
+    let mut cuts: Vec<(u64, f64)> = Vec::new();
+    for s in &cfg.disturbances {
+        for tb in s.breakpoints() {
+            let kf = tb / dt;
+            let k = kf.floor();
+            let frac = kf - k;
+            if k < 0.0 || k >= cfg.steps as f64 || frac < SAMPLE_NUDGE || 1.0 - frac < SAMPLE_NUDGE {
+                continue; // outside the run, or on a sample (handled by the sampling convention)
+            }
+            cuts.push((k as u64, tb - k * dt));
+        }
+    }
+    cuts.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    cuts.dedup();
+    let mut out: Vec<(u64, Vec<Piece>)> = Vec::new();
+    let mut i = 0;
+    while i < cuts.len() {
+        let k = cuts[i].0;
+        let mut offsets = vec![0.0];
+        while i < cuts.len() && cuts[i].0 == k {
+            offsets.push(cuts[i].1);
+            i += 1;
+        }
+        offsets.push(dt);
+        let pieces = offsets.windows(2).map(|w| piece(w[0], w[1] - w[0])).collect();
+        out.push((k, pieces));
+    }
+    out
+}
