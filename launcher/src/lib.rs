@@ -1,1 +1,15 @@
-// placeholder
+//! The launcher: reads a scenario, designs its observers and controller, runs the components
+//! (as separate processes over iceoryx2, or in one process), and records every signal to a
+//! Rerun `.rrd` with a summary of how each observer did.
+
+pub mod design_report;
+pub mod error;
+pub mod plan;
+pub mod record;
+pub mod recording;
+pub mod run;
+pub mod scenario;
+pub mod summary;
+
+pub use error::LaunchError;
+pub use scenario::Scenario;

@@ -1,1 +1,182 @@
-fn main() {}
+//! `launcher`: run, design and inspect unknown-input-observer co-simulations.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use launcher::error::{LaunchError, EXIT_BAD_INPUT, EXIT_EXPECT};
+use launcher::run::{Mode, Options, Stop};
+use launcher::{design_report, plan, run, Scenario};
+use lockstep::Wait;
+
+#[derive(Parser)]
+#[command(name = "launcher", version, about = "Design and co-simulate unknown input observers for LTI plants")]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a scenario and record it to DIR/<name>.rrd and DIR/<name>.summary.json.
+    Run {
+        /// The scenario file.
+        scenario: PathBuf,
+        /// Output directory.
+        #[arg(long, default_value = "runs")]
+        out: PathBuf,
+        /// Where the components run.
+        #[arg(long, value_parser = ["processes", "in-process"], default_value = "processes")]
+        mode: String,
+        /// How components wait for samples: yield, block, spin-then-block[:µs].
+        #[arg(long)]
+        wait: Option<Wait>,
+        /// Overwrite an existing recording.
+        #[arg(long)]
+        force: bool,
+        /// Run even if the closed loop is unstable (the run stops when a state diverges).
+        #[arg(long)]
+        allow_unstable: bool,
+    },
+    /// Check the existence conditions and show the designs of a scenario.
+    Design {
+        /// The scenario file.
+        scenario: PathBuf,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+    /// List the shipped scenarios.
+    List {
+        /// Directory of scenarios.
+        #[arg(long)]
+        dir: Option<PathBuf>,
+    },
+    /// Run one component (used by the launcher when the component binaries are not beside it).
+    #[command(hide = true, disable_help_flag = true)]
+    Component {
+        /// plant, observer or controller.
+        kind: String,
+        /// The component's own arguments.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
+}
+
+/// The shipped scenarios: ./scenarios, else the repository's.
+fn scenarios_dir() -> PathBuf {
+    let local = PathBuf::from("scenarios");
+    if local.is_dir() { local } else { Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios") }
+}
+
+fn fail(e: &LaunchError) -> ExitCode {
+    eprintln!("error: {e}");
+    ExitCode::from(e.exit_code() as u8)
+}
+
+fn load(path: &Path) -> Result<Scenario, LaunchError> {
+    Ok(Scenario::load(path)?)
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let command = cli.command.unwrap_or_else(|| Command::Run {
+        scenario: scenarios_dir().join("seed002-sine.toml"),
+        out: "runs".into(),
+        mode: "processes".into(),
+        wait: None,
+        force: true,
+        allow_unstable: false,
+    });
+    match command {
+        Command::Run { scenario, out, mode, wait, force, allow_unstable } => {
+            let s = match load(&scenario) {
+                Ok(s) => s,
+                Err(e) => return fail(&e),
+            };
+            let p = match plan::plan(&s) {
+                Ok(p) => p,
+                Err(e) => return fail(&LaunchError::Scenario(e.error)),
+            };
+            for w in &p.warnings {
+                eprintln!("warning: {w}");
+            }
+            let mode = if mode == "in-process" { Mode::InProcess } else { Mode::Processes };
+            let opts = Options { out, mode, wait: wait.unwrap_or_else(Wait::default_for_machine), force, allow_unstable, record: true };
+            match run::run(&s, &p, &opts) {
+                Ok(o) => {
+                    print!("{}", o.summary.table());
+                    if let Some(rrd) = &o.rrd {
+                        println!("recording: {}   (view it with: rerun {})", rrd.display(), rrd.display());
+                    }
+                    match o.stop {
+                        Stop::Completed if o.summary.expectations_met() => ExitCode::SUCCESS,
+                        Stop::Completed => {
+                            eprintln!("error: {}: the run missed its [expect] table", s.path.display());
+                            ExitCode::from(EXIT_EXPECT as u8)
+                        }
+                        Stop::Diverged(w) => fail(&LaunchError::Diverged(format!("{}: run stopped: {w}", s.name))),
+                        Stop::Interrupted(sig) => fail(&LaunchError::Interrupted(format!("{}: run interrupted by {sig}; recording closed", s.name))),
+                        Stop::Failed(w) => fail(&LaunchError::Component(format!("{}: {w}", s.name))),
+                    }
+                }
+                Err(e) => fail(&e),
+            }
+        }
+        Command::Design { scenario, json } => {
+            let s = match load(&scenario) {
+                Ok(s) => s,
+                Err(e) => return fail(&e),
+            };
+            let r = design_report::report(&s);
+            if json {
+                println!("{}", serde_json::to_string_pretty(&r.json).expect("serialises"));
+            } else {
+                print!("{}", r.text);
+            }
+            if r.ok { ExitCode::SUCCESS } else { ExitCode::from(EXIT_BAD_INPUT as u8) }
+        }
+        Command::List { dir } => {
+            let dir = dir.unwrap_or_else(scenarios_dir);
+            let mut files: Vec<PathBuf> = std::fs::read_dir(&dir).map(|d| d.flatten().map(|e| e.path()).filter(|p| p.extension().is_some_and(|x| x == "toml")).collect()).unwrap_or_default();
+            files.sort();
+            for f in files {
+                match Scenario::load(&f) {
+                    Ok(s) => println!("{:<34} {}", s.name, s.description),
+                    Err(e) => println!("{:<34} (invalid: {e})", f.display()),
+                }
+            }
+            ExitCode::SUCCESS
+        }
+        Command::Component { kind, args } => component(&kind, args),
+    }
+}
+
+/// Runs a component's shell in this process (the fallback when its binary is not installed).
+fn component(kind: &str, args: Vec<String>) -> ExitCode {
+    lockstep::die_with_parent();
+    if let Ok(name) = std::ffi::CString::new(kind) {
+        // SAFETY: PR_SET_NAME copies at most 16 bytes from a valid C string.
+        unsafe { libc::prctl(libc::PR_SET_NAME, name.as_ptr()) };
+    }
+    let launch = match lockstep::parse_launch(kind, args) {
+        Ok(l) => l,
+        Err(msg) => {
+            eprintln!("{msg}");
+            return ExitCode::from(lockstep::EXIT_USAGE as u8);
+        }
+    };
+    let code = match kind {
+        "plant" => plant::shell::run(&launch).map_err(|e| (e.exit_code(), e.to_string())),
+        "observer" => observer::shell::run(&launch).map_err(|e| (observer::shell::EXIT_FAILED, e.to_string())),
+        "controller" => controller::shell::run(&launch).map_err(|e| (controller::shell::EXIT_FAILED, e.to_string())),
+        other => Err((lockstep::EXIT_USAGE, format!("unknown component '{other}'"))),
+    };
+    match code {
+        Ok(()) => ExitCode::SUCCESS,
+        Err((c, msg)) => {
+            eprintln!("{kind}: {msg}");
+            ExitCode::from(c as u8)
+        }
+    }
+}

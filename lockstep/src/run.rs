@@ -70,7 +70,8 @@ impl RunSpace {
     }
 
     fn at(id: String, dir: PathBuf) -> Result<Self, LockstepError> {
-        let mut config = Config::global_config().clone();
+        // The built-in defaults, not a config file: runs must not depend on what /etc holds.
+        let mut config = Config::default();
         config.global.prefix = FileName::new(format!("uio{id}_").as_bytes()).map_err(LockstepError::ipc)?;
         let root = format!("{}/", dir.join("iox2").display());
         config.global.set_root_path(&IoxPath::new(root.as_bytes()).map_err(LockstepError::ipc)?);

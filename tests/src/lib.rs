@@ -1,1 +1,124 @@
-// placeholder
+//! Helpers for tests that run the real binaries: where they are, a private directory per test,
+//! and checks that a run left no process and no shared memory behind.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+pub use launcher::recording::{read, Recording, Series};
+
+/// The directory holding the built binaries (next to this test executable's `deps/`).
+pub fn bin_dir() -> PathBuf {
+    let exe = std::env::current_exe().expect("test executable path");
+    let dir = exe.parent().and_then(Path::parent).expect("target/<profile>").to_path_buf();
+    for b in ["launcher", "plant", "observer", "controller"] {
+        assert!(dir.join(b).is_file(), "{} is missing: build the workspace binaries first (cargo test --release --workspace builds them)", dir.join(b).display());
+    }
+    dir
+}
+
+/// The repository root.
+pub fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("workspace root").to_path_buf()
+}
+
+/// A shipped scenario.
+pub fn scenario(name: &str) -> PathBuf {
+    repo().join("scenarios").join(format!("{name}.toml"))
+}
+
+/// A fresh empty directory under the system temp dir, removed by [`Scratch::drop`].
+pub struct Scratch(pub PathBuf);
+
+impl Scratch {
+    /// Creates one, named after `tag`.
+    pub fn new(tag: &str) -> Self {
+        static N: AtomicUsize = AtomicUsize::new(0);
+        let dir = std::env::temp_dir().join(format!("uio-test-{}-{}-{tag}", std::process::id(), N.fetch_add(1, Ordering::Relaxed)));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        Scratch(dir)
+    }
+
+    /// A path inside.
+    pub fn join(&self, p: &str) -> PathBuf {
+        self.0.join(p)
+    }
+
+    /// The runs directory the launcher is pointed at.
+    pub fn runs(&self) -> PathBuf {
+        self.0.join("iox-runs")
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// A launcher command whose runs live in `scratch`.
+pub fn launcher(scratch: &Scratch) -> Command {
+    let mut c = Command::new(bin_dir().join("launcher"));
+    c.env(lockstep_runs_env(), scratch.runs()).current_dir(&scratch.0);
+    c
+}
+
+/// The environment variable naming the runs directory.
+pub fn lockstep_runs_env() -> &'static str {
+    "UIO_RUNS_DIR"
+}
+
+/// Runs `launcher run <scenario> --out <scratch>/out` with extra args; returns the output.
+pub fn run(scratch: &Scratch, scenario: &Path, extra: &[&str]) -> Output {
+    launcher(scratch).arg("run").arg(scenario).arg("--out").arg(scratch.join("out")).args(extra).output().expect("launcher starts")
+}
+
+/// Text of stdout and stderr.
+pub fn text(o: &Output) -> (String, String) {
+    (String::from_utf8_lossy(&o.stdout).into_owned(), String::from_utf8_lossy(&o.stderr).into_owned())
+}
+
+/// The summary a run wrote.
+pub fn summary(scratch: &Scratch, name: &str) -> serde_json::Value {
+    let p = scratch.join("out").join(format!("{name}.summary.json"));
+    serde_json::from_str(&std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))).unwrap()
+}
+
+/// Shared-memory files of runs of launcher `pid`.
+pub fn shm_of(pid: u32) -> Vec<String> {
+    let prefix = format!("uio{pid}x");
+    std::fs::read_dir("/dev/shm")
+        .map(|d| d.flatten().map(|e| e.file_name().to_string_lossy().into_owned()).filter(|n| n.starts_with(&prefix)).collect())
+        .unwrap_or_default()
+}
+
+/// Processes whose command line names a run of launcher `pid`.
+pub fn processes_of(pid: u32) -> Vec<String> {
+    let needle = format!("--run\0{pid}x");
+    let mut found = Vec::new();
+    for e in std::fs::read_dir("/proc").into_iter().flatten().flatten() {
+        if let Ok(cmd) = std::fs::read(e.path().join("cmdline")) {
+            let cmd = String::from_utf8_lossy(&cmd);
+            if cmd.contains(&needle) {
+                found.push(format!("{}: {}", e.file_name().to_string_lossy(), cmd.replace('\0', " ")));
+            }
+        }
+    }
+    found
+}
+
+/// Asserts a finished launcher `pid` left nothing behind in `scratch`, /dev/shm or /proc.
+pub fn assert_clean(scratch: &Scratch, pid: u32) {
+    let procs = processes_of(pid);
+    assert!(procs.is_empty(), "processes left behind: {procs:?}");
+    let shm = shm_of(pid);
+    assert!(shm.is_empty(), "shared memory left behind: {shm:?}");
+    let runs: Vec<_> = std::fs::read_dir(scratch.runs()).map(|d| d.flatten().map(|e| e.path()).collect()).unwrap_or_default();
+    assert!(runs.is_empty(), "run directories left behind: {runs:?}");
+}
+
+/// Every series except latency (which is timing, not trajectory).
+pub fn trajectories(r: &Recording) -> Vec<(&String, &Series)> {
+    r.series.iter().filter(|(k, _)| !k.starts_with("/latency")).collect()
+}

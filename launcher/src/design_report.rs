@@ -1,0 +1,149 @@
+//! `launcher design`: every condition with its value and verdict, the design matrices under the
+//! papers' names, the observer and closed-loop eigenvalues (continuous and sampled), warnings.
+
+use std::collections::BTreeMap;
+
+use lti::eig::{format_list, sig, C64};
+use lti::Mat;
+use observer::design::{design, Condition};
+use serde::Serialize;
+use serde_json::{json, Value};
+
+use crate::plan::plan;
+use crate::scenario::Scenario;
+
+/// The report, in both renderings.
+pub struct DesignReport {
+    /// The JSON document.
+    pub json: Value,
+    /// The human-readable text.
+    pub text: String,
+    /// Whether every design succeeded.
+    pub ok: bool,
+}
+
+fn rows(m: &Mat) -> Vec<Vec<f64>> {
+    (0..m.nrows()).map(|i| m.row(i).iter().copied().collect()).collect()
+}
+
+fn pairs(v: &[C64]) -> Vec<[f64; 2]> {
+    v.iter().map(|z| [z.re, z.im]).collect()
+}
+
+#[derive(Serialize)]
+struct JsonCondition<'a> {
+    name: &'a str,
+    ok: bool,
+    detail: &'a str,
+}
+
+fn conditions_json(c: &[Condition]) -> Value {
+    json!(c.iter().map(|c| JsonCondition { name: &c.name, ok: c.ok, detail: &c.detail }).collect::<Vec<_>>())
+}
+
+fn matrix_text(name: &str, m: &Mat) -> String {
+    let mut s = format!("    {name} =\n");
+    for i in 0..m.nrows() {
+        let row: Vec<String> = m.row(i).iter().map(|&v| format!("{:>14}", sig(v))).collect();
+        s += &format!("      [{} ]\n", row.join(""));
+    }
+    s
+}
+
+fn conditions_text(c: &[Condition]) -> String {
+    c.iter().map(|c| format!("    {} {:<52} {}\n", if c.ok { "ok  " } else { "FAIL" }, c.name, c.detail)).collect()
+}
+
+/// Designs everything in the scenario and reports it.
+pub fn report(s: &Scenario) -> DesignReport {
+    let mut ok = true;
+    let mut text = format!("{}: {}\n", s.name, s.description);
+    let mut observers = Vec::new();
+    for o in &s.observers {
+        text += &format!("\nobserver '{}' ({})\n", o.name, o.spec.kind());
+        match design(&s.model, &o.spec, s.dt) {
+            Ok(d) => {
+                let r = &d.report;
+                text += "  conditions:\n";
+                text += &conditions_text(&r.conditions);
+                text += "  matrices:\n";
+                for (n, m) in &r.matrices {
+                    text += &matrix_text(n, m);
+                }
+                text += &format!("  poles:            {}\n", format_list(&r.poles));
+                text += &format!("  sampled (dt = {}): {}\n", s.dt, format_list(&r.discrete_poles));
+                if !r.fixed_modes.is_empty() {
+                    text += &format!("  fixed modes:      {}\n", format_list(&r.fixed_modes));
+                }
+                for n in &r.notes {
+                    text += &format!("  note: {n}\n");
+                }
+                let matrices: BTreeMap<&str, Vec<Vec<f64>>> = r.matrices.iter().map(|(n, m)| (n.as_str(), rows(m))).collect();
+                observers.push(json!({
+                    "name": o.name, "kind": o.spec.kind(),
+                    "conditions": conditions_json(&r.conditions),
+                    "matrices": matrices,
+                    "poles": pairs(&r.poles),
+                    "discrete_poles": pairs(&r.discrete_poles),
+                    "fixed_modes": pairs(&r.fixed_modes),
+                }));
+            }
+            Err(e) => {
+                ok = false;
+                text += "  conditions:\n";
+                text += &conditions_text(&e.conditions);
+                if !e.conditions.iter().any(|c| !c.ok) {
+                    text += &format!("    FAIL {:<52} {}\n", e.condition, e.detail);
+                }
+                text += &format!("  no observer: {} does not hold: {}\n", e.condition, e.detail);
+                observers.push(json!({
+                    "name": o.name, "kind": o.spec.kind(),
+                    "conditions": conditions_json(&e.conditions),
+                    "error": format!("{} does not hold: {}", e.condition, e.detail),
+                }));
+            }
+        }
+    }
+    let mut controller = Value::Null;
+    let mut warnings = Vec::new();
+    if ok {
+        match plan(s) {
+            Ok(p) => {
+                warnings = p.warnings.clone();
+                if let (Some(c), Some(fb)) = (&s.controller, &p.feedback) {
+                    text += &format!("\ncontroller: state feedback u = r − G x̂ on '{}'\n", c.observer);
+                    text += &matrix_text("G", &fb.g);
+                    text += &format!("  closed loop eig(A − BG):       {}\n", format_list(&fb.closed_loop));
+                    text += &format!("  sampled eig(A_d − B_dG):       {}\n", format_list(&fb.discrete_closed_loop));
+                    text += &format!("  stable: {}\n", fb.stable());
+                    controller = json!({
+                        "kind": "state-feedback",
+                        "observer": c.observer,
+                        "matrices": {"G": rows(&fb.g)},
+                        "closed_loop_poles": pairs(&fb.closed_loop),
+                        "discrete_closed_loop_poles": pairs(&fb.discrete_closed_loop),
+                        "stable": fb.stable(),
+                    });
+                }
+            }
+            Err(e) => {
+                ok = false;
+                text += &format!("\ncontroller: {}\n", e.error);
+                controller = json!({"kind": "state-feedback", "error": e.error.to_string()});
+            }
+        }
+    }
+    if !warnings.is_empty() {
+        text += "\nwarnings:\n";
+        for w in &warnings {
+            text += &format!("  - {w}\n");
+        }
+    }
+    let json = json!({
+        "scenario": s.name,
+        "observers": observers,
+        "controller": controller,
+        "warnings": warnings,
+    });
+    DesignReport { json, text, ok }
+}

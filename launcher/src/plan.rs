@@ -1,0 +1,86 @@
+//! Designing everything a scenario names, before anything runs: the observers, the state
+//! feedback, and the warnings an engineer should see.
+
+use controller::design::{design as design_feedback, FeedbackDesign, FeedbackSpec};
+use lti::eig::{eigenvalues, format_list, sig, C64};
+use observer::{design, Designed};
+
+use crate::scenario::{Scenario, ScenarioError};
+
+/// The designs of a scenario.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    /// (name, design) per observer, in scenario order.
+    pub observers: Vec<(String, Designed)>,
+    /// The state feedback, if any.
+    pub feedback: Option<FeedbackDesign>,
+    /// Things worth knowing that do not stop a run.
+    pub warnings: Vec<String>,
+}
+
+/// A design that could not be made, located in the scenario.
+#[derive(Debug, Clone)]
+pub struct PlanError {
+    /// As a scenario error (file, field, reason).
+    pub error: ScenarioError,
+    /// The failing observer's evaluated conditions (empty for the controller).
+    pub conditions: Vec<observer::design::Condition>,
+    /// The observer's index, if an observer failed.
+    pub observer: Option<usize>,
+}
+
+/// Designs every observer and the controller.
+pub fn plan(s: &Scenario) -> Result<Plan, PlanError> {
+    let locate = |field: String, reason: String| crate::scenario::locate_error(s, &field, reason);
+    let mut observers = Vec::new();
+    for (i, o) in s.observers.iter().enumerate() {
+        let d = design(&s.model, &o.spec, s.dt).map_err(|e| {
+            let sub = if e.condition.ends_with("poles") || e.condition.ends_with("pole placement") { ".poles" } else { "" };
+            PlanError {
+                error: locate(format!("observer[{i}]{sub}"), format!("{} observer '{}': {} does not hold: {}", e.kind, o.name, e.condition, e.detail)),
+                conditions: e.conditions.clone(),
+                observer: Some(i),
+            }
+        })?;
+        observers.push((o.name.clone(), d));
+    }
+    let feedback = match &s.controller {
+        Some(c) => Some(design_feedback(&s.model, &c.spec, s.dt).map_err(|reason| {
+            let field = if matches!(c.spec, FeedbackSpec::Gain(_)) { "controller.gain" } else { "controller.poles" };
+            PlanError { error: locate(field.into(), reason), conditions: vec![], observer: None }
+        })?),
+        None => None,
+    };
+    let warnings = warnings(s, &observers, feedback.as_ref());
+    Ok(Plan { observers, feedback, warnings })
+}
+
+/// dt too coarse for the fastest pole, an unstable loop, and the like.
+fn warnings(s: &Scenario, observers: &[(String, Designed)], feedback: Option<&FeedbackDesign>) -> Vec<String> {
+    let mut out = Vec::new();
+    let fastest = |ev: &[C64]| ev.iter().map(|z| z.norm()).fold(0.0, f64::max);
+    let mut check = |what: String, ev: &[C64]| {
+        let f = fastest(ev);
+        if f * s.dt > 0.2 {
+            out.push(format!("dt = {} is coarse for {what}: fastest pole |p| = {}, |p|·dt = {} (keep it below 0.2)", s.dt, sig(f), sig(f * s.dt)));
+        }
+    };
+    if let Ok(ev) = eigenvalues(&s.model.a) {
+        check("the plant".into(), &ev);
+    }
+    for (name, d) in observers {
+        check(format!("observer '{name}'"), &d.report.poles);
+    }
+    if let Some(fb) = feedback {
+        check("the closed loop".into(), &fb.closed_loop);
+        if let Some(why) = fb.instability() {
+            out.push(why);
+        }
+    }
+    for (name, d) in observers {
+        if !d.report.fixed_modes.is_empty() {
+            out.push(format!("observer '{name}': fixed modes {} cannot be moved by any admissible gain", format_list(&d.report.fixed_modes)));
+        }
+    }
+    out
+}

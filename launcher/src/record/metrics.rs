@@ -1,0 +1,110 @@
+//! Figures of merit, accumulated step by step: per observer the largest |x − x̂| and |y − Cx̂|
+//! over the last quarter of the run (the "tail", after transients), and between observers the
+//! largest difference of their estimates at any step.
+
+use lockstep::PlantLayout;
+use lti::Mat;
+
+use super::StepRow;
+
+/// The figures of one observer.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ObserverFigures {
+    /// max_k≥tail max_i |x_i − x̂_i|.
+    pub tail_max_abs_error: f64,
+    /// max_k≥tail max_j |y_j − (Cx̂)_j|.
+    pub tail_max_abs_residual: f64,
+    /// max over the whole run of max_i |x_i − x̂_i|.
+    pub max_abs_error: f64,
+    /// max_i |x_i − x̂_i| at the last step.
+    pub final_abs_error: f64,
+}
+
+/// Accumulates [`ObserverFigures`] and pairwise differences.
+#[derive(Debug, Clone)]
+pub struct Metrics {
+    layout: PlantLayout,
+    c: Mat,
+    tail_start: u64,
+    /// Per observer.
+    pub observers: Vec<ObserverFigures>,
+    /// max_k max_i |x̂_a − x̂_b| for each pair (a, b), a < b.
+    pub differences: Vec<((usize, usize), f64)>,
+    /// Steps seen.
+    pub steps: u64,
+    /// e_k and r_k of the last row, per observer (for the recording).
+    pub error: Vec<Vec<f64>>,
+    /// Residuals of the last row.
+    pub residual: Vec<Vec<f64>>,
+}
+
+impl Metrics {
+    /// For a run of `steps` steps with `observers` observers.
+    pub fn new(layout: PlantLayout, c: Mat, observers: usize, steps: u64) -> Self {
+        let mut differences = Vec::new();
+        for a in 0..observers {
+            for b in a + 1..observers {
+                differences.push(((a, b), 0.0));
+            }
+        }
+        Metrics {
+            layout,
+            c,
+            tail_start: steps - steps / 4,
+            observers: vec![ObserverFigures::default(); observers],
+            differences,
+            steps: 0,
+            error: vec![vec![0.0; layout.n]; observers],
+            residual: vec![vec![0.0; layout.p]; observers],
+        }
+    }
+
+    /// The first step of the tail.
+    pub fn tail_start(&self) -> u64 {
+        self.tail_start
+    }
+
+    /// Adds one step.
+    pub fn push(&mut self, row: &StepRow) {
+        let x = &row.plant[self.layout.x()];
+        let y = &row.plant[self.layout.y()];
+        let tail = row.k >= self.tail_start;
+        for (o, xhat) in row.xhat.iter().enumerate() {
+            let mut emax: f64 = 0.0;
+            for i in 0..self.layout.n {
+                let e = x[i] - xhat[i];
+                self.error[o][i] = e;
+                emax = emax.max(e.abs());
+            }
+            let mut rmax: f64 = 0.0;
+            for j in 0..self.layout.p {
+                let mut cx = 0.0;
+                for i in 0..self.layout.n {
+                    cx += self.c[(j, i)] * xhat[i];
+                }
+                let r = y[j] - cx;
+                self.residual[o][j] = r;
+                rmax = rmax.max(r.abs());
+            }
+            let f = &mut self.observers[o];
+            f.max_abs_error = f.max_abs_error.max(emax);
+            f.final_abs_error = emax;
+            if tail {
+                f.tail_max_abs_error = f.tail_max_abs_error.max(emax);
+                f.tail_max_abs_residual = f.tail_max_abs_residual.max(rmax);
+            }
+        }
+        for ((a, b), d) in self.differences.iter_mut() {
+            for i in 0..self.layout.n {
+                *d = d.max((row.xhat[*a][i] - row.xhat[*b][i]).abs());
+            }
+        }
+        self.steps += 1;
+    }
+
+    /// max |x̂_a − x̂_b| for observers a and b.
+    pub fn difference(&self, a: usize, b: usize) -> Option<f64> {
+        let key = (a.min(b), a.max(b));
+        self.differences.iter().find(|(p, _)| *p == key).map(|(_, d)| *d)
+    }
+}

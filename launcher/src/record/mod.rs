@@ -1,0 +1,49 @@
+//! Everything the launcher keeps of a run: each step's samples assembled into a [`StepRow`],
+//! the figures of merit ([`Metrics`]), the latency histograms ([`Latency`]), and the `.rrd`
+//! recording ([`RrdSink`]), written in batched columns off the lockstep's critical path.
+
+mod blueprint;
+mod latency;
+mod metrics;
+mod rrd;
+
+pub use blueprint::blueprint;
+pub use latency::{Latency, Percentiles};
+pub use metrics::{Metrics, ObserverFigures};
+pub use rrd::RrdSink;
+
+use lockstep::{Header, PlantLayout};
+
+/// One step of a run, as every component published it.
+#[derive(Debug, Clone, Default)]
+pub struct StepRow {
+    /// Step k.
+    pub k: u64,
+    /// t_k.
+    pub t: f64,
+    /// The plant's sample ([`PlantLayout`]).
+    pub plant: Vec<f64>,
+    /// The plant sample's header.
+    pub plant_hdr: Header,
+    /// Each observer's x̂_k, in scenario order.
+    pub xhat: Vec<Vec<f64>>,
+    /// Their headers.
+    pub xhat_hdr: Vec<Header>,
+    /// The controller's u_k (empty without a controller).
+    pub u: Vec<f64>,
+    /// Its header.
+    pub u_hdr: Header,
+}
+
+impl StepRow {
+    /// An empty row sized for a run.
+    pub fn new(layout: PlantLayout, observers: usize, controller: bool) -> Self {
+        StepRow {
+            plant: vec![0.0; layout.len()],
+            xhat: vec![vec![0.0; layout.n]; observers],
+            xhat_hdr: vec![Header::default(); observers],
+            u: if controller { vec![0.0; layout.l] } else { Vec::new() },
+            ..Default::default()
+        }
+    }
+}

@@ -1,0 +1,57 @@
+//! The configuration each component receives, built from the scenario and its designs. The
+//! same values drive the in-process loop, so both modes compute with identical numbers.
+
+use controller::ControllerConfig;
+use lockstep::PlantLayout;
+use observer::shell::ObserverRun;
+use plant::{PlantConfig, PlantRun};
+
+use crate::plan::Plan;
+use crate::scenario::Scenario;
+
+/// Every component's configuration.
+#[derive(Debug, Clone)]
+pub struct Configs {
+    /// The plant's.
+    pub plant: PlantRun,
+    /// (name, config) per observer.
+    pub observers: Vec<(String, ObserverRun)>,
+    /// The controller's.
+    pub controller: Option<ControllerConfig>,
+    /// The plant sample layout.
+    pub layout: PlantLayout,
+}
+
+/// Builds the configurations.
+pub fn configs(s: &Scenario, plan: &Plan) -> Configs {
+    let m = &s.model;
+    let layout = PlantLayout { n: m.n(), p: m.p(), q: m.e.ncols(), r: m.d.ncols(), l: m.l() };
+    let plant = PlantRun {
+        plant: PlantConfig {
+            a: (&m.a).into(),
+            b: (&m.b).into(),
+            c: (&m.c).into(),
+            e: (&m.e).into(),
+            d: (&m.d).into(),
+            x0: s.x0.clone(),
+            disturbances: s.disturbances.clone(),
+            measurement_disturbances: s.measurement_disturbances.clone(),
+            inputs: s.inputs.clone(),
+            dt: s.dt,
+            steps: s.steps,
+            state_bound: s.state_bound,
+        },
+        observers: s.observers.iter().map(|o| o.name.clone()).collect(),
+        controller: s.controller.is_some(),
+    };
+    let observers = plan
+        .observers
+        .iter()
+        .map(|(name, d)| (name.clone(), ObserverRun { observer: d.runtime.clone(), layout, steps: s.steps }))
+        .collect();
+    let controller = match (&s.controller, &plan.feedback) {
+        (Some(c), Some(fb)) => Some(ControllerConfig { g: (&fb.g).into(), references: s.inputs.clone(), dt: s.dt, steps: s.steps, observer: c.observer.clone() }),
+        _ => None,
+    };
+    Configs { plant, observers, controller, layout }
+}

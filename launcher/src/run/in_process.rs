@@ -1,0 +1,52 @@
+//! `--mode in-process`: the same step functions, called in lockstep order in one process.
+
+use controller::Controller;
+use lockstep::now_ns;
+use observer::ObserverState;
+use plant::Plant;
+
+use super::configs::Configs;
+use super::session::Session;
+use super::{interrupt, Stop};
+use crate::error::LaunchError;
+use crate::record::StepRow;
+
+/// Runs every step; returns how it ended.
+pub fn run(cfg: &Configs, session: &mut Session) -> Result<Stop, LaunchError> {
+    let mut plant = Plant::new(&cfg.plant.plant).map_err(LaunchError::Component)?;
+    let mut observers: Vec<ObserverState> = cfg.observers.iter().map(|(_, o)| o.observer.instantiate()).collect();
+    let mut controller = cfg.controller.as_ref().map(Controller::new).transpose().map_err(LaunchError::Component)?;
+    let ctrl_obs = cfg.controller.as_ref().and_then(|c| cfg.observers.iter().position(|(n, _)| *n == c.observer));
+    let lay = cfg.layout;
+    let mut row = StepRow::new(lay, observers.len(), controller.is_some());
+    let mut u = vec![0.0; lay.l];
+    for k in 0..cfg.plant.plant.steps {
+        if k % 1024 == 0 {
+            if let Some(sig) = interrupt::received() {
+                return Ok(Stop::Interrupted(sig));
+            }
+        }
+        let start = now_ns();
+        row.k = k;
+        row.t = plant.time(k);
+        row.plant.copy_from_slice(plant.sample(k));
+        for (i, obs) in observers.iter_mut().enumerate() {
+            let xhat = obs.step(&row.plant[lay.y()], &row.plant[lay.u_prev()]);
+            row.xhat[i].copy_from_slice(xhat);
+        }
+        match (&mut controller, ctrl_obs) {
+            (Some(c), Some(o)) => {
+                u.copy_from_slice(c.step(k, &row.xhat[o]));
+                row.u.copy_from_slice(&u);
+            }
+            _ => u.copy_from_slice(plant.reference()),
+        }
+        let diverged = plant.advance(k, &u);
+        let step_ns = now_ns() - start;
+        session.record_in_process(&row, step_ns)?;
+        if let Err(d) = diverged {
+            return Ok(Stop::Diverged(d.to_string()));
+        }
+    }
+    Ok(Stop::Completed)
+}

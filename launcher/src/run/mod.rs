@@ -1,0 +1,140 @@
+//! Running a scenario: output checks, the chosen mode, the recording, the summary.
+
+mod configs;
+pub mod interrupt;
+mod in_process;
+mod processes;
+mod session;
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use lockstep::Wait;
+
+pub use configs::{configs, Configs};
+pub use session::{hop_entity, hop_names, Session};
+
+use crate::error::LaunchError;
+use crate::plan::Plan;
+use crate::scenario::Scenario;
+use crate::summary::Summary;
+
+/// Where the components run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    /// One process per component, over iceoryx2.
+    Processes,
+    /// All step functions in the launcher's process.
+    InProcess,
+}
+
+impl Mode {
+    /// "processes" or "in-process".
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Processes => "processes",
+            Mode::InProcess => "in-process",
+        }
+    }
+}
+
+/// How to run.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// Output directory.
+    pub out: PathBuf,
+    /// Where the components run.
+    pub mode: Mode,
+    /// Wait strategy of the components.
+    pub wait: Wait,
+    /// Overwrite an existing recording.
+    pub force: bool,
+    /// Run a scenario whose closed loop is unstable.
+    pub allow_unstable: bool,
+    /// Write the `.rrd` (off for benchmarks).
+    pub record: bool,
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Stop {
+    /// Every step done.
+    Completed,
+    /// A state left its bound or became non-finite.
+    Diverged(String),
+    /// SIGINT or SIGTERM.
+    Interrupted(&'static str),
+    /// A component failed.
+    Failed(String),
+}
+
+/// What a finished run produced.
+#[derive(Debug)]
+pub struct Outcome {
+    /// The summary (also written as JSON).
+    pub summary: Summary,
+    /// The recording, if one was written.
+    pub rrd: Option<PathBuf>,
+    /// The summary file.
+    pub summary_path: Option<PathBuf>,
+    /// How it ended.
+    pub stop: Stop,
+}
+
+/// The recording and summary paths of a scenario in `out`.
+pub fn output_paths(out: &Path, name: &str) -> (PathBuf, PathBuf) {
+    (out.join(format!("{name}.rrd")), out.join(format!("{name}.summary.json")))
+}
+
+/// Makes sure the outputs can be written, before anything runs.
+fn prepare_output(out: &Path, name: &str, force: bool) -> Result<(PathBuf, PathBuf), LaunchError> {
+    fs::create_dir_all(out).map_err(|e| LaunchError::BadInput(format!("{}: cannot create the output directory: {e}", out.display())))?;
+    let probe = out.join(format!(".{name}.write-test"));
+    fs::write(&probe, b"").map_err(|e| LaunchError::BadInput(format!("{}: output directory is not writable: {e}", out.display())))?;
+    let _ = fs::remove_file(&probe);
+    let (rrd, summary) = output_paths(out, name);
+    if !force {
+        for p in [&rrd, &summary] {
+            if p.exists() {
+                return Err(LaunchError::BadInput(format!("{}: already exists (pass --force to overwrite)", p.display())));
+            }
+        }
+    }
+    Ok((rrd, summary))
+}
+
+/// Runs a designed scenario.
+pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchError> {
+    if let Some(fb) = &plan.feedback {
+        if let Some(why) = fb.instability() {
+            if !opts.allow_unstable {
+                return Err(LaunchError::BadInput(format!("{}: controller: {why}; pass --allow-unstable to run it anyway", s.path.display())));
+            }
+        }
+    }
+    let (rrd, summary_path) = if opts.record { prepare_output(&opts.out, &s.name, opts.force).map(|(a, b)| (Some(a), Some(b)))? } else { (None, None) };
+    interrupt::install();
+    let cfg = configs(s, plan);
+    let mut session = Session::new(s, plan, cfg.layout, rrd.as_deref())?;
+    let start = Instant::now();
+    let stop = match opts.mode {
+        Mode::InProcess => in_process::run(&cfg, &mut session),
+        Mode::Processes => processes::run(&cfg, &mut session, opts.wait),
+    };
+    let wall = start.elapsed().as_secs_f64();
+    let stop = match stop {
+        Ok(stop) => stop,
+        Err(e) => {
+            // Close what was recorded so far before reporting.
+            let _ = session.finish();
+            return Err(e);
+        }
+    };
+    let (metrics, latency) = session.finish()?;
+    let summary = Summary::new(s, plan, opts, &metrics, &latency, wall, &stop, rrd.as_deref());
+    if let Some(path) = &summary_path {
+        summary.write(path).map_err(LaunchError::BadInput)?;
+    }
+    Ok(Outcome { summary, rrd, summary_path, stop })
+}

@@ -1,0 +1,343 @@
+//! `--mode processes`: one process per component, in lockstep over iceoryx2, supervised.
+//!
+//! The launcher creates the run's space and its own recording subscribers first, starts the
+//! components (each in its own process group, so a terminal's Ctrl-C reaches only the launcher),
+//! waits until every component reports `ready`, then says `go`. While the run goes it drains
+//! the recording subscribers and polls the children: a component that exits early or is killed
+//! stops the run within a poll interval, the others are killed, and the recording is closed.
+
+use std::collections::VecDeque;
+use std::io::{BufRead, BufReader, Read, Write};
+use std::os::unix::process::{CommandExt, ExitStatusExt};
+use std::process::{Child, Command, ExitStatus, Stdio};
+use std::sync::mpsc;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use lockstep::{cleanup_dead_runs, Bus, Header, Reader, RunSpace, Sample, Wait};
+
+use super::configs::Configs;
+use super::session::Session;
+use super::{interrupt, Stop};
+use crate::error::LaunchError;
+use crate::record::StepRow;
+
+/// How long components may take to report ready.
+const READY_TIMEOUT: Duration = Duration::from_secs(20);
+/// How long the run may make no progress before it is declared stuck.
+const STALL_TIMEOUT: Duration = Duration::from_secs(10);
+/// Sleep between polls when nothing arrived.
+const POLL: Duration = Duration::from_micros(500);
+
+/// A started component.
+struct Proc {
+    label: String,
+    child: Child,
+    stderr: Arc<Mutex<String>>,
+    status: Option<ExitStatus>,
+}
+
+impl Proc {
+    fn describe_exit(&self) -> String {
+        let status = self.status.expect("exited");
+        let how = match (status.code(), status.signal()) {
+            (Some(code), _) => format!("exited with status {code}"),
+            (None, Some(sig)) => format!("was killed by signal {sig} ({})", signal_name(sig)),
+            _ => "ended".into(),
+        };
+        let err = self.stderr.lock().map(|s| s.trim().lines().last().unwrap_or("").to_string()).unwrap_or_default();
+        if err.is_empty() { format!("{} (pid {}) {how}", self.label, self.child.id()) } else { format!("{} (pid {}) {how}: {err}", self.label, self.child.id()) }
+    }
+}
+
+fn signal_name(sig: i32) -> &'static str {
+    match sig {
+        libc::SIGKILL => "SIGKILL",
+        libc::SIGTERM => "SIGTERM",
+        libc::SIGINT => "SIGINT",
+        libc::SIGSEGV => "SIGSEGV",
+        libc::SIGABRT => "SIGABRT",
+        libc::SIGBUS => "SIGBUS",
+        libc::SIGFPE => "SIGFPE",
+        libc::SIGPIPE => "SIGPIPE",
+        _ => "signal",
+    }
+}
+
+/// Kills and reaps every child still running; safe to call twice.
+fn stop_all(procs: &mut [Proc]) {
+    for p in procs.iter_mut() {
+        if p.status.is_none() {
+            let _ = p.child.kill();
+        }
+    }
+    for p in procs.iter_mut() {
+        if p.status.is_none() {
+            p.status = p.child.wait().ok();
+        }
+    }
+}
+
+/// The command that starts a component: its binary next to the launcher's, or, when only the
+/// launcher was built (`cargo run`), the launcher itself in component mode.
+fn component_command(kind: &str) -> Command {
+    let exe = std::env::current_exe().unwrap_or_else(|_| "launcher".into());
+    let sibling = exe.with_file_name(kind);
+    if sibling.is_file() {
+        Command::new(sibling)
+    } else {
+        let mut c = Command::new(exe);
+        c.args(["component", kind]);
+        c
+    }
+}
+
+fn spawn(kind: &str, label: String, name: &str, space: &RunSpace, wait: Wait, tx: &mpsc::Sender<(usize, String)>, index: usize) -> Result<Proc, LaunchError> {
+    let mut cmd = component_command(kind);
+    cmd.args(["--run", space.id(), "--name", name, "--wait", &wait.to_string()])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .process_group(0);
+    let mut child = cmd.spawn().map_err(|e| LaunchError::Component(format!("cannot start {label}: {e}")))?;
+    let out = child.stdout.take().expect("piped");
+    let tx = tx.clone();
+    std::thread::spawn(move || {
+        for line in BufReader::new(out).lines().map_while(Result::ok) {
+            if tx.send((index, line)).is_err() {
+                break;
+            }
+        }
+    });
+    let mut err = child.stderr.take().expect("piped");
+    let stderr = Arc::new(Mutex::new(String::new()));
+    let sink = stderr.clone();
+    std::thread::spawn(move || {
+        let mut buf = [0u8; 4096];
+        while let Ok(n) = err.read(&mut buf) {
+            if n == 0 {
+                break;
+            }
+            if let Ok(mut s) = sink.lock() {
+                s.push_str(&String::from_utf8_lossy(&buf[..n]));
+            }
+        }
+    });
+    Ok(Proc { label, child, stderr, status: None })
+}
+
+/// Per-topic queues of received samples, assembled into rows in step order.
+struct Assembly {
+    plant: VecDeque<(Header, Sample)>,
+    observers: Vec<VecDeque<(Header, Sample)>>,
+    controller: Option<VecDeque<(Header, Sample)>>,
+    next: u64,
+}
+
+fn header(s: &Sample) -> Header {
+    Header { step: s.step, sim_time: s.sim_time, sent_ns: s.sent_ns, taken_ns: s.taken_ns, received_ns: 0 }
+}
+
+impl Assembly {
+    /// Moves every complete step into the session.
+    fn assemble(&mut self, row: &mut StepRow, session: &mut Session) -> Result<usize, LaunchError> {
+        let mut done = 0;
+        loop {
+            let ready = !self.plant.is_empty() && self.observers.iter().all(|q| !q.is_empty()) && self.controller.as_ref().is_none_or(|q| !q.is_empty());
+            if !ready {
+                return Ok(done);
+            }
+            let k = self.next;
+            let check = |h: &Header, topic: &str| {
+                if h.step == k { Ok(()) } else { Err(LaunchError::Component(format!("lockstep broken on {topic}: expected step {k}, got {}", h.step))) }
+            };
+            let (ph, ps) = self.plant.pop_front().expect("non-empty");
+            check(&ph, "plant")?;
+            row.k = k;
+            row.t = ps.sim_time;
+            let len = row.plant.len();
+            row.plant.copy_from_slice(&ps.values[..len]);
+            row.plant_hdr = ph;
+            for (i, q) in self.observers.iter_mut().enumerate() {
+                let (h, s) = q.pop_front().expect("non-empty");
+                check(&h, "observer")?;
+                let n = row.xhat[i].len();
+                row.xhat[i].copy_from_slice(&s.values[..n]);
+                row.xhat_hdr[i] = h;
+            }
+            if let Some(q) = &mut self.controller {
+                let (h, s) = q.pop_front().expect("non-empty");
+                check(&h, "controller")?;
+                let l = row.u.len();
+                row.u.copy_from_slice(&s.values[..l]);
+                row.u_hdr = h;
+            }
+            session.record(row)?;
+            self.next += 1;
+            done += 1;
+        }
+    }
+}
+
+fn drain(reader: &Reader, q: &mut VecDeque<(Header, Sample)>) -> Result<usize, LaunchError> {
+    reader.drain(|s| q.push_back((header(s), *s))).map_err(|e| LaunchError::Component(e.to_string()))
+}
+
+/// Runs the scenario across processes.
+pub fn run(cfg: &Configs, session: &mut Session, wait: Wait) -> Result<Stop, LaunchError> {
+    cleanup_dead_runs();
+    let space = RunSpace::create().map_err(|e| LaunchError::Component(e.to_string()))?;
+    let result = run_in(&space, cfg, session, wait);
+    space.remove();
+    result
+}
+
+fn run_in(space: &RunSpace, cfg: &Configs, session: &mut Session, wait: Wait) -> Result<Stop, LaunchError> {
+    let ipc = |e: lockstep::LockstepError| LaunchError::Component(e.to_string());
+    space.write_config("plant", &to_json(&cfg.plant)).map_err(ipc)?;
+    for (name, o) in &cfg.observers {
+        space.write_config(&format!("observer-{name}"), &to_json(o)).map_err(ipc)?;
+    }
+    if let Some(c) = &cfg.controller {
+        space.write_config("controller", &to_json(c)).map_err(ipc)?;
+    }
+
+    // The recorder's subscribers exist before any component can publish.
+    let bus = Bus::join(space, "launcher", Wait::Yield).map_err(ipc)?;
+    let plant_reader = bus.reader("plant").map_err(ipc)?;
+    let observer_readers = cfg.observers.iter().map(|(n, _)| bus.reader(&format!("observer/{n}"))).collect::<Result<Vec<_>, _>>().map_err(ipc)?;
+    let controller_reader = cfg.controller.as_ref().map(|_| bus.reader("controller")).transpose().map_err(ipc)?;
+
+    let (tx, rx) = mpsc::channel();
+    let mut procs: Vec<Proc> = Vec::new();
+    let result = (|| {
+        procs.push(spawn("plant", "plant".into(), "plant", space, wait, &tx, 0)?);
+        for (name, _) in &cfg.observers {
+            let i = procs.len();
+            procs.push(spawn("observer", format!("observer '{name}'"), name, space, wait, &tx, i)?);
+        }
+        if cfg.controller.is_some() {
+            let i = procs.len();
+            procs.push(spawn("controller", "controller".into(), "controller", space, wait, &tx, i)?);
+        }
+        handshake(&mut procs, &rx)?;
+        supervise(cfg, session, &mut procs, &plant_reader, &observer_readers, controller_reader.as_ref())
+    })();
+    stop_all(&mut procs);
+    drop((plant_reader, observer_readers, controller_reader, bus));
+    result
+}
+
+/// Waits for every component's `ready`, then tells them all `go`.
+fn handshake(procs: &mut [Proc], rx: &mpsc::Receiver<(usize, String)>) -> Result<(), LaunchError> {
+    let deadline = Instant::now() + READY_TIMEOUT;
+    let mut ready = vec![false; procs.len()];
+    while !ready.iter().all(|&r| r) {
+        if let Some(sig) = interrupt::received() {
+            return Err(LaunchError::Interrupted(format!("{sig} received while the components started")));
+        }
+        for p in procs.iter_mut() {
+            if p.status.is_none() {
+                if let Ok(Some(st)) = p.child.try_wait() {
+                    p.status = Some(st);
+                    // Give its stderr reader a moment to collect the message.
+                    std::thread::sleep(Duration::from_millis(20));
+                    return Err(LaunchError::Component(format!("{} before the run began", p.describe_exit())));
+                }
+            }
+        }
+        match rx.recv_timeout(Duration::from_millis(20)) {
+            Ok((i, line)) if line.trim() == "ready" => ready[i] = true,
+            Ok(_) | Err(mpsc::RecvTimeoutError::Timeout) => {}
+            Err(mpsc::RecvTimeoutError::Disconnected) => {}
+        }
+        if Instant::now() > deadline {
+            let slow: Vec<&str> = procs.iter().zip(&ready).filter(|(_, r)| !**r).map(|(p, _)| p.label.as_str()).collect();
+            return Err(LaunchError::Component(format!("{} did not report ready within {} s", slow.join(", "), READY_TIMEOUT.as_secs())));
+        }
+    }
+    for p in procs.iter_mut() {
+        let mut stdin = p.child.stdin.take().expect("piped");
+        stdin.write_all(b"go\n").and_then(|_| stdin.flush()).map_err(|e| LaunchError::Component(format!("{}: {e}", p.label)))?;
+    }
+    Ok(())
+}
+
+fn supervise(
+    cfg: &Configs,
+    session: &mut Session,
+    procs: &mut [Proc],
+    plant: &Reader,
+    observers: &[Reader],
+    controller: Option<&Reader>,
+) -> Result<Stop, LaunchError> {
+    let steps = cfg.plant.plant.steps;
+    let mut asm = Assembly {
+        plant: VecDeque::new(),
+        observers: observers.iter().map(|_| VecDeque::new()).collect(),
+        controller: controller.map(|_| VecDeque::new()),
+        next: 0,
+    };
+    let mut row = StepRow::new(cfg.layout, observers.len(), controller.is_some());
+    let mut last_progress = Instant::now();
+    loop {
+        let mut got = drain(plant, &mut asm.plant)?;
+        for (r, q) in observers.iter().zip(asm.observers.iter_mut()) {
+            got += drain(r, q)?;
+        }
+        if let (Some(r), Some(q)) = (controller, asm.controller.as_mut()) {
+            got += drain(r, q)?;
+        }
+        if asm.assemble(&mut row, session)? > 0 {
+            last_progress = Instant::now();
+        }
+        if asm.next == steps {
+            return Ok(Stop::Completed);
+        }
+        if let Some(sig) = interrupt::received() {
+            return Ok(Stop::Interrupted(sig));
+        }
+        // A component that ended before the last step ends the run.
+        for i in 0..procs.len() {
+            if procs[i].status.is_some() {
+                continue;
+            }
+            let Ok(Some(st)) = procs[i].child.try_wait() else { continue };
+            procs[i].status = Some(st);
+            if st.success() {
+                continue;
+            }
+            // Collect what it published before it went, then stop the others.
+            std::thread::sleep(Duration::from_millis(20));
+            let _ = drain(plant, &mut asm.plant);
+            for (r, q) in observers.iter().zip(asm.observers.iter_mut()) {
+                let _ = drain(r, q);
+            }
+            if let (Some(r), Some(q)) = (controller, asm.controller.as_mut()) {
+                let _ = drain(r, q);
+            }
+            asm.assemble(&mut row, session)?;
+            stop_all(procs);
+            let what = procs[i].describe_exit();
+            let last = if asm.next == 0 { "no step completed".to_string() } else { format!("last completed step {}", asm.next - 1) };
+            if i == 0 && st.code() == Some(plant::shell::EXIT_DIVERGED) {
+                return Ok(Stop::Diverged(format!("{what} ({last})")));
+            }
+            return Ok(Stop::Failed(format!("{what}; {last}")));
+        }
+        if procs.iter().all(|p| p.status.is_some()) && got == 0 {
+            return Ok(Stop::Failed(format!("every component finished but only {} of {steps} steps arrived", asm.next)));
+        }
+        if last_progress.elapsed() > STALL_TIMEOUT {
+            stop_all(procs);
+            return Ok(Stop::Failed(format!("no step completed for {} s after step {}", STALL_TIMEOUT.as_secs(), asm.next as i64 - 1)));
+        }
+        if got == 0 {
+            std::thread::sleep(POLL);
+        }
+    }
+}
+
+fn to_json<T: serde::Serialize>(v: &T) -> String {
+    serde_json::to_string(v).expect("configurations serialise")
+}

@@ -1,0 +1,189 @@
+//! What both run modes do with each completed step: figures, latency, recording.
+
+use std::path::Path;
+
+use lockstep::PlantLayout;
+
+use crate::error::LaunchError;
+use crate::plan::Plan;
+use crate::record::{blueprint, Latency, Metrics, RrdSink, StepRow};
+use crate::scenario::Scenario;
+
+/// Channel ids of one observer.
+struct ObserverChannels {
+    xhat: Vec<usize>,
+    error: Vec<usize>,
+    residual: Vec<usize>,
+}
+
+struct Channels {
+    x: Vec<usize>,
+    y: Vec<usize>,
+    w: Vec<usize>,
+    v: Vec<usize>,
+    r: Vec<usize>,
+    u: Vec<usize>,
+    observers: Vec<ObserverChannels>,
+    step_latency: usize,
+    hops: Vec<usize>,
+}
+
+/// The recording side of a run.
+pub struct Session {
+    layout: PlantLayout,
+    /// Figures of merit so far.
+    pub metrics: Metrics,
+    /// Latency histograms so far.
+    pub latency: Latency,
+    sink: Option<(RrdSink, Channels)>,
+    /// Index of the observer the controller reads.
+    controller_observer: Option<usize>,
+    /// (plant sent_ns, controller sent_ns) of the previous step.
+    prev: Option<(u64, u64)>,
+    /// Steps recorded.
+    pub steps: u64,
+    dt: f64,
+}
+
+/// Hop names of a run, in the order [`Session`] records them.
+pub fn hop_names(s: &Scenario) -> Vec<String> {
+    let mut hops: Vec<String> = s.observers.iter().map(|o| format!("plant->observer/{}", o.name)).collect();
+    if let Some(c) = &s.controller {
+        hops.push(format!("observer/{}->controller", c.observer));
+        hops.push("controller->plant".into());
+    }
+    hops
+}
+
+/// The entity path of a hop: "plant->observer/uio" becomes "/latency/plant_to_observer_uio".
+pub fn hop_entity(hop: &str) -> String {
+    format!("/latency/{}", hop.replace("->", "_to_").replace('/', "_"))
+}
+
+impl Session {
+    /// Starts a session; with `rrd`, opens the recording there.
+    pub fn new(s: &Scenario, plan: &Plan, layout: PlantLayout, rrd: Option<&Path>) -> Result<Self, LaunchError> {
+        let controller_observer = s.controller.as_ref().and_then(|c| s.observers.iter().position(|o| o.name == c.observer));
+        let hops = hop_names(s);
+        let sink = match rrd {
+            Some(path) => {
+                let mut sink = RrdSink::create(path, &s.name, blueprint(s), &s.source).map_err(LaunchError::BadInput)?;
+                let name = |i: usize| s.state_names[i].clone();
+                let mut series = |path: String, legend: String| sink.channel(&path, &legend);
+                let x = (0..layout.n).map(|i| series(format!("/plant/x/{i}"), format!("{} (true)", name(i)))).collect();
+                let y = (0..layout.p).map(|j| series(format!("/plant/y/{j}"), format!("y{}", j + 1))).collect();
+                let w = (0..layout.q).map(|k| series(format!("/disturbance/{k}"), format!("w{}", k + 1))).collect();
+                let v = (0..layout.r).map(|k| series(format!("/measurement_disturbance/{k}"), format!("v{}", k + 1))).collect();
+                let r = (0..layout.l).map(|k| series(format!("/input/{k}"), format!("r{}", k + 1))).collect();
+                let u = if s.controller.is_some() {
+                    (0..layout.l).map(|k| series(format!("/controller/u/{k}"), format!("u{}", k + 1))).collect()
+                } else {
+                    Vec::new()
+                };
+                let observers = s
+                    .observers
+                    .iter()
+                    .map(|o| ObserverChannels {
+                        xhat: (0..layout.n).map(|i| series(format!("/observer/{}/xhat/{i}", o.name), format!("{} ({})", name(i), o.name))).collect(),
+                        error: (0..layout.n).map(|i| series(format!("/observer/{}/error/{i}", o.name), format!("e{} ({})", i + 1, o.name))).collect(),
+                        residual: (0..layout.p).map(|j| series(format!("/observer/{}/residual/{j}", o.name), format!("r{} ({})", j + 1, o.name))).collect(),
+                    })
+                    .collect();
+                let step_latency = series("/latency/step".into(), "step".into());
+                let hop_ids = hops.iter().map(|h| series(hop_entity(h), h.clone())).collect();
+                Some((sink, Channels { x, y, w, v, r, u, observers, step_latency, hops: hop_ids }))
+            }
+            None => None,
+        };
+        let _ = plan;
+        Ok(Session {
+            layout,
+            metrics: Metrics::new(layout, s.model.c.clone(), s.observers.len(), s.steps),
+            latency: Latency::new(hops),
+            sink,
+            controller_observer,
+            prev: None,
+            steps: 0,
+            dt: s.dt,
+        })
+    }
+
+    /// Records one step whose samples carry the components' timestamps (processes mode).
+    pub fn record(&mut self, row: &StepRow) -> Result<(), LaunchError> {
+        // Hops completed by this row.
+        let nobs = row.xhat.len();
+        let mut hop_values: Vec<(usize, u64)> = Vec::with_capacity(nobs + 2);
+        for i in 0..nobs {
+            hop_values.push((i, row.xhat_hdr[i].taken_ns.saturating_sub(row.plant_hdr.sent_ns)));
+        }
+        if let Some(c) = self.controller_observer {
+            hop_values.push((nobs, row.u_hdr.taken_ns.saturating_sub(row.xhat_hdr[c].sent_ns)));
+        }
+        // The previous step ends when this row's plant sample says when it had u_{k−1}.
+        let mut step_ns = None;
+        if let Some((plant_sent, ctrl_sent)) = self.prev {
+            step_ns = Some(row.plant_hdr.taken_ns.saturating_sub(plant_sent));
+            if self.controller_observer.is_some() {
+                hop_values.push((nobs + 1, row.plant_hdr.taken_ns.saturating_sub(ctrl_sent)));
+            }
+        }
+        self.prev = Some((row.plant_hdr.sent_ns, row.u_hdr.sent_ns));
+        for &(i, ns) in &hop_values {
+            self.latency.hop(i, ns);
+        }
+        if let Some(ns) = step_ns {
+            self.latency.step(ns);
+        }
+        self.push(row, step_ns.map(|ns| (row.k - 1, ns)), &hop_values)
+    }
+
+    /// Records one step of the in-process loop, whose step time was measured directly.
+    pub fn record_in_process(&mut self, row: &StepRow, step_ns: u64) -> Result<(), LaunchError> {
+        self.latency.step(step_ns);
+        self.push(row, Some((row.k, step_ns)), &[])
+    }
+
+    fn push(&mut self, row: &StepRow, step_ns: Option<(u64, u64)>, hops: &[(usize, u64)]) -> Result<(), LaunchError> {
+        self.metrics.push(row);
+        self.steps += 1;
+        let Some((sink, ch)) = &mut self.sink else { return Ok(()) };
+        let (k, t) = (row.k, row.t);
+        let lay = self.layout;
+        let put = |sink: &mut RrdSink, ids: &[usize], vals: &[f64]| {
+            for (&id, &v) in ids.iter().zip(vals) {
+                sink.push(id, k, t, v);
+            }
+        };
+        put(sink, &ch.x, &row.plant[lay.x()]);
+        put(sink, &ch.y, &row.plant[lay.y()]);
+        put(sink, &ch.w, &row.plant[lay.w()]);
+        put(sink, &ch.v, &row.plant[lay.v()]);
+        put(sink, &ch.r, &row.plant[lay.r()]);
+        put(sink, &ch.u, &row.u);
+        for (o, oc) in ch.observers.iter().enumerate() {
+            put(sink, &oc.xhat, &row.xhat[o]);
+            put(sink, &oc.error, &self.metrics.error[o]);
+            put(sink, &oc.residual, &self.metrics.residual[o]);
+        }
+        // Latencies are recorded at the step they belong to: the step time and the
+        // controller→plant hop of step k−1 complete with row k.
+        let dt = self.dt;
+        if let Some((ks, ns)) = step_ns {
+            sink.push(ch.step_latency, ks, ks as f64 * dt, ns as f64);
+        }
+        let last_hop = ch.hops.len().wrapping_sub(1);
+        for &(i, ns) in hops {
+            let ks = if i == last_hop && self.controller_observer.is_some() { k - 1 } else { k };
+            sink.push(ch.hops[i], ks, ks as f64 * dt, ns as f64);
+        }
+        sink.flush_full().map_err(LaunchError::Component)
+    }
+
+    /// Closes the recording (footer written); returns the figures.
+    pub fn finish(self) -> Result<(Metrics, Latency), LaunchError> {
+        if let Some((sink, _)) = self.sink {
+            sink.finish().map_err(LaunchError::Component)?;
+        }
+        Ok((self.metrics, self.latency))
+    }
+}

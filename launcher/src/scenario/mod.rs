@@ -1,0 +1,135 @@
+//! Scenario files: parsing, validation, and the validated [`Scenario`] the launcher runs.
+//!
+//! Every problem is reported as one [`ScenarioError`]: file, line:column where known, the field
+//! (as a path such as `plant.A` or `observer[1].poles`), and the reason.
+
+mod locate;
+mod raw;
+mod validate;
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use controller::design::FeedbackSpec;
+use lti::signal::Signal;
+use lti::Model;
+use observer::Spec;
+
+pub use raw::RawExpect;
+
+/// A scenario that passed every check.
+#[derive(Debug, Clone)]
+pub struct Scenario {
+    /// The file it came from.
+    pub path: PathBuf,
+    /// Its name (also the recording's file name).
+    pub name: String,
+    /// One line.
+    pub description: String,
+    /// Sample period, s.
+    pub dt: f64,
+    /// Length, s.
+    pub duration: f64,
+    /// Number of steps, round(duration / dt).
+    pub steps: u64,
+    /// The plant.
+    pub model: Model,
+    /// Initial state.
+    pub x0: Vec<f64>,
+    /// |x_i| beyond this stops the run.
+    pub state_bound: f64,
+    /// State names for plots.
+    pub state_names: Vec<String>,
+    /// State units for plots ("" when unknown).
+    pub state_units: Vec<String>,
+    /// One per column of E.
+    pub disturbances: Vec<Signal>,
+    /// One per column of D.
+    pub measurement_disturbances: Vec<Signal>,
+    /// One per column of B.
+    pub inputs: Vec<Signal>,
+    /// The observers, in file order.
+    pub observers: Vec<ObserverEntry>,
+    /// The state feedback, if any.
+    pub controller: Option<ControllerEntry>,
+    /// What the run must achieve.
+    pub expect: RawExpect,
+    /// The file's text (to locate fields in later messages).
+    pub source: String,
+}
+
+/// One `[[observer]]`.
+#[derive(Debug, Clone)]
+pub struct ObserverEntry {
+    /// Unique name.
+    pub name: String,
+    /// The design.
+    pub spec: Spec,
+}
+
+/// The `[controller]`.
+#[derive(Debug, Clone)]
+pub struct ControllerEntry {
+    /// Whose estimate it feeds back.
+    pub observer: String,
+    /// How G is obtained.
+    pub spec: FeedbackSpec,
+}
+
+/// A problem with a scenario file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScenarioError {
+    /// The file.
+    pub file: PathBuf,
+    /// 1-based line and column, where known.
+    pub at: Option<(usize, usize)>,
+    /// The field, e.g. "plant.A".
+    pub field: String,
+    /// What is wrong.
+    pub reason: String,
+}
+
+impl fmt::Display for ScenarioError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.file.display())?;
+        if let Some((l, c)) = self.at {
+            write!(f, ":{l}:{c}")?;
+        }
+        if self.field.is_empty() {
+            write!(f, ": {}", self.reason)
+        } else {
+            write!(f, ": {}: {}", self.field, self.reason)
+        }
+    }
+}
+
+impl std::error::Error for ScenarioError {}
+
+/// A [`ScenarioError`] for `field` of a validated scenario, located in its text.
+pub fn locate_error(s: &Scenario, field: &str, reason: String) -> ScenarioError {
+    let at = locate::offset(&s.source, &locate::parse_path(field)).map(|o| locate::line_col(&s.source, o));
+    ScenarioError { file: s.path.clone(), at, field: field.to_string(), reason }
+}
+
+impl Scenario {
+    /// Reads and validates a scenario file.
+    pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
+        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError {
+            file: path.to_path_buf(),
+            at: None,
+            field: String::new(),
+            reason: format!("cannot read: {e}"),
+        })?;
+        Self::parse(path, &text)
+    }
+
+    /// Validates scenario text (`path` is used in messages).
+    pub fn parse(path: &Path, text: &str) -> Result<Scenario, ScenarioError> {
+        validate::parse(path, text)
+    }
+
+    /// Names of the observers, in order.
+    pub fn observer_names(&self) -> Vec<&str> {
+        self.observers.iter().map(|o| o.name.as_str()).collect()
+    }
+}

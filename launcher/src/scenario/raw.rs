@@ -1,0 +1,105 @@
+//! The scenario file as written: every table rejects unknown keys.
+
+use std::collections::BTreeMap;
+
+use lti::signal::Signal;
+use serde::Deserialize;
+
+/// A matrix as rows of numbers.
+pub type Rows = Vec<Vec<f64>>;
+
+/// The whole file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawScenario {
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    pub dt: f64,
+    pub duration: f64,
+    pub plant: RawPlant,
+    #[serde(default)]
+    pub disturbance: Vec<Signal>,
+    #[serde(default)]
+    pub measurement_disturbance: Vec<Signal>,
+    #[serde(default)]
+    pub input: Vec<Signal>,
+    #[serde(default)]
+    pub observer: Vec<RawObserver>,
+    pub controller: Option<RawController>,
+    pub expect: Option<RawExpect>,
+}
+
+/// `[plant]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawPlant {
+    #[serde(rename = "A")]
+    pub a: Rows,
+    #[serde(rename = "B")]
+    pub b: Rows,
+    #[serde(rename = "C")]
+    pub c: Rows,
+    #[serde(rename = "E")]
+    pub e: Option<Rows>,
+    #[serde(rename = "D")]
+    pub d: Option<Rows>,
+    pub x0: Vec<f64>,
+    /// |x_i| beyond this stops the run (default 1e9).
+    pub state_bound: Option<f64>,
+    /// Names of the states for plots (default x1, x2, …).
+    pub state_names: Option<Vec<String>>,
+    /// Units of the states for plots.
+    pub state_units: Option<Vec<String>>,
+}
+
+/// One pole as written: a real number, or [re, im] for a complex pair.
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+pub enum RawPole {
+    Real(f64),
+    Pair(Vec<f64>),
+}
+
+/// `[[observer]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawObserver {
+    pub name: String,
+    pub kind: String,
+    pub poles: Option<Vec<RawPole>>,
+    pub placement: Option<String>,
+    #[serde(rename = "H")]
+    pub h: Option<Rows>,
+    pub decay: Option<f64>,
+    pub path: Option<String>,
+}
+
+/// `[controller]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawController {
+    pub kind: String,
+    pub observer: String,
+    pub poles: Option<Vec<RawPole>>,
+    pub gain: Option<Rows>,
+    pub placement: Option<String>,
+}
+
+/// `[expect]`: per-observer upper bounds on the run's figures.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawExpect {
+    /// Max |x − x̂| over the last quarter of the run, per observer.
+    #[serde(default)]
+    pub tail_max_abs_error: BTreeMap<String, f64>,
+    /// Max |y − Cx̂| over the last quarter of the run, per observer.
+    #[serde(default)]
+    pub tail_max_abs_residual: BTreeMap<String, f64>,
+    /// Pairs of observers whose estimates must agree at every step: "a/b" = tolerance.
+    #[serde(default)]
+    pub max_abs_difference: BTreeMap<String, f64>,
+    /// Upper bound on tail error(uio) / tail error(reference): "uio/luenberger" = 1e-4.
+    #[serde(default)]
+    pub tail_error_ratio: BTreeMap<String, f64>,
+}

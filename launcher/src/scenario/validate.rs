@@ -1,0 +1,341 @@
+//! From TOML text to a checked [`Scenario`].
+
+use std::collections::BTreeSet;
+use std::path::Path;
+
+use controller::design::FeedbackSpec;
+use lti::place::Method;
+use lti::signal::Signal;
+use lti::{Mat, Model, PoleSpec, Poles};
+use observer::design::Path as HuiZakPath;
+use observer::Spec;
+
+use super::locate::{line_col, offset, parse_path};
+use super::raw::{RawController, RawExpect, RawObserver, RawPole, RawScenario, Rows};
+use super::{ControllerEntry, ObserverEntry, Scenario, ScenarioError};
+
+/// Observer kinds a scenario may name.
+pub const KINDS: [&str; 7] = ["luenberger", "chen-patton-uio", "das-ghosal", "das-ghosal-uio", "gi-full-order", "cumming", "hui-zak-uio"];
+
+/// Field path and reason, before the location is looked up.
+type Bad = (String, String);
+
+fn bad(field: impl Into<String>, reason: impl Into<String>) -> Bad {
+    (field.into(), reason.into())
+}
+
+pub(super) fn parse(path: &Path, text: &str) -> Result<Scenario, ScenarioError> {
+    let at = |field: &str| offset(text, &parse_path(field)).map(|o| line_col(text, o));
+    let error = |(field, reason): Bad| ScenarioError { file: path.to_path_buf(), at: at(&field), field, reason };
+    let de = toml::de::Deserializer::parse(text).map_err(|e| ScenarioError {
+        file: path.to_path_buf(),
+        at: e.span().map(|s| line_col(text, s.start)),
+        field: String::new(),
+        reason: format!("malformed TOML: {}", first_line(e.message())),
+    })?;
+    let raw: RawScenario = serde_path_to_error::deserialize(de).map_err(|e| {
+        let field = e.path().to_string();
+        let field = if field == "." { String::new() } else { field };
+        let mut reason = first_line(e.inner().message()).to_string();
+        if field.contains("poles") && reason.contains("untagged") {
+            reason = "each pole is a number, or [re, im] for a complex pair".into();
+        }
+        let loc = e.inner().span().map(|s| line_col(text, s.start)).or_else(|| at(&field));
+        ScenarioError { file: path.to_path_buf(), at: loc, field, reason }
+    })?;
+    build(path, raw).map_err(error).map(|mut s| {
+        s.path = path.to_path_buf();
+        s.source = text.to_string();
+        s
+    })
+}
+
+fn first_line(s: &str) -> &str {
+    s.lines().next().unwrap_or(s).trim()
+}
+
+fn finite(field: &str, v: f64) -> Result<f64, Bad> {
+    if v.is_finite() { Ok(v) } else { Err(bad(field, format!("{v} is not a finite number"))) }
+}
+
+/// A matrix from rows: not empty, not ragged, finite, and of the required shape.
+fn matrix(field: &str, rows: &Rows, shape: (Option<usize>, Option<usize>), why: &str) -> Result<Mat, Bad> {
+    if rows.is_empty() || rows.iter().all(|r| r.is_empty()) {
+        return Err(bad(field, "must not be empty"));
+    }
+    let cols = rows[0].len();
+    for (i, r) in rows.iter().enumerate() {
+        if r.len() != cols {
+            return Err(bad(format!("{field}[{i}]"), format!("ragged: row {i} has {} entries, row 0 has {cols}", r.len())));
+        }
+        for (j, &v) in r.iter().enumerate() {
+            if !v.is_finite() {
+                return Err(bad(format!("{field}[{i}]"), format!("entry {j} is {v}, not a finite number")));
+            }
+        }
+    }
+    let (want_r, want_c) = shape;
+    if want_r.is_some_and(|r| r != rows.len()) || want_c.is_some_and(|c| c != cols) {
+        let show = |o: Option<usize>| o.map_or("·".to_string(), |v| v.to_string());
+        return Err(bad(field, format!("is {}×{cols}, must be {}×{} ({why})", rows.len(), show(want_r), show(want_c))));
+    }
+    Ok(Mat::from_fn(rows.len(), cols, |i, j| rows[i][j]))
+}
+
+fn signals(field: &str, list: &[Signal], count: usize, source: &str) -> Result<Vec<Signal>, Bad> {
+    if list.len() != count {
+        return Err(bad(
+            field,
+            format!("{} [[{field}]] entr{} given, {source} needs {count} (one per column, in order)", list.len(), if list.len() == 1 { "y" } else { "ies" }),
+        ));
+    }
+    for (i, s) in list.iter().enumerate() {
+        s.validate().map_err(|(f, reason)| bad(format!("{field}[{i}].{f}"), reason))?;
+    }
+    Ok(list.to_vec())
+}
+
+fn poles(field: &str, raw: &[RawPole]) -> Result<Poles, Bad> {
+    let mut specs = Vec::new();
+    for (i, p) in raw.iter().enumerate() {
+        let f = format!("{field}[{i}]");
+        match p {
+            RawPole::Real(x) => specs.push(PoleSpec::Real(finite(&f, *x)?)),
+            RawPole::Pair(v) if v.len() == 2 => {
+                let (re, im) = (finite(&f, v[0])?, finite(&f, v[1])?);
+                if im != 0.0 && specs.contains(&PoleSpec::Pair(re, -im)) {
+                    return Err(bad(f, format!("[{re}, {im}] is the conjugate of [{re}, {}], which already implies it", -im)));
+                }
+                specs.push(PoleSpec::Pair(re, im));
+            }
+            RawPole::Pair(v) => return Err(bad(f, format!("a complex pair is written [re, im]; this has {} numbers", v.len()))),
+        }
+    }
+    if specs.is_empty() {
+        return Err(bad(field, "must not be empty"));
+    }
+    Poles::new(specs).map_err(|e| bad(field, e.to_string()))
+}
+
+fn placement(field: &str, p: &Option<String>) -> Result<Method, Bad> {
+    match p.as_deref() {
+        None | Some("robust") | Some("yt") => Ok(Method::YangTits),
+        Some("knv0") => Ok(Method::Knv0),
+        Some("matlab") => Ok(Method::Matlab),
+        Some("ackermann") => Ok(Method::Ackermann),
+        Some(other) => Err(bad(field, format!("'{other}' is not a placement (robust, knv0, matlab, ackermann)"))),
+    }
+}
+
+fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
+    let _ = path;
+    if raw.name.is_empty() || !raw.name.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_') {
+        return Err(bad("name", format!("'{}' must be non-empty letters, digits, '-' or '_' (it names the recording)", raw.name)));
+    }
+    let dt = finite("dt", raw.dt)?;
+    let duration = finite("duration", raw.duration)?;
+    if dt <= 0.0 {
+        return Err(bad("dt", format!("{dt} must be > 0")));
+    }
+    if duration <= 0.0 {
+        return Err(bad("duration", format!("{duration} must be > 0")));
+    }
+    if duration < dt {
+        return Err(bad("duration", format!("{duration} is shorter than one step (dt = {dt})")));
+    }
+    let steps_f = (duration / dt).round();
+    if (steps_f * dt - duration).abs() > 1e-9 * duration {
+        return Err(bad("duration", format!("{duration} is not a whole number of steps of dt = {dt}")));
+    }
+    if steps_f > 1e9 {
+        return Err(bad("duration", format!("{steps_f} steps is more than 1e9")));
+    }
+    let steps = steps_f as u64;
+
+    // Plant.
+    let p = &raw.plant;
+    let a = matrix("plant.A", &p.a, (None, None), "")?;
+    let n = a.nrows();
+    if a.ncols() != n {
+        return Err(bad("plant.A", format!("is {}×{}, must be square", n, a.ncols())));
+    }
+    let b = matrix("plant.B", &p.b, (Some(n), None), "n rows, one column per known input")?;
+    let c = matrix("plant.C", &p.c, (None, Some(n)), "one column per state")?;
+    let pn = c.nrows();
+    let e = match &p.e {
+        Some(rows) => matrix("plant.E", rows, (Some(n), None), "n rows, one column per unknown input")?,
+        None => Mat::zeros(n, 0),
+    };
+    let d = match &p.d {
+        Some(rows) => matrix("plant.D", rows, (Some(pn), None), "one row per output, one column per measurement disturbance")?,
+        None => Mat::zeros(pn, 0),
+    };
+    if p.x0.len() != n {
+        return Err(bad("plant.x0", format!("has {} entries, the plant has {n} states", p.x0.len())));
+    }
+    for (i, &v) in p.x0.iter().enumerate() {
+        finite(&format!("plant.x0[{i}]"), v)?;
+    }
+    let state_bound = finite("plant.state_bound", p.state_bound.unwrap_or(1e9))?;
+    if state_bound <= 0.0 {
+        return Err(bad("plant.state_bound", "must be > 0"));
+    }
+    let layout = lockstep::PlantLayout { n, p: pn, q: e.ncols(), r: d.ncols(), l: b.ncols() };
+    if layout.len() > lockstep::MAX_VALUES {
+        return Err(bad("plant", format!("n + p + q + r + 2l = {} values exceed the {} a sample holds", layout.len(), lockstep::MAX_VALUES)));
+    }
+    let names = |field: &str, v: &Option<Vec<String>>, default: &dyn Fn(usize) -> String| -> Result<Vec<String>, Bad> {
+        match v {
+            Some(v) if v.len() != n => Err(bad(field, format!("has {} entries, the plant has {n} states", v.len()))),
+            Some(v) => Ok(v.clone()),
+            None => Ok((0..n).map(default).collect()),
+        }
+    };
+    let state_names = names("plant.state_names", &p.state_names, &|i| format!("x{}", i + 1))?;
+    let state_units = names("plant.state_units", &p.state_units, &|_| String::new())?;
+
+    let disturbances = signals("disturbance", &raw.disturbance, e.ncols(), "plant.E")?;
+    let measurement_disturbances = signals("measurement_disturbance", &raw.measurement_disturbance, d.ncols(), "plant.D")?;
+    let inputs = signals("input", &raw.input, b.ncols(), "plant.B")?;
+    let model = Model { a, b, c, e, d };
+
+    // Observers.
+    let mut seen = BTreeSet::new();
+    let mut observers = Vec::new();
+    for (i, o) in raw.observer.iter().enumerate() {
+        let f = format!("observer[{i}]");
+        if o.name.is_empty() || !o.name.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_') {
+            return Err(bad(format!("{f}.name"), format!("'{}' must be non-empty letters, digits, '-' or '_'", o.name)));
+        }
+        if !seen.insert(o.name.clone()) {
+            return Err(bad(format!("{f}.name"), format!("two observers are named '{}'", o.name)));
+        }
+        observers.push(ObserverEntry { name: o.name.clone(), spec: observer_spec(&f, o, &model)? });
+    }
+
+    let controller = raw.controller.as_ref().map(|c| controller_entry(c, &model, &seen)).transpose()?;
+    let expect = raw.expect.unwrap_or_default();
+    check_expect(&expect, &seen)?;
+    Ok(Scenario {
+        path: Default::default(),
+        name: raw.name,
+        description: raw.description,
+        dt,
+        duration,
+        steps,
+        model,
+        x0: p.x0.clone(),
+        state_bound,
+        state_names,
+        state_units,
+        disturbances,
+        measurement_disturbances,
+        inputs,
+        observers,
+        controller,
+        expect,
+        source: String::new(),
+    })
+}
+
+fn observer_spec(f: &str, o: &RawObserver, model: &Model) -> Result<Spec, Bad> {
+    if !KINDS.contains(&o.kind.as_str()) {
+        return Err(bad(format!("{f}.kind"), format!("'{}' is not an observer kind ({})", o.kind, KINDS.join(", "))));
+    }
+    let method = placement(&format!("{f}.placement"), &o.placement)?;
+    let needs_poles = || match &o.poles {
+        Some(p) => poles(&format!("{f}.poles"), p),
+        None => Err(bad(format!("{f}.poles"), format!("a {} observer needs poles", o.kind))),
+    };
+    let opt_poles = || o.poles.as_ref().map(|p| poles(&format!("{f}.poles"), p)).transpose();
+    let refuse = |key: &str, given: bool| {
+        if given { Err(bad(format!("{f}.{key}"), format!("a {} observer takes no {key}", o.kind))) } else { Ok(()) }
+    };
+    let (n, p) = (model.n(), model.p());
+    if o.kind != "hui-zak-uio" {
+        refuse("decay", o.decay.is_some())?;
+        refuse("path", o.path.is_some())?;
+    }
+    if !matches!(o.kind.as_str(), "das-ghosal-uio" | "cumming") {
+        refuse("H", o.h.is_some())?;
+    }
+    Ok(match o.kind.as_str() {
+        "luenberger" => Spec::Luenberger { poles: needs_poles()?, placement: method },
+        "chen-patton-uio" => Spec::ChenPatton { poles: needs_poles()?, placement: method },
+        "das-ghosal" => Spec::DasGhosal { poles: needs_poles()?, placement: method },
+        "gi-full-order" => Spec::GiFullOrder { poles: needs_poles()?, placement: method },
+        "das-ghosal-uio" => {
+            let h = o.h.as_ref().map(|h| matrix(&format!("{f}.H"), h, (Some(n - p.min(n)), Some(p)), "(n − p)×p, the free matrix of eq. 22")).transpose()?;
+            if h.is_some() && o.poles.is_some() {
+                return Err(bad(format!("{f}.poles"), "give H or poles, not both (H fixes the poles)"));
+            }
+            if h.is_none() && o.poles.is_none() {
+                return Err(bad(format!("{f}.H"), "a das-ghosal-uio observer needs H = [[…]] or poles = […]"));
+            }
+            Spec::DasGhosalUio { h, poles: opt_poles()?, placement: method }
+        }
+        "cumming" => {
+            let h = o.h.as_ref().map(|h| matrix(&format!("{f}.H"), h, (Some(n - p.min(n)), Some(n)), "(n − p)×n, completing C to an invertible [C; H]")).transpose()?;
+            Spec::Cumming { poles: needs_poles()?, placement: method, h }
+        }
+        "hui-zak-uio" => {
+            let decay = finite(&format!("{f}.decay"), o.decay.unwrap_or(0.0))?;
+            if decay < 0.0 {
+                return Err(bad(format!("{f}.decay"), format!("{decay} must be ≥ 0")));
+            }
+            let path = match o.path.as_deref() {
+                None | Some("placement") => HuiZakPath::Placement,
+                Some("lmi") => HuiZakPath::Lmi,
+                Some(other) => return Err(bad(format!("{f}.path"), format!("'{other}' is not a design path (placement, lmi)"))),
+            };
+            Spec::HuiZak { decay, poles: opt_poles()?, placement: method, path }
+        }
+        _ => unreachable!("kind checked above"),
+    })
+}
+
+fn controller_entry(c: &RawController, model: &Model, observers: &BTreeSet<String>) -> Result<ControllerEntry, Bad> {
+    if c.kind != "state-feedback" {
+        return Err(bad("controller.kind", format!("'{}' is not a controller kind (state-feedback)", c.kind)));
+    }
+    if !observers.contains(&c.observer) {
+        let known: Vec<&str> = observers.iter().map(String::as_str).collect();
+        return Err(bad("controller.observer", format!("no observer named '{}' (observers: {})", c.observer, known.join(", "))));
+    }
+    let method = placement("controller.placement", &c.placement)?;
+    let spec = match (&c.poles, &c.gain) {
+        (Some(p), None) => FeedbackSpec::Poles { poles: poles("controller.poles", p)?, placement: method },
+        (None, Some(g)) => FeedbackSpec::Gain(matrix("controller.gain", g, (Some(model.l()), Some(model.n())), "one row per input, one column per state")?),
+        (Some(_), Some(_)) => return Err(bad("controller.gain", "give poles or gain, not both")),
+        (None, None) => return Err(bad("controller.poles", "a state-feedback controller needs poles = […] or gain = [[…]]")),
+    };
+    Ok(ControllerEntry { observer: c.observer.clone(), spec })
+}
+
+fn check_expect(e: &RawExpect, observers: &BTreeSet<String>) -> Result<(), Bad> {
+    let known = |field: &str, name: &str| {
+        if observers.contains(name) { Ok(()) } else { Err(bad(field, format!("no observer named '{name}'"))) }
+    };
+    let positive = |field: &str, v: f64| {
+        if v.is_finite() && v > 0.0 { Ok(()) } else { Err(bad(field, format!("{v} must be a finite number > 0"))) }
+    };
+    for (table, map) in [("tail_max_abs_error", &e.tail_max_abs_error), ("tail_max_abs_residual", &e.tail_max_abs_residual)] {
+        for (name, &v) in map {
+            let f = format!("expect.{table}.{name}");
+            known(&f, name)?;
+            positive(&f, v)?;
+        }
+    }
+    for (table, map) in [("max_abs_difference", &e.max_abs_difference), ("tail_error_ratio", &e.tail_error_ratio)] {
+        for (pair, &v) in map {
+            let f = format!("expect.{table}");
+            let Some((a, b)) = pair.split_once('/') else {
+                return Err(bad(f, format!("'{pair}' must name two observers as \"a/b\"")));
+            };
+            known(&f, a)?;
+            known(&f, b)?;
+            positive(&f, v)?;
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,227 @@
+//! The run summary: what `summary.json` holds and the table the launcher prints.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use lti::eig::sig;
+use serde::Serialize;
+
+use crate::plan::Plan;
+use crate::record::{Latency, Metrics, Percentiles};
+use crate::run::{Options, Stop};
+use crate::scenario::Scenario;
+
+/// One observer's line.
+#[derive(Debug, Clone, Serialize)]
+pub struct ObserverSummary {
+    /// Name.
+    pub name: String,
+    /// Kind.
+    pub kind: String,
+    /// max |x − x̂| over the last quarter of the run.
+    pub tail_max_abs_error: f64,
+    /// max |y − Cx̂| over the last quarter of the run.
+    pub tail_max_abs_residual: f64,
+    /// max |x − x̂| over the run.
+    pub max_abs_error: f64,
+    /// max |x − x̂| at the last step.
+    pub final_abs_error: f64,
+    /// Continuous error-dynamics eigenvalues, [re, im].
+    pub poles: Vec<[f64; 2]>,
+    /// Sampled observer eigenvalues, [re, im].
+    pub discrete_poles: Vec<[f64; 2]>,
+}
+
+/// One `[expect]` entry, checked.
+#[derive(Debug, Clone, Serialize)]
+pub struct Expectation {
+    /// What, e.g. "tail_max_abs_error.uio".
+    pub what: String,
+    /// The bound.
+    pub limit: f64,
+    /// The value reached.
+    pub value: f64,
+    /// value ≤ limit.
+    pub ok: bool,
+}
+
+/// Latency percentiles.
+#[derive(Debug, Clone, Serialize)]
+pub struct LatencySummary {
+    /// Full step: plant sends y_k → plant has u_k.
+    pub step: Percentiles,
+    /// Per hop.
+    pub hops: BTreeMap<String, Percentiles>,
+}
+
+/// The summary of a run.
+#[derive(Debug, Clone, Serialize)]
+pub struct Summary {
+    /// Scenario name.
+    pub scenario: String,
+    /// "processes" or "in-process".
+    pub mode: String,
+    /// Wait strategy (processes mode).
+    pub wait: String,
+    /// Sample period, s.
+    pub dt: f64,
+    /// Scenario duration, s.
+    pub duration: f64,
+    /// Steps completed.
+    pub steps: u64,
+    /// Steps the scenario asks for.
+    pub steps_planned: u64,
+    /// Wall-clock time of the run, s.
+    pub wall_s: f64,
+    /// steps / wall_s.
+    pub steps_per_s: f64,
+    /// Per observer.
+    pub observers: Vec<ObserverSummary>,
+    /// max |x̂_a − x̂_b| over the run, "a/b" → value.
+    pub differences: BTreeMap<String, f64>,
+    /// Closed-loop eigenvalues eig(A − BG), [re, im] (with a controller).
+    pub closed_loop_poles: Option<Vec<[f64; 2]>>,
+    /// Latency, ns.
+    pub latency_ns: LatencySummary,
+    /// `[expect]`, checked.
+    pub expectations: Vec<Expectation>,
+    /// Why the run stopped early, if it did.
+    pub stopped: Option<String>,
+    /// The recording.
+    pub recording: Option<String>,
+}
+
+fn pairs(v: &[lti::C64]) -> Vec<[f64; 2]> {
+    v.iter().map(|z| [z.re, z.im]).collect()
+}
+
+impl Summary {
+    /// Gathers the summary of a run.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(s: &Scenario, plan: &Plan, opts: &Options, m: &Metrics, lat: &Latency, wall_s: f64, stop: &Stop, rrd: Option<&Path>) -> Self {
+        let observers: Vec<ObserverSummary> = s
+            .observers
+            .iter()
+            .zip(&m.observers)
+            .zip(&plan.observers)
+            .map(|((o, f), (_, d))| ObserverSummary {
+                name: o.name.clone(),
+                kind: o.spec.kind().into(),
+                tail_max_abs_error: f.tail_max_abs_error,
+                tail_max_abs_residual: f.tail_max_abs_residual,
+                max_abs_error: f.max_abs_error,
+                final_abs_error: f.final_abs_error,
+                poles: pairs(&d.report.poles),
+                discrete_poles: pairs(&d.report.discrete_poles),
+            })
+            .collect();
+        let names = s.observer_names();
+        let differences = m.differences.iter().map(|((a, b), d)| (format!("{}/{}", names[*a], names[*b]), *d)).collect();
+        let stopped = match stop {
+            Stop::Completed => None,
+            Stop::Diverged(w) => Some(format!("diverged: {w}")),
+            Stop::Interrupted(sig) => Some(format!("interrupted by {sig}")),
+            Stop::Failed(w) => Some(format!("failed: {w}")),
+        };
+        let mut summary = Summary {
+            scenario: s.name.clone(),
+            mode: opts.mode.name().into(),
+            wait: opts.wait.to_string(),
+            dt: s.dt,
+            duration: s.duration,
+            steps: m.steps,
+            steps_planned: s.steps,
+            wall_s,
+            steps_per_s: m.steps as f64 / wall_s.max(1e-9),
+            observers,
+            differences,
+            closed_loop_poles: plan.feedback.as_ref().map(|f| pairs(&f.closed_loop)),
+            latency_ns: LatencySummary { step: lat.step_percentiles(), hops: lat.hop_percentiles().into_iter().collect() },
+            expectations: Vec::new(),
+            stopped,
+            recording: rrd.map(|p| p.display().to_string()),
+        };
+        summary.expectations = summary.check(s);
+        summary
+    }
+
+    fn observer(&self, name: &str) -> Option<&ObserverSummary> {
+        self.observers.iter().find(|o| o.name == name)
+    }
+
+    /// Checks the scenario's `[expect]` table against this run.
+    pub fn check(&self, s: &Scenario) -> Vec<Expectation> {
+        let e = &s.expect;
+        let mut out = Vec::new();
+        let mut add = |what: String, limit: f64, value: Option<f64>| {
+            let value = value.unwrap_or(f64::INFINITY);
+            out.push(Expectation { what, limit, value, ok: value <= limit });
+        };
+        for (name, &limit) in &e.tail_max_abs_error {
+            add(format!("tail_max_abs_error.{name}"), limit, self.observer(name).map(|o| o.tail_max_abs_error));
+        }
+        for (name, &limit) in &e.tail_max_abs_residual {
+            add(format!("tail_max_abs_residual.{name}"), limit, self.observer(name).map(|o| o.tail_max_abs_residual));
+        }
+        for (pair, &limit) in &e.max_abs_difference {
+            let (a, b) = pair.split_once('/').unwrap_or((pair, pair));
+            let v = self.differences.get(pair).or_else(|| self.differences.get(&format!("{b}/{a}"))).copied();
+            add(format!("max_abs_difference.{pair}"), limit, v);
+        }
+        for (pair, &limit) in &e.tail_error_ratio {
+            let (a, b) = pair.split_once('/').unwrap_or((pair, pair));
+            let v = match (self.observer(a), self.observer(b)) {
+                (Some(x), Some(y)) => Some(x.tail_max_abs_error / y.tail_max_abs_error),
+                _ => None,
+            };
+            add(format!("tail_error_ratio.{pair}"), limit, v);
+        }
+        out
+    }
+
+    /// Whether every expectation holds.
+    pub fn expectations_met(&self) -> bool {
+        self.expectations.iter().all(|e| e.ok)
+    }
+
+    /// Writes the JSON atomically (a temporary file renamed into place).
+    pub fn write(&self, path: &Path) -> Result<(), String> {
+        let tmp = path.with_extension("json.tmp");
+        let text = serde_json::to_string_pretty(self).expect("summary serialises");
+        std::fs::write(&tmp, text + "\n").and_then(|_| std::fs::rename(&tmp, path)).map_err(|e| format!("{}: cannot write: {e}", path.display()))
+    }
+
+    /// The table printed after a run.
+    pub fn table(&self) -> String {
+        let mut t = String::new();
+        let us = |ns: u64| format!("{:.1} µs", ns as f64 / 1000.0);
+        t += &format!(
+            "{} ({}, {} of {} steps of {} s, {:.2} s wall, {} steps/s)\n",
+            self.scenario,
+            self.mode,
+            self.steps,
+            self.steps_planned,
+            self.dt,
+            self.wall_s,
+            sig(self.steps_per_s.round())
+        );
+        t += &format!("  {:<14} {:<16} {:>14} {:>14}\n", "observer", "kind", "tail max|e|", "tail max|r|");
+        for o in &self.observers {
+            t += &format!("  {:<14} {:<16} {:>14.3e} {:>14.3e}\n", o.name, o.kind, o.tail_max_abs_error, o.tail_max_abs_residual);
+        }
+        let p = &self.latency_ns.step;
+        if p.max > 0 {
+            t += &format!("  step latency   p50 {}  p90 {}  p99 {}  p99.9 {}  max {}\n", us(p.p50), us(p.p90), us(p.p99), us(p.p999), us(p.max));
+            for (hop, p) in &self.latency_ns.hops {
+                t += &format!("    {:<30} p50 {}  p99 {}  max {}\n", hop, us(p.p50), us(p.p99), us(p.max));
+            }
+        }
+        for e in &self.expectations {
+            t += &format!("  expect {} ≤ {:.3e}: {:.3e} {}\n", e.what, e.limit, e.value, if e.ok { "ok" } else { "MISSED" });
+        }
+        if let Some(why) = &self.stopped {
+            t += &format!("  stopped: {why}\n");
+        }
+        t
+    }
+}
