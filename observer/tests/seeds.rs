@@ -179,8 +179,26 @@ fn seed004() -> Model {
 
 #[test]
 fn seed004_hui_zak_placement_path() {
+    seed004_hui_zak(Path::Placement);
+}
+
+#[cfg(feature = "lmi")]
+#[test]
+fn seed004_hui_zak_lmi_path() {
+    seed004_hui_zak(Path::Lmi);
+}
+
+#[cfg(not(feature = "lmi"))]
+#[test]
+fn seed004_lmi_path_needs_the_feature() {
+    let spec = Spec::HuiZak { decay: 0.05, poles: None, placement: Method::YangTits, path: Path::Lmi };
+    let err = design(&seed004(), &spec, 1e-3).unwrap_err();
+    assert!(err.detail.contains("lmi"), "{err}");
+}
+
+fn seed004_hui_zak(path: Path) {
     let s = &seeds()["seed_004"];
-    let spec = Spec::HuiZak { decay: 0.05, poles: None, placement: Method::YangTits, path: Path::Placement };
+    let spec = Spec::HuiZak { decay: 0.05, poles: None, placement: Method::YangTits, path };
     let r = design(&seed004(), &spec, 1e-3).unwrap().report;
     assert!(close(matrix(&r, "M"), &mat(&s["design"]["M"]), 1e-12));
     assert!(close(matrix(&r, "A1"), &mat(&s["design"]["A1=(I-MC)A"]), 1e-12));

@@ -221,7 +221,15 @@ pub(super) fn design(model: &Model, decay: f64, poles: Option<&Poles>, method: M
 #[cfg(feature = "lmi")]
 fn solve_lmi(model: &Model, decay: f64, checks: &mut Checks) -> Result<LmiSolution, DesignError> {
     let dec = decoupling(&model.a, &model.e, &model.c, &model.d).map_err(|e| checks.error("decoupling", e.to_string()))?;
-    crate::lmi::solve(&dec.a1, &model.c, &model.d, decay).map_err(|e| checks.error("LMI", e))
+    let sol = crate::lmi::solve(&dec.a1, &model.c, &model.d, decay).map_err(|e| checks.error("LMI", e))?;
+    let lhs = dec.a1.transpose() * &sol.p + &sol.p * &dec.a1 - model.c.transpose() * sol.y.transpose() - &sol.y * &model.c + &sol.p * decay;
+    let worst = lhs.symmetric_eigen().eigenvalues.max();
+    checks.require(
+        "A1ᵀP + PA1 − CᵀYᵀ − YC + αP ⪯ 0, P ⪰ 0.01I, YD = 0 (LMI)",
+        worst <= 1e-7 * sol.p.amax() && lyapunov::min_eigenvalue(&sol.p) >= 0.01 * (1.0 - 1e-6),
+        format!("λmax = {}, λmin(P) = {}", sig(worst), sig(lyapunov::min_eigenvalue(&sol.p))),
+    )?;
+    Ok(sol)
 }
 
 #[cfg(not(feature = "lmi"))]
