@@ -18,6 +18,12 @@ fi
 
 # The multi-process tests start the component binaries: build them all first.
 cargo build --release --workspace --bins
-cargo test --release --workspace
+
+log=$(mktemp)
+trap 'rm -f "$log"' EXIT
+cargo test --release --workspace 2>&1 | tee "$log"
 # The same design tests with the LMI solver compiled in.
-cargo test --release -p observer --features lmi
+cargo test --release -p observer --features lmi 2>&1 | tee -a "$log"
+
+# One closing line for the whole suite.
+awk '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed\n", p, f }' "$log"

@@ -4,12 +4,14 @@
 
 pub mod design_report;
 pub mod error;
+pub mod export;
 pub mod plan;
 pub mod record;
 pub mod recording;
 pub mod run;
 pub mod scenario;
 pub mod summary;
+pub mod tools;
 
 pub use error::LaunchError;
 pub use scenario::Scenario;

@@ -52,6 +52,14 @@ enum Command {
         #[arg(long)]
         dir: Option<PathBuf>,
     },
+    /// Export a recording's signals as CSV, one file per entity group.
+    Export {
+        /// The recording.
+        recording: PathBuf,
+        /// Output directory.
+        #[arg(long)]
+        csv: PathBuf,
+    },
     /// Run one component (used by the launcher when the component binaries are not beside it).
     #[command(hide = true, disable_help_flag = true)]
     Component {
@@ -147,6 +155,23 @@ fn main() -> ExitCode {
                 }
             }
             ExitCode::SUCCESS
+        }
+        Command::Export { recording, csv } => {
+            let r = match launcher::recording::read(&recording) {
+                Ok(r) => r,
+                Err(e) => return fail(&LaunchError::BadInput(e.to_string())),
+            };
+            let dt = launcher::tools::recorded_dt(&r);
+            if !r.complete {
+                eprintln!("warning: {}: incomplete recording (its writer did not finish); exporting what it holds", recording.display());
+            }
+            match launcher::export::export(&r, &csv, dt) {
+                Ok(files) => {
+                    println!("{} files in {}", files.len(), csv.display());
+                    ExitCode::SUCCESS
+                }
+                Err(e) => fail(&LaunchError::BadInput(e)),
+            }
         }
         Command::Component { kind, args } => component(&kind, args),
     }

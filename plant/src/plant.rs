@@ -10,6 +10,9 @@
 //! G = [B, E, a₁E₁ e₁ᵀ, …],  W = blockdiag(0, 0, Ω₁, …)
 //! ```
 //!
+//! (Φ_h and the B, E columns are computed by [`lti::Model::discretize`], exactly as the observer
+//! designs compute them; each generator's columns by its own block exponential.)
+//!
 //! is exact: nothing inside the step is approximated. A step that contains a switching time of
 //! some c(t) is split there; its pieces' exponentials are computed once, at construction. The
 //! generator is re-evaluated from t at every step rather than propagated, so it cannot drift.
@@ -109,20 +112,24 @@ impl Plant {
             .filter_map(|(i, s)| s.sine().map(|(_, w, ph)| (i, w, ph)))
             .collect();
         let m = l + q + 2 * sines.len();
-        let mut g = DMatrix::<f64>::zeros(n, m);
-        g.columns_mut(0, l).copy_from(&b);
-        g.columns_mut(l, q).copy_from(&e);
-        let mut w = DMatrix::<f64>::zeros(m, m);
-        for (j, &(i, omega, _)) in sines.iter().enumerate() {
-            let amp = cfg.disturbances[i].sine().map_or(0.0, |s| s.0);
-            let col = l + q + 2 * j;
-            g.set_column(col, &(e.column(i) * amp));
-            w[(col, col + 1)] = omega;
-            w[(col + 1, col)] = -omega;
-        }
+        let model = lti::Model { a: a.clone(), b: b.clone(), c: c.clone(), e: e.clone(), d: d.clone() };
+        // Φ, B_d and E_d exactly as the observer designs compute them (Model::discretize), so
+        // plant and observers share the same sampled model to the last bit; only the sine
+        // generators' columns need the larger exponential.
         let piece = |offset: f64, h: f64| {
-            let (phi, gamma) = exp_upper(&a, &g, &w, h);
-            Piece { offset, h, phi, gamma }
+            let dm = model.discretize(h);
+            let mut gamma = DMatrix::<f64>::zeros(n, m);
+            gamma.columns_mut(0, l).copy_from(&dm.b);
+            gamma.columns_mut(l, q).copy_from(&dm.e);
+            for (j, &(i, omega, _)) in sines.iter().enumerate() {
+                let amp = cfg.disturbances[i].sine().map_or(0.0, |s| s.0);
+                let mut g = DMatrix::<f64>::zeros(n, 2);
+                g.set_column(0, &(e.column(i) * amp));
+                let w = DMatrix::from_row_slice(2, 2, &[0.0, omega, -omega, 0.0]);
+                let (_, gj) = exp_upper(&a, &g, &w, h);
+                gamma.columns_mut(l + q + 2 * j, 2).copy_from(&gj);
+            }
+            Piece { offset, h, phi: dm.a, gamma }
         };
         let full = piece(0.0, cfg.dt);
         let splits = split_steps(cfg, &piece);
