@@ -4,6 +4,7 @@
 pub mod design;
 pub mod shell;
 
+use lti::kernel::mul_into;
 use lti::signal::Signal;
 use lti::MatData;
 use nalgebra::{DMatrix, DVector};
@@ -30,7 +31,7 @@ pub struct Controller {
     g: DMatrix<f64>,
     references: Vec<Signal>,
     dt: f64,
-    xhat: DVector<f64>,
+    gx: DVector<f64>,
     u: DVector<f64>,
 }
 
@@ -41,17 +42,19 @@ impl Controller {
         if g.nrows() != cfg.references.len() {
             return Err(format!("G has {} rows but there are {} references", g.nrows(), cfg.references.len()));
         }
-        Ok(Self { xhat: DVector::zeros(g.ncols()), u: DVector::zeros(g.nrows()), g, references: cfg.references.clone(), dt: cfg.dt })
+        Ok(Self { gx: DVector::zeros(g.nrows()), u: DVector::zeros(g.nrows()), g, references: cfg.references.clone(), dt: cfg.dt })
     }
 
     /// u_k = r(t_k) − G x̂_k.
     pub fn step(&mut self, k: u64, xhat: &[f64]) -> &[f64] {
         let t = k as f64 * self.dt;
-        self.xhat.as_mut_slice().copy_from_slice(xhat);
         for (u, r) in self.u.iter_mut().zip(&self.references) {
             *u = r.sample(t, self.dt);
         }
-        self.u.gemv(-1.0, &self.g, &self.xhat, 1.0);
+        mul_into(self.gx.as_mut_slice(), &self.g, xhat);
+        for (u, gx) in self.u.iter_mut().zip(self.gx.iter()) {
+            *u -= gx;
+        }
         self.u.as_slice()
     }
 }

@@ -2,6 +2,7 @@
 //! (as separate processes over iceoryx2, or in one process), and records every signal to a
 //! Rerun `.rrd` with a summary of how each observer did.
 
+pub mod bench;
 pub mod design_report;
 pub mod error;
 pub mod export;

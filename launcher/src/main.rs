@@ -46,6 +46,24 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Benchmark the seed-002 closed loop in one process and across processes.
+    Bench {
+        /// Steps per run.
+        #[arg(long, default_value_t = 100_000)]
+        steps: u64,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+        /// How components wait for samples.
+        #[arg(long)]
+        wait: Option<Wait>,
+        /// Only this mode (default: both).
+        #[arg(long, value_parser = ["processes", "in-process"])]
+        mode: Option<String>,
+        /// Only runs with (on) or without (off) recording (default: both).
+        #[arg(long, value_parser = ["on", "off"])]
+        recording: Option<String>,
+    },
     /// List the shipped scenarios.
     List {
         /// Directory of scenarios.
@@ -143,6 +161,30 @@ fn main() -> ExitCode {
                 print!("{}", r.text);
             }
             if r.ok { ExitCode::SUCCESS } else { ExitCode::from(EXIT_BAD_INPUT as u8) }
+        }
+        Command::Bench { steps, json, wait, mode, recording } => {
+            let wait = wait.unwrap_or_else(Wait::default_for_machine);
+            let modes: Vec<Mode> = match mode.as_deref() {
+                Some("processes") => vec![Mode::Processes],
+                Some(_) => vec![Mode::InProcess],
+                None => vec![Mode::InProcess, Mode::Processes],
+            };
+            let rec: Vec<bool> = match recording.as_deref() {
+                Some("on") => vec![true],
+                Some(_) => vec![false],
+                None => vec![false, true],
+            };
+            match launcher::bench::bench(&scenarios_dir().join("seed002-sine.toml"), steps, wait, &modes, &rec) {
+                Ok(runs) => {
+                    if json {
+                        println!("{}", serde_json::to_string_pretty(&serde_json::json!({ "runs": runs })).expect("serialises"));
+                    } else {
+                        print!("{}", launcher::bench::table(&runs, wait));
+                    }
+                    ExitCode::SUCCESS
+                }
+                Err(e) => fail(&e),
+            }
         }
         Command::List { dir } => {
             let dir = dir.unwrap_or_else(scenarios_dir);

@@ -13,6 +13,7 @@ pub mod discretize;
 pub mod eig;
 pub mod error;
 pub mod householder;
+pub mod kernel;
 pub mod lyapunov;
 pub mod model;
 pub mod pinv;

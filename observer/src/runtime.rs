@@ -8,8 +8,9 @@
 //! step): it first advances z_{k−1} → z_k with the stored y_{k−1}, then forms x̂_k. All buffers are
 //! allocated at construction; `step` does not allocate.
 
+use lti::kernel::{mul_acc, mul_into};
 use lti::MatData;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 /// The matrices of a sampled observer (what the launcher sends to an observer process).
@@ -75,12 +76,10 @@ impl LinearObserver {
             k: (&self.k).into(),
             p: (&self.p).into(),
             q: (&self.q).into(),
-            z: DVector::zeros(r),
-            z_next: DVector::zeros(r),
-            y: DVector::zeros(self.outputs()),
-            y_prev: DVector::zeros(self.outputs()),
-            u_prev: DVector::zeros(self.inputs()),
-            xhat: DVector::zeros(self.states()),
+            z: vec![0.0; r],
+            z_next: vec![0.0; r],
+            y_prev: vec![0.0; self.outputs()],
+            xhat: vec![0.0; self.states()],
             started: false,
         }
     }
@@ -94,31 +93,27 @@ pub struct ObserverState {
     k: DMatrix<f64>,
     p: DMatrix<f64>,
     q: DMatrix<f64>,
-    z: DVector<f64>,
-    z_next: DVector<f64>,
-    y: DVector<f64>,
-    y_prev: DVector<f64>,
-    u_prev: DVector<f64>,
-    xhat: DVector<f64>,
+    z: Vec<f64>,
+    z_next: Vec<f64>,
+    y_prev: Vec<f64>,
+    xhat: Vec<f64>,
     started: bool,
 }
 
 impl ObserverState {
     /// One step: takes y_k and u_{k−1}, returns x̂_k.
     pub fn step(&mut self, y: &[f64], u_prev: &[f64]) -> &[f64] {
-        self.y.as_mut_slice().copy_from_slice(y);
         if self.started {
-            self.u_prev.as_mut_slice().copy_from_slice(u_prev);
-            self.z_next.gemv(1.0, &self.f, &self.z, 0.0);
-            self.z_next.gemv(1.0, &self.g, &self.u_prev, 1.0);
-            self.z_next.gemv(1.0, &self.k, &self.y_prev, 1.0);
+            mul_into(&mut self.z_next, &self.f, &self.z);
+            mul_acc(&mut self.z_next, &self.g, u_prev);
+            mul_acc(&mut self.z_next, &self.k, &self.y_prev);
             std::mem::swap(&mut self.z, &mut self.z_next);
         }
         self.started = true;
-        self.xhat.gemv(1.0, &self.p, &self.z, 0.0);
-        self.xhat.gemv(1.0, &self.q, &self.y, 1.0);
-        std::mem::swap(&mut self.y, &mut self.y_prev);
-        self.xhat.as_slice()
+        mul_into(&mut self.xhat, &self.p, &self.z);
+        mul_acc(&mut self.xhat, &self.q, y);
+        self.y_prev.copy_from_slice(y);
+        &self.xhat
     }
 }
 

@@ -19,6 +19,7 @@
 
 use lockstep::PlantLayout;
 use lti::discretize::exp_upper;
+use lti::kernel::{mul_acc, mul_into};
 use lti::signal::{Signal, SAMPLE_NUDGE};
 use nalgebra::{DMatrix, DVector};
 
@@ -68,6 +69,8 @@ pub struct Plant {
     inputs: Vec<Signal>,
     /// (disturbance index, ω, φ) of each sinusoidal part.
     sines: Vec<(usize, f64, f64)>,
+    /// (sin, cos) of each generator at the last sampled t_k, shared by the sample and the step.
+    generators: Vec<(f64, f64)>,
     c: DMatrix<f64>,
     d: DMatrix<f64>,
     full: Piece,
@@ -78,9 +81,6 @@ pub struct Plant {
     x: DVector<f64>,
     x_next: DVector<f64>,
     xi: DVector<f64>,
-    v: DVector<f64>,
-    y: DVector<f64>,
-    u_prev: Vec<f64>,
     out: Vec<f64>,
 }
 
@@ -140,6 +140,7 @@ impl Plant {
             disturbances: cfg.disturbances.clone(),
             measurement: cfg.measurement_disturbances.clone(),
             inputs: cfg.inputs.clone(),
+            generators: vec![(0.0, 1.0); sines.len()],
             sines,
             c,
             d,
@@ -150,9 +151,6 @@ impl Plant {
             x: DVector::from_column_slice(&cfg.x0),
             x_next: DVector::zeros(n),
             xi: DVector::zeros(m),
-            v: DVector::zeros(r),
-            y: DVector::zeros(p),
-            u_prev: vec![0.0; l],
             out: vec![0.0; layout.len()],
         })
     }
@@ -170,22 +168,34 @@ impl Plant {
     /// The sample of step k: [x_k | y_k | w(t_k) | v(t_k) | r(t_k) | u_{k−1}].
     pub fn sample(&mut self, k: u64) -> &[f64] {
         let t = self.time(k);
-        let lay = self.layout;
-        for (i, s) in self.measurement.iter().enumerate() {
-            self.v[i] = s.sample(t, self.dt);
+        let (dt, lay) = (self.dt, self.layout);
+        for (g, &(_, omega, phase)) in self.generators.iter_mut().zip(&self.sines) {
+            *g = (omega * t + phase).sin_cos();
         }
-        self.y.gemv(1.0, &self.c, &self.x, 0.0);
-        self.y.gemv(1.0, &self.d, &self.v, 1.0);
-        self.out[lay.x()].copy_from_slice(self.x.as_slice());
-        self.out[lay.y()].copy_from_slice(self.y.as_slice());
-        for (o, s) in self.out[lay.w()].iter_mut().zip(&self.disturbances) {
-            *o = s.sample(t, self.dt);
+        let out = &mut self.out;
+        out[lay.x()].copy_from_slice(self.x.as_slice());
+        let mut next_sine = 0;
+        for (i, (o, s)) in out[lay.w()].iter_mut().zip(&self.disturbances).enumerate() {
+            *o = match self.sines.get(next_sine) {
+                Some(&(d, _, _)) if d == i => {
+                    let amplitude = s.sine().map_or(0.0, |a| a.0);
+                    next_sine += 1;
+                    amplitude * self.generators[next_sine - 1].0 + s.held(t + SAMPLE_NUDGE * dt)
+                }
+                _ => s.sample(t, dt),
+            };
         }
-        self.out[lay.v()].copy_from_slice(self.v.as_slice());
-        for (o, s) in self.out[lay.r()].iter_mut().zip(&self.inputs) {
-            *o = s.sample(t, self.dt);
+        for (o, s) in out[lay.v()].iter_mut().zip(&self.measurement) {
+            *o = s.sample(t, dt);
         }
-        self.out[lay.u_prev()].copy_from_slice(&self.u_prev);
+        for (o, s) in out[lay.r()].iter_mut().zip(&self.inputs) {
+            *o = s.sample(t, dt);
+        }
+        // y = C x + D v, written in place.
+        let (head, tail) = out.split_at_mut(lay.w().start);
+        let y = &mut head[lay.y()];
+        mul_into(y, &self.c, self.x.as_slice());
+        mul_acc(y, &self.d, &tail[lay.v().start - lay.w().start..lay.v().end - lay.w().start]);
         &self.out
     }
 
@@ -197,7 +207,8 @@ impl Plant {
     /// x_k → x_{k+1} with u_k held over the step.
     pub fn advance(&mut self, k: u64, u: &[f64]) -> Result<(), Divergence> {
         let t = self.time(k);
-        self.u_prev.copy_from_slice(u);
+        let lay = self.layout;
+        self.out[lay.u_prev()].copy_from_slice(u);
         let pieces: &[Piece] = match self.splits.get(self.next_split) {
             Some((s, pieces)) if *s == k => {
                 self.next_split += 1;
@@ -206,7 +217,8 @@ impl Plant {
             _ => std::slice::from_ref(&self.full),
         };
         for piece in pieces {
-            integrate(piece, t, u, &self.disturbances, &self.sines, &mut self.xi, &mut self.x, &mut self.x_next);
+            let at_tk = (piece.offset == 0.0).then_some(self.generators.as_slice());
+            integrate(piece, t, u, &self.disturbances, &self.sines, at_tk, &mut self.xi, &mut self.x, &mut self.x_next);
         }
         for (i, &v) in self.x.iter().enumerate() {
             if !v.is_finite() || v.abs() > self.bound {
@@ -225,6 +237,7 @@ fn integrate(
     u: &[f64],
     disturbances: &[Signal],
     sines: &[(usize, f64, f64)],
+    generators_at_tk: Option<&[(f64, f64)]>,
     xi: &mut DVector<f64>,
     x: &mut DVector<f64>,
     x_next: &mut DVector<f64>,
@@ -239,12 +252,15 @@ fn integrate(
         xi[l + i] = s.held(mid);
     }
     for (j, &(_, omega, phase)) in sines.iter().enumerate() {
-        let theta = omega * t0 + phase;
-        xi[l + q + 2 * j] = theta.sin();
-        xi[l + q + 2 * j + 1] = theta.cos();
+        let (sin, cos) = match generators_at_tk {
+            Some(g) => g[j],
+            None => (omega * t0 + phase).sin_cos(),
+        };
+        xi[l + q + 2 * j] = sin;
+        xi[l + q + 2 * j + 1] = cos;
     }
-    x_next.gemv(1.0, &piece.phi, x, 0.0);
-    x_next.gemv(1.0, &piece.gamma, xi, 1.0);
+    mul_into(x_next.as_mut_slice(), &piece.phi, x.as_slice());
+    mul_acc(x_next.as_mut_slice(), &piece.gamma, xi.as_slice());
     std::mem::swap(x, x_next);
 }
 

@@ -3,6 +3,7 @@
 //! largest difference of their estimates at any step.
 
 use lockstep::PlantLayout;
+use lti::kernel::mul_into;
 use lti::Mat;
 
 use super::StepRow;
@@ -77,13 +78,10 @@ impl Metrics {
                 emax = emax.max(e.abs());
             }
             let mut rmax: f64 = 0.0;
-            for j in 0..self.layout.p {
-                let mut cx = 0.0;
-                for i in 0..self.layout.n {
-                    cx += self.c[(j, i)] * xhat[i];
-                }
-                let r = y[j] - cx;
-                self.residual[o][j] = r;
+            let res = &mut self.residual[o];
+            mul_into(res, &self.c, xhat);
+            for (r, &yj) in res.iter_mut().zip(y) {
+                *r = yj - *r;
                 rmax = rmax.max(r.abs());
             }
             let f = &mut self.observers[o];

@@ -3,6 +3,7 @@
 //! recording ([`RrdSink`]), written in batched columns off the lockstep's critical path.
 
 mod blueprint;
+mod file_sink;
 mod latency;
 mod metrics;
 mod rrd;
@@ -10,7 +11,7 @@ mod rrd;
 pub use blueprint::blueprint;
 pub use latency::{Latency, Percentiles};
 pub use metrics::{Metrics, ObserverFigures};
-pub use rrd::RrdSink;
+pub use rrd::{RrdSink, SeriesId};
 
 use lockstep::{Header, PlantLayout};
 

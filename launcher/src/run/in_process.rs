@@ -26,7 +26,9 @@ pub fn run(cfg: &Configs, session: &mut Session) -> Result<Stop, LaunchError> {
                 return Ok(Stop::Interrupted(sig));
             }
         }
-        let start = now_ns();
+        // Timing every step would cost two clock reads per ~0.2 µs step: sample one in 16.
+        let timed = k % 16 == 0;
+        let start = if timed { now_ns() } else { 0 };
         row.k = k;
         row.t = plant.time(k);
         row.plant.copy_from_slice(plant.sample(k));
@@ -42,7 +44,7 @@ pub fn run(cfg: &Configs, session: &mut Session) -> Result<Stop, LaunchError> {
             _ => u.copy_from_slice(plant.reference()),
         }
         let diverged = plant.advance(k, &u);
-        let step_ns = now_ns() - start;
+        let step_ns = if timed { Some(now_ns() - start) } else { None };
         session.record_in_process(&row, step_ns)?;
         if let Err(d) = diverged {
             return Ok(Stop::Diverged(d.to_string()));

@@ -6,26 +6,32 @@ use lockstep::PlantLayout;
 
 use crate::error::LaunchError;
 use crate::plan::Plan;
-use crate::record::{blueprint, Latency, Metrics, RrdSink, StepRow};
+use crate::record::{blueprint, Latency, Metrics, RrdSink, SeriesId, StepRow};
 use crate::scenario::Scenario;
 
-/// Channel ids of one observer.
+/// Series of one observer.
 struct ObserverChannels {
-    xhat: Vec<usize>,
-    error: Vec<usize>,
-    residual: Vec<usize>,
+    xhat: Vec<SeriesId>,
+    error: Vec<SeriesId>,
+    residual: Vec<SeriesId>,
 }
 
+/// The recording's series, in three groups by time stamp: the signals of step k, the hops
+/// measured at step k, and what completes one step late (the step time, controller→plant).
 struct Channels {
-    x: Vec<usize>,
-    y: Vec<usize>,
-    w: Vec<usize>,
-    v: Vec<usize>,
-    r: Vec<usize>,
-    u: Vec<usize>,
+    signals: usize,
+    hops_now: usize,
+    hops_late: usize,
+    x: Vec<SeriesId>,
+    y: Vec<SeriesId>,
+    w: Vec<SeriesId>,
+    v: Vec<SeriesId>,
+    r: Vec<SeriesId>,
+    u: Vec<SeriesId>,
     observers: Vec<ObserverChannels>,
-    step_latency: usize,
-    hops: Vec<usize>,
+    step_latency: SeriesId,
+    /// One per hop; the last is controller→plant (late) when there is a controller.
+    hops: Vec<SeriesId>,
 }
 
 /// The recording side of a run.
@@ -68,15 +74,16 @@ impl Session {
         let sink = match rrd {
             Some(path) => {
                 let mut sink = RrdSink::create(path, &s.name, blueprint(s), &s.source).map_err(LaunchError::BadInput)?;
+                let (signals, hops_now, hops_late) = (sink.group(), sink.group(), sink.group());
                 let name = |i: usize| s.state_names[i].clone();
-                let mut series = |path: String, legend: String| sink.channel(&path, &legend);
-                let x = (0..layout.n).map(|i| series(format!("/plant/x/{i}"), format!("{} (true)", name(i)))).collect();
-                let y = (0..layout.p).map(|j| series(format!("/plant/y/{j}"), format!("y{}", j + 1))).collect();
-                let w = (0..layout.q).map(|k| series(format!("/disturbance/{k}"), format!("w{}", k + 1))).collect();
-                let v = (0..layout.r).map(|k| series(format!("/measurement_disturbance/{k}"), format!("v{}", k + 1))).collect();
-                let r = (0..layout.l).map(|k| series(format!("/input/{k}"), format!("r{}", k + 1))).collect();
+                let mut series = |g: usize, path: String, legend: String| sink.series(g, &path, &legend);
+                let x = (0..layout.n).map(|i| series(signals, format!("/plant/x/{i}"), format!("{} (true)", name(i)))).collect();
+                let y = (0..layout.p).map(|j| series(signals, format!("/plant/y/{j}"), format!("y{}", j + 1))).collect();
+                let w = (0..layout.q).map(|k| series(signals, format!("/disturbance/{k}"), format!("w{}", k + 1))).collect();
+                let v = (0..layout.r).map(|k| series(signals, format!("/measurement_disturbance/{k}"), format!("v{}", k + 1))).collect();
+                let r = (0..layout.l).map(|k| series(signals, format!("/input/{k}"), format!("r{}", k + 1))).collect();
                 let u = if s.controller.is_some() {
-                    (0..layout.l).map(|k| series(format!("/controller/u/{k}"), format!("u{}", k + 1))).collect()
+                    (0..layout.l).map(|k| series(signals, format!("/controller/u/{k}"), format!("u{}", k + 1))).collect()
                 } else {
                     Vec::new()
                 };
@@ -84,14 +91,19 @@ impl Session {
                     .observers
                     .iter()
                     .map(|o| ObserverChannels {
-                        xhat: (0..layout.n).map(|i| series(format!("/observer/{}/xhat/{i}", o.name), format!("{} ({})", name(i), o.name))).collect(),
-                        error: (0..layout.n).map(|i| series(format!("/observer/{}/error/{i}", o.name), format!("e{} ({})", i + 1, o.name))).collect(),
-                        residual: (0..layout.p).map(|j| series(format!("/observer/{}/residual/{j}", o.name), format!("r{} ({})", j + 1, o.name))).collect(),
+                        xhat: (0..layout.n).map(|i| series(signals, format!("/observer/{}/xhat/{i}", o.name), format!("{} ({})", name(i), o.name))).collect(),
+                        error: (0..layout.n).map(|i| series(signals, format!("/observer/{}/error/{i}", o.name), format!("e{} ({})", i + 1, o.name))).collect(),
+                        residual: (0..layout.p).map(|j| series(signals, format!("/observer/{}/residual/{j}", o.name), format!("r{} ({})", j + 1, o.name))).collect(),
                     })
                     .collect();
-                let step_latency = series("/latency/step".into(), "step".into());
-                let hop_ids = hops.iter().map(|h| series(hop_entity(h), h.clone())).collect();
-                Some((sink, Channels { x, y, w, v, r, u, observers, step_latency, hops: hop_ids }))
+                let step_latency = series(hops_late, "/latency/step".into(), "step".into());
+                let late = s.controller.is_some();
+                let hop_ids = hops
+                    .iter()
+                    .enumerate()
+                    .map(|(i, h)| series(if late && i == hops.len() - 1 { hops_late } else { hops_now }, hop_entity(h), h.clone()))
+                    .collect();
+                Some((sink, Channels { signals, hops_now, hops_late, x, y, w, v, r, u, observers, step_latency, hops: hop_ids }))
             }
             None => None,
         };
@@ -137,10 +149,12 @@ impl Session {
         self.push(row, step_ns.map(|ns| (row.k - 1, ns)), &hop_values)
     }
 
-    /// Records one step of the in-process loop, whose step time was measured directly.
-    pub fn record_in_process(&mut self, row: &StepRow, step_ns: u64) -> Result<(), LaunchError> {
-        self.latency.step(step_ns);
-        self.push(row, Some((row.k, step_ns)), &[])
+    /// Records one step of the in-process loop, with its step time when it was measured.
+    pub fn record_in_process(&mut self, row: &StepRow, step_ns: Option<u64>) -> Result<(), LaunchError> {
+        if let Some(ns) = step_ns {
+            self.latency.step(ns);
+        }
+        self.push(row, step_ns.map(|ns| (row.k, ns)), &[])
     }
 
     fn push(&mut self, row: &StepRow, step_ns: Option<(u64, u64)>, hops: &[(usize, u64)]) -> Result<(), LaunchError> {
@@ -149,9 +163,10 @@ impl Session {
         let Some((sink, ch)) = &mut self.sink else { return Ok(()) };
         let (k, t) = (row.k, row.t);
         let lay = self.layout;
-        let put = |sink: &mut RrdSink, ids: &[usize], vals: &[f64]| {
+        sink.row(ch.signals, k, t);
+        let put = |sink: &mut RrdSink, ids: &[SeriesId], vals: &[f64]| {
             for (&id, &v) in ids.iter().zip(vals) {
-                sink.push(id, k, t, v);
+                sink.push(id, v);
             }
         };
         put(sink, &ch.x, &row.plant[lay.x()]);
@@ -166,15 +181,16 @@ impl Session {
             put(sink, &oc.residual, &self.metrics.residual[o]);
         }
         // Latencies are recorded at the step they belong to: the step time and the
-        // controller→plant hop of step k−1 complete with row k.
-        let dt = self.dt;
+        // controller→plant hop of step k−1 complete with row k (in-process: step k itself).
         if let Some((ks, ns)) = step_ns {
-            sink.push(ch.step_latency, ks, ks as f64 * dt, ns as f64);
+            sink.row(ch.hops_late, ks, ks as f64 * self.dt);
+            sink.push(ch.step_latency, ns as f64);
         }
-        let last_hop = ch.hops.len().wrapping_sub(1);
+        if !hops.is_empty() {
+            sink.row(ch.hops_now, k, t);
+        }
         for &(i, ns) in hops {
-            let ks = if i == last_hop && self.controller_observer.is_some() { k - 1 } else { k };
-            sink.push(ch.hops[i], ks, ks as f64 * dt, ns as f64);
+            sink.push(ch.hops[i], ns as f64);
         }
         sink.flush_full().map_err(LaunchError::Component)
     }
