@@ -28,7 +28,7 @@ pub struct BenchRun {
 }
 
 /// Runs the benchmark on `scenario` (seed002-sine) for `steps` steps.
-pub fn bench(scenario: &Path, steps: u64, wait: Wait, modes: &[Mode], recording: &[bool]) -> Result<Vec<BenchRun>, LaunchError> {
+pub fn bench(scenario: &Path, steps: u64, wait: Wait, pin: bool, modes: &[Mode], recording: &[bool]) -> Result<Vec<BenchRun>, LaunchError> {
     let mut s = Scenario::load(scenario)?;
     s.steps = steps;
     s.duration = steps as f64 * s.dt;
@@ -38,7 +38,7 @@ pub fn bench(scenario: &Path, steps: u64, wait: Wait, modes: &[Mode], recording:
     let mut out = Vec::new();
     for &mode in modes {
         for &record in recording {
-            let opts = Options { out: tmp.clone(), mode, wait, force: true, allow_unstable: false, record };
+            let opts = Options { out: tmp.clone(), mode, wait, force: true, allow_unstable: false, record, pin };
             let o = run(&s, &p, &opts)?;
             if o.stop != Stop::Completed {
                 return Err(LaunchError::Component(format!("benchmark run stopped: {:?}", o.stop)));

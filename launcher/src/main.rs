@@ -37,6 +37,9 @@ enum Command {
         /// Run even if the closed loop is unstable (the run stops when a state diverges).
         #[arg(long)]
         allow_unstable: bool,
+        /// Place the lockstep ring's processes on CPUs (auto) or leave it to the scheduler (off).
+        #[arg(long, value_parser = ["auto", "off"], default_value = "auto")]
+        pin: String,
     },
     /// Check the existence conditions and show the designs of a scenario.
     Design {
@@ -63,6 +66,9 @@ enum Command {
         /// Only runs with (on) or without (off) recording (default: both).
         #[arg(long, value_parser = ["on", "off"])]
         recording: Option<String>,
+        /// Place the lockstep ring's processes on CPUs (auto) or not (off).
+        #[arg(long, value_parser = ["auto", "off"], default_value = "auto")]
+        pin: String,
     },
     /// List the shipped scenarios.
     List {
@@ -113,9 +119,10 @@ fn main() -> ExitCode {
         wait: None,
         force: true,
         allow_unstable: false,
+        pin: "auto".into(),
     });
     match command {
-        Command::Run { scenario, out, mode, wait, force, allow_unstable } => {
+        Command::Run { scenario, out, mode, wait, force, allow_unstable, pin } => {
             let s = match load(&scenario) {
                 Ok(s) => s,
                 Err(e) => return fail(&e),
@@ -128,7 +135,7 @@ fn main() -> ExitCode {
                 eprintln!("warning: {w}");
             }
             let mode = if mode == "in-process" { Mode::InProcess } else { Mode::Processes };
-            let opts = Options { out, mode, wait: wait.unwrap_or_else(Wait::default_for_machine), force, allow_unstable, record: true };
+            let opts = Options { out, mode, wait: wait.unwrap_or_else(Wait::default_for_machine), force, allow_unstable, record: true, pin: pin == "auto" };
             match run::run(&s, &p, &opts) {
                 Ok(o) => {
                     print!("{}", o.summary.table());
@@ -162,7 +169,7 @@ fn main() -> ExitCode {
             }
             if r.ok { ExitCode::SUCCESS } else { ExitCode::from(EXIT_BAD_INPUT as u8) }
         }
-        Command::Bench { steps, json, wait, mode, recording } => {
+        Command::Bench { steps, json, wait, mode, recording, pin } => {
             let wait = wait.unwrap_or_else(Wait::default_for_machine);
             let modes: Vec<Mode> = match mode.as_deref() {
                 Some("processes") => vec![Mode::Processes],
@@ -174,7 +181,7 @@ fn main() -> ExitCode {
                 Some(_) => vec![false],
                 None => vec![false, true],
             };
-            match launcher::bench::bench(&scenarios_dir().join("seed002-sine.toml"), steps, wait, &modes, &rec) {
+            match launcher::bench::bench(&scenarios_dir().join("seed002-sine.toml"), steps, wait, pin == "auto", &modes, &rec) {
                 Ok(runs) => {
                     if json {
                         println!("{}", serde_json::to_string_pretty(&serde_json::json!({ "runs": runs })).expect("serialises"));

@@ -14,6 +14,10 @@
 //! ```
 //!
 //! A sample whose step counter is not the one expected is an error ([`LockstepError::Step`]).
+//! In closed loop only the controller's observer is on the critical path; the other observers
+//! ("followers") take exactly the same samples in the same order but may trail the plant by up
+//! to [`FOLLOWER_LAG`] steps, so they can sleep between batches instead of competing for a core
+//! every step. Without a controller every observer completes each step before the next.
 //! No first sample is lost: components create all their ports, report "ready" to the launcher,
 //! and publish only after the launcher's "go", when every subscriber already exists.
 //! The launcher records every sample from its own subscribers, whose large buffers and the
@@ -26,13 +30,14 @@ mod layout;
 mod port;
 mod run;
 mod sample;
+pub mod service;
 mod wait;
 
 pub use clock::now_ns;
 pub use error::LockstepError;
 pub use handshake::{die_with_parent, parse_launch, ready_then_wait_for_go, Launch, EXIT_USAGE};
 pub use layout::PlantLayout;
-pub use port::{Bus, Inlet, Outlet, Reader, RECORDER_BUFFER};
+pub use port::{Bus, Inlet, Outlet, Reader, FOLLOWER_LAG, RECORDER_BUFFER};
 pub use run::{cleanup_dead_runs, RunSpace, RUNS_DIR_ENV};
 pub use sample::{Header, Sample, MAX_VALUES};
 pub use wait::Wait;

@@ -10,9 +10,11 @@ use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
+use iceoryx2::waitset::WaitSetGuard;
 use iceoryx2::service::port_factory::publish_subscribe::PortFactory;
 
 use crate::clock::now_ns;
+use crate::service::Service as Ipc;
 use crate::error::LockstepError;
 use crate::run::RunSpace;
 use crate::sample::{Header, Sample, MAX_VALUES};
@@ -20,12 +22,15 @@ use crate::wait::Wait;
 
 /// Buffer of the recorder's subscribers: how many steps the launcher may lag behind.
 pub const RECORDER_BUFFER: usize = 4096;
-/// Buffer of the lockstep subscribers (one sample is ever pending; two leave slack).
-const LOCKSTEP_BUFFER: usize = 2;
+/// Buffer of the lockstep subscribers: a follower (an observer off the critical path) may be up
+/// to [`FOLLOWER_LAG`] steps behind, so its input and its acknowledgements queue that deep.
+const LOCKSTEP_BUFFER: usize = FOLLOWER_LAG as usize + 2;
+/// How many steps an observer the controller does not read may trail the plant.
+pub const FOLLOWER_LAG: u64 = 4096;
 
 /// A process's node on the run's bus.
 pub struct Bus {
-    node: Node<ipc::Service>,
+    node: Node<Ipc>,
     wait: Wait,
 }
 
@@ -36,7 +41,7 @@ impl Bus {
             .name(&NodeName::new(name).map_err(LockstepError::ipc)?)
             .config(space.config())
             .signal_handling_mode(SignalHandlingMode::Disabled)
-            .create::<ipc::Service>()
+            .create::<Ipc>()
             .map_err(LockstepError::ipc)?;
         Ok(Self { node, wait })
     }
@@ -46,7 +51,7 @@ impl Bus {
         self.wait
     }
 
-    fn service(&self, topic: &str) -> Result<PortFactory<ipc::Service, Sample, ()>, LockstepError> {
+    fn service(&self, topic: &str) -> Result<PortFactory<Ipc, Sample, ()>, LockstepError> {
         // Every port opens the service with the same settings, so any of them may create it.
         self.node
             .service_builder(&ServiceName::new(topic).map_err(LockstepError::ipc)?)
@@ -55,13 +60,13 @@ impl Bus {
             .max_subscribers(8)
             .max_nodes(16)
             .history_size(0)
-            .subscriber_max_buffer_size(RECORDER_BUFFER)
+            .subscriber_max_buffer_size(RECORDER_BUFFER.max(LOCKSTEP_BUFFER))
             .enable_safe_overflow(false)
             .open_or_create()
             .map_err(LockstepError::ipc)
     }
 
-    fn event(&self, topic: &str) -> Result<iceoryx2::service::port_factory::event::PortFactory<ipc::Service>, LockstepError> {
+    fn event(&self, topic: &str) -> Result<iceoryx2::service::port_factory::event::PortFactory<Ipc>, LockstepError> {
         self.node
             .service_builder(&ServiceName::new(&format!("{topic}/wake")).map_err(LockstepError::ipc)?)
             .event()
@@ -92,12 +97,24 @@ impl Bus {
     /// A lockstep reading end of `topic`.
     pub fn inlet(&self, topic: &str) -> Result<Inlet, LockstepError> {
         let subscriber = self.service(topic)?.subscriber_builder().buffer_size(LOCKSTEP_BUFFER).create().map_err(LockstepError::ipc)?;
-        let listener = if self.wait.needs_events() {
+        let mut listener = if self.wait.needs_events() {
             Some(self.event(topic)?.listener_builder().create().map_err(LockstepError::ipc)?)
         } else {
             None
         };
-        Ok(Inlet { subscriber, listener, topic: topic.to_string(), wait: self.wait, timeout: Duration::from_secs(10) })
+        let waitset = if self.wait == Wait::WaitSet {
+            // The WaitSet borrows the listener it watches; both live as long as the process (an
+            // inlet is made once per component), so they are leaked to 'static.
+            let listener: &'static Listener<Ipc> = Box::leak(Box::new(listener.take().expect("waitset waits have a listener")));
+            let ws: &'static WaitSet<Ipc> = Box::leak(Box::new(
+                WaitSetBuilder::new().signal_handling_mode(SignalHandlingMode::Disabled).create::<Ipc>().map_err(LockstepError::ipc)?,
+            ));
+            let guard = ws.attach_notification(listener).map_err(LockstepError::ipc)?;
+            Some(WaitSetWait { ws, listener, _guard: guard })
+        } else {
+            None
+        };
+        Ok(Inlet { subscriber, listener, waitset, topic: topic.to_string(), wait: self.wait, timeout: Duration::from_secs(10) })
     }
 
     /// A recording end of `topic` that never makes the publisher drop a sample.
@@ -109,8 +126,8 @@ impl Bus {
 
 /// Publishes one sample per step.
 pub struct Outlet {
-    publisher: Publisher<ipc::Service, Sample, ()>,
-    notifier: Option<Notifier<ipc::Service>>,
+    publisher: Publisher<Ipc, Sample, ()>,
+    notifier: Option<Notifier<Ipc>>,
 }
 
 impl Outlet {
@@ -144,10 +161,18 @@ impl Outlet {
     }
 }
 
+/// A WaitSet watching an inlet's listener.
+struct WaitSetWait {
+    ws: &'static WaitSet<Ipc>,
+    listener: &'static Listener<Ipc>,
+    _guard: WaitSetGuard<'static, 'static, Ipc>,
+}
+
 /// Waits for the sample of a given step.
 pub struct Inlet {
-    subscriber: Subscriber<ipc::Service, Sample, ()>,
-    listener: Option<Listener<ipc::Service>>,
+    subscriber: Subscriber<Ipc, Sample, ()>,
+    listener: Option<Listener<Ipc>>,
+    waitset: Option<WaitSetWait>,
     topic: String,
     wait: Wait,
     timeout: Duration,
@@ -197,6 +222,41 @@ impl Inlet {
                     }
                 }
                 Wait::Block => self.block(start, limit, step)?,
+                Wait::WaitSet => {
+                    let elapsed = now_ns() - start;
+                    if elapsed > limit {
+                        return Err(self.timed_out(step));
+                    }
+                    let w = self.waitset.as_ref().expect("waitset waits have a waitset");
+                    let slice = Duration::from_nanos((limit - elapsed).min(100_000_000));
+                    w.ws
+                        .wait_and_process_once_with_timeout(
+                            |_| {
+                                let _ = w.listener.try_wait(|_| {});
+                                CallbackProgression::Continue
+                            },
+                            slice,
+                        )
+                        .map_err(LockstepError::ipc)?;
+                }
+                Wait::SpinThenYield(ns) => {
+                    if now_ns() - start < ns as u64 {
+                        for _ in 0..32 {
+                            std::hint::spin_loop();
+                        }
+                    } else {
+                        std::thread::yield_now();
+                        if polls % 1024 == 0 && now_ns() - start > limit {
+                            return Err(self.timed_out(step));
+                        }
+                    }
+                }
+                Wait::Sleep(us) => {
+                    std::thread::sleep(Duration::from_micros(us as u64));
+                    if now_ns() - start > limit {
+                        return Err(self.timed_out(step));
+                    }
+                }
                 Wait::SpinThenBlock(us) => {
                     let elapsed = now_ns() - start;
                     if elapsed < us as u64 * 1000 {
@@ -227,7 +287,7 @@ impl Inlet {
 
 /// Drains a service without blocking (the recorder).
 pub struct Reader {
-    subscriber: Subscriber<ipc::Service, Sample, ()>,
+    subscriber: Subscriber<Ipc, Sample, ()>,
     topic: String,
 }
 

@@ -134,23 +134,34 @@ fn shm_files_with_prefix(prefix: &str) -> Vec<PathBuf> {
         .collect()
 }
 
-/// Removes what runs whose launcher has died left behind; returns how many were cleaned.
+fn alive(pid: i32) -> bool {
+    // SAFETY: kill with signal 0 only checks for existence and permission.
+    unsafe { libc::kill(pid, 0) == 0 || *libc::__errno_location() == libc::EPERM }
+}
+
+/// Removes what runs whose launcher has died left behind — their directories and their shared
+/// memory, also shared memory whose directory is already gone; returns how many runs were cleaned.
 pub fn cleanup_dead_runs() -> usize {
-    let Ok(entries) = fs::read_dir(runs_dir()) else { return 0 };
     let mut cleaned = 0;
-    for entry in entries.flatten() {
-        let id = entry.file_name().to_string_lossy().to_string();
-        let owner = fs::read_to_string(entry.path().join("owner.pid")).ok().and_then(|s| s.trim().parse::<i32>().ok());
-        let alive = owner.is_some_and(|pid| {
-            // SAFETY: kill with signal 0 only checks for existence and permission.
-            unsafe { libc::kill(pid, 0) == 0 || *libc::__errno_location() == libc::EPERM }
-        });
-        if !alive {
-            for f in shm_files_with_prefix(&format!("uio{id}_")) {
-                let _ = fs::remove_file(f);
+    if let Ok(entries) = fs::read_dir(runs_dir()) {
+        for entry in entries.flatten() {
+            let id = entry.file_name().to_string_lossy().to_string();
+            let owner = fs::read_to_string(entry.path().join("owner.pid")).ok().and_then(|s| s.trim().parse::<i32>().ok());
+            if !owner.is_some_and(alive) {
+                for f in shm_files_with_prefix(&format!("uio{id}_")) {
+                    let _ = fs::remove_file(f);
+                }
+                let _ = fs::remove_dir_all(entry.path());
+                cleaned += 1;
             }
-            let _ = fs::remove_dir_all(entry.path());
-            cleaned += 1;
+        }
+    }
+    // Shared memory is named uio<launcher pid>x<n>x<nonce>_…: the owner is in the name.
+    for f in shm_files_with_prefix("uio") {
+        let name = f.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+        let pid = name.strip_prefix("uio").and_then(|r| r.split('x').next()).and_then(|p| p.parse::<i32>().ok());
+        if pid.is_some_and(|p| !alive(p)) {
+            let _ = fs::remove_file(f);
         }
     }
     cleaned

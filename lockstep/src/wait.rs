@@ -13,14 +13,21 @@ pub enum Wait {
     Yield,
     /// Block on an iceoryx2 event until the publisher notifies (one wake-up per hop).
     Block,
+    /// Block in an iceoryx2 WaitSet (epoll) to which the event listener is attached.
+    WaitSet,
     /// Yield-poll for up to this many microseconds, then block.
     SpinThenBlock(u32),
+    /// Poll, sleeping this many microseconds between polls: for processes off the critical
+    /// path, which then take a core only briefly and work through a batch of samples.
+    Sleep(u32),
+    /// Busy-poll (with the CPU's spin hint) for up to this many nanoseconds, then yield-poll.
+    SpinThenYield(u32),
 }
 
 impl Wait {
     /// Whether publishers must notify an event after each send.
     pub fn needs_events(self) -> bool {
-        !matches!(self, Wait::Yield)
+        matches!(self, Wait::Block | Wait::WaitSet | Wait::SpinThenBlock(_))
     }
 
     /// The default for this machine: yielding polls (measured fastest on 2 cores and up; a
@@ -37,6 +44,9 @@ impl FromStr for Wait {
         match s {
             "yield" => Ok(Wait::Yield),
             "block" => Ok(Wait::Block),
+            "waitset" => Ok(Wait::WaitSet),
+            _ if s.starts_with("spin-then-yield:") => s["spin-then-yield:".len()..].parse().map(Wait::SpinThenYield).map_err(|_| format!("'{s}': write spin-then-yield:<nanoseconds>")),
+            _ if s.starts_with("sleep:") => s["sleep:".len()..].parse().map(Wait::Sleep).map_err(|_| format!("'{s}': write sleep:<microseconds>")),
             _ => match s.strip_prefix("spin-then-block") {
                 Some("") => Ok(Wait::SpinThenBlock(50)),
                 Some(rest) => rest
@@ -44,7 +54,7 @@ impl FromStr for Wait {
                     .and_then(|us| us.parse().ok())
                     .map(Wait::SpinThenBlock)
                     .ok_or_else(|| format!("'{s}': write spin-then-block:<microseconds>")),
-                None => Err(format!("'{s}' is not a wait strategy (yield, block, spin-then-block[:µs])")),
+                None => Err(format!("'{s}' is not a wait strategy (yield, block, waitset, spin-then-block[:µs], spin-then-yield:ns, sleep:µs)")),
             },
         }
     }
@@ -55,7 +65,10 @@ impl std::fmt::Display for Wait {
         match self {
             Wait::Yield => write!(f, "yield"),
             Wait::Block => write!(f, "block"),
+            Wait::WaitSet => write!(f, "waitset"),
             Wait::SpinThenBlock(us) => write!(f, "spin-then-block:{us}"),
+            Wait::Sleep(us) => write!(f, "sleep:{us}"),
+            Wait::SpinThenYield(ns) => write!(f, "spin-then-yield:{ns}"),
         }
     }
 }

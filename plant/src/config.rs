@@ -40,6 +40,8 @@ pub struct PlantRun {
     pub plant: PlantConfig,
     /// Names of the observers whose estimates complete each step.
     pub observers: Vec<String>,
+    /// Which of them may trail the plant (followers, see [`lockstep::FOLLOWER_LAG`]).
+    pub followers: Vec<bool>,
     /// Whether a controller provides u (else u = the input signals).
     pub controller: bool,
 }

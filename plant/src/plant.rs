@@ -41,8 +41,8 @@ struct Piece {
 pub struct Divergence {
     /// The step whose result diverged (x_{step+1}).
     pub step: u64,
-    /// The signal, e.g. "x[2]".
-    pub signal: String,
+    /// The state that diverged: x[state].
+    pub state: usize,
     /// Its value.
     pub value: f64,
     /// The bound it exceeded.
@@ -52,9 +52,9 @@ pub struct Divergence {
 impl std::fmt::Display for Divergence {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         if self.value.is_finite() {
-            write!(f, "{} = {:.6e} left the bound ±{:.3e} at step {}", self.signal, self.value, self.bound, self.step + 1)
+            write!(f, "x[{}] = {:.6e} left the bound ±{:.3e} at step {}", self.state, self.value, self.bound, self.step + 1)
         } else {
-            write!(f, "{} = {} at step {}", self.signal, self.value, self.step + 1)
+            write!(f, "x[{}] = {} at step {}", self.state, self.value, self.step + 1)
         }
     }
 }
@@ -222,7 +222,7 @@ impl Plant {
         }
         for (i, &v) in self.x.iter().enumerate() {
             if !v.is_finite() || v.abs() > self.bound {
-                return Err(Divergence { step: k, signal: format!("x[{i}]"), value: v, bound: self.bound });
+                return Err(Divergence { step: k, state: i, value: v, bound: self.bound });
             }
         }
         Ok(())

@@ -54,6 +54,8 @@ pub struct Options {
     pub allow_unstable: bool,
     /// Write the `.rrd` (off for benchmarks).
     pub record: bool,
+    /// Place the lockstep ring's processes on CPUs (processes mode).
+    pub pin: bool,
 }
 
 /// How a run ended.
@@ -120,7 +122,7 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
     let start = Instant::now();
     let stop = match opts.mode {
         Mode::InProcess => in_process::run(&cfg, &mut session),
-        Mode::Processes => processes::run(&cfg, &mut session, opts.wait),
+        Mode::Processes => processes::run(&cfg, &mut session, opts.wait, opts.pin),
     };
     let wall = start.elapsed().as_secs_f64();
     let stop = match stop {

@@ -1,0 +1,147 @@
+//! Issue 5: after start-up, neither the step functions nor the process loops allocate.
+//! A counting global allocator counts the allocations made by this thread while enabled.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use controller::shell::ControllerLoop;
+use controller::Controller;
+use launcher::plan::plan;
+use launcher::run::configs;
+use launcher::Scenario;
+use lockstep::{Bus, RunSpace, Wait};
+use observer::shell::ObserverLoop;
+use plant::shell::PlantLoop;
+use plant::Plant;
+use tests::*;
+
+struct Counting;
+
+static ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
+thread_local! {
+    static TRACKING: Cell<bool> = const { Cell::new(false) };
+}
+
+// SAFETY: defers to the system allocator; counting touches only an atomic and a const TLS cell.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        if TRACKING.with(|t| t.get()) {
+            ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        }
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        if TRACKING.with(|t| t.get()) {
+            ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        }
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+/// Allocations made by `f` on this thread.
+fn allocations(f: impl FnOnce()) -> u64 {
+    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    TRACKING.with(|t| t.set(true));
+    f();
+    TRACKING.with(|t| t.set(false));
+    ALLOCATIONS.load(Ordering::Relaxed) - before
+}
+
+#[test]
+fn counting_allocator_counts() {
+    assert_eq!(allocations(|| drop(vec![1u8; 16])), 1);
+}
+
+fn shipped() -> Vec<Scenario> {
+    let mut v: Vec<_> = std::fs::read_dir(repo().join("scenarios")).unwrap().flatten().map(|e| e.path()).collect();
+    v.sort();
+    v.iter().filter(|p| p.extension().is_some_and(|x| x == "toml")).map(|p| Scenario::load(p).unwrap()).collect()
+}
+
+#[test]
+fn step_functions_do_not_allocate() {
+    let mut scenarios = shipped();
+    // A disturbance switching between samples makes the plant take its split-step path.
+    let mut split = Scenario::load(&scenario("seed002-piecewise")).unwrap();
+    split.disturbances[0] = lti::signal::Signal::Piecewise { times: vec![0.0, 0.00105, 0.0023], values: vec![1.0, -1.0, 2.0] };
+    scenarios.push(split);
+    for s in scenarios {
+        let Ok(p) = plan(&s) else { panic!("{} does not design", s.name) };
+        let cfg = configs(&s, &p);
+        let mut plant = Plant::new(&cfg.plant.plant).unwrap();
+        let mut observers: Vec<_> = cfg.observers.iter().map(|(_, o)| o.observer.instantiate()).collect();
+        let mut controller = cfg.controller.as_ref().map(|c| Controller::new(c).unwrap());
+        let c_obs = cfg.controller.as_ref().and_then(|c| cfg.observers.iter().position(|(n, _)| *n == c.observer)).unwrap_or(0);
+        let lay = cfg.layout;
+        let (mut row, mut xhat, mut u) = (vec![0.0; lay.len()], vec![vec![0.0; lay.n]; observers.len()], vec![0.0; lay.l]);
+        let steps = s.steps.min(5000);
+        // A diverging run (the printed gain) stops at its first error, whose message allocates.
+        let mut stopped = false;
+        let mut step = |k: u64| {
+            if stopped {
+                return;
+            }
+            row.copy_from_slice(plant.sample(k));
+            for (i, o) in observers.iter_mut().enumerate() {
+                xhat[i].copy_from_slice(o.step(&row[lay.y()], &row[lay.u_prev()]));
+            }
+            match &mut controller {
+                Some(c) => u.copy_from_slice(c.step(k, &xhat[c_obs])),
+                None => u.copy_from_slice(plant.reference()),
+            }
+            stopped = plant.advance(k, &u).is_err();
+        };
+        for k in 0..10 {
+            step(k);
+        }
+        let n = allocations(|| (10..steps).for_each(&mut step));
+        assert_eq!(n, 0, "{}: {n} allocations in {} steps", s.name, steps - 10);
+    }
+}
+
+#[test]
+fn process_loops_do_not_allocate() {
+    let scratch = Scratch::new("no-alloc");
+    // SAFETY: set before any run space is created; this test binary's other tests make none.
+    unsafe { std::env::set_var(lockstep::RUNS_DIR_ENV, scratch.runs()) };
+    let s = Scenario::load(&scenario("seed002-sine")).unwrap();
+    let cfg = configs(&s, &plan(&s).unwrap());
+    /// Removes the run's files even when an assertion fails.
+    struct Cleanup(RunSpace);
+    impl Drop for Cleanup {
+        fn drop(&mut self) {
+            self.0.remove();
+        }
+    }
+    let space = Cleanup(RunSpace::create().unwrap());
+    let space = &space.0;
+    {
+        let plant_bus = Bus::join(space, "plant", Wait::Yield).unwrap();
+        let obs_buses: Vec<Bus> = cfg.observers.iter().map(|(n, _)| Bus::join(space, &format!("observer-{n}"), Wait::Yield).unwrap()).collect();
+        let ctrl_bus = Bus::join(space, "controller", Wait::Yield).unwrap();
+        let mut plant = PlantLoop::new(&cfg.plant, &plant_bus).unwrap();
+        let mut observers: Vec<ObserverLoop> = cfg.observers.iter().zip(&obs_buses).map(|((n, o), b)| ObserverLoop::new(o, n, b).unwrap()).collect();
+        let mut controller = ControllerLoop::new(cfg.controller.as_ref().unwrap(), &ctrl_bus).unwrap();
+        // Every component steps in lockstep order; each wait finds its sample already there.
+        let mut step = |k: u64| {
+            plant.publish(k).unwrap();
+            for o in observers.iter_mut() {
+                o.step(k).unwrap();
+            }
+            controller.step(k).unwrap();
+            plant.complete(k).unwrap();
+        };
+        for k in 0..100 {
+            step(k);
+        }
+        let n = allocations(|| (100..5000).for_each(&mut step));
+        assert_eq!(n, 0, "{n} allocations in 4900 steps of the process loops");
+    }
+}
