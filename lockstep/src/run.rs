@@ -54,6 +54,7 @@ impl RunSpace {
         fs::DirBuilder::new().mode(0o700).create(dir.join("iox2")).map_err(|e| io("cannot create", &dir, e))?;
         let mut f = fs::File::create(dir.join("owner.pid")).map_err(|e| io("cannot write", &dir, e))?;
         writeln!(f, "{}", std::process::id()).map_err(|e| io("cannot write", &dir, e))?;
+        fs::set_permissions(dir.join("owner.pid"), fs::Permissions::from_mode(0o600)).map_err(|e| io("cannot chmod", &dir, e))?;
         Self::at(id, dir)
     }
 
@@ -114,6 +115,18 @@ impl RunSpace {
     /// The shared-memory files of this run that exist now.
     pub fn shm_files(&self) -> Vec<PathBuf> {
         shm_files_with_prefix(&format!("uio{}_", self.id))
+    }
+
+    /// Makes the run's shared-memory files readable and writable by their owner only.
+    ///
+    /// iceoryx2 creates its data, connection and dynamic segments with mode 0600, but its node
+    /// counter (`…node.<version>.global_mgmt`) with global access (0666). The launcher creates
+    /// that segment when it joins the bus, before any component starts, and calls this at once.
+    pub fn restrict_shm(&self) -> Result<(), LockstepError> {
+        for f in self.shm_files() {
+            fs::set_permissions(&f, fs::Permissions::from_mode(0o600)).map_err(|e| io("cannot chmod", &f, e))?;
+        }
+        Ok(())
     }
 
     /// Removes every file of the run: its shared memory and its directory.

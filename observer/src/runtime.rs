@@ -70,7 +70,12 @@ impl LinearObserver {
     /// A runnable instance with zero initial state.
     pub fn instantiate(&self) -> ObserverState {
         let r = self.order();
+        let p: DMatrix<f64> = (&self.p).into();
+        let zero = |m: &MatData| m.data.iter().all(|&x| x == 0.0);
         ObserverState {
+            p_identity: p.is_square() && p == DMatrix::identity(p.nrows(), p.ncols()),
+            g_zero: zero(&self.g),
+            q_zero: zero(&self.q),
             f: (&self.f).into(),
             g: (&self.g).into(),
             k: (&self.k).into(),
@@ -98,6 +103,12 @@ pub struct ObserverState {
     y_prev: Vec<f64>,
     xhat: Vec<f64>,
     started: bool,
+    /// P = I (full-order observers): x̂ = z + Qy needs no product with P.
+    p_identity: bool,
+    /// G = 0 (no known input acts): skip G u.
+    g_zero: bool,
+    /// Q = 0 (predictor-form Luenberger): skip Q y.
+    q_zero: bool,
 }
 
 impl ObserverState {
@@ -105,13 +116,23 @@ impl ObserverState {
     pub fn step(&mut self, y: &[f64], u_prev: &[f64]) -> &[f64] {
         if self.started {
             mul_into(&mut self.z_next, &self.f, &self.z);
-            mul_acc(&mut self.z_next, &self.g, u_prev);
+            if !self.g_zero {
+                mul_acc(&mut self.z_next, &self.g, u_prev);
+            }
             mul_acc(&mut self.z_next, &self.k, &self.y_prev);
             std::mem::swap(&mut self.z, &mut self.z_next);
         }
         self.started = true;
-        mul_into(&mut self.xhat, &self.p, &self.z);
-        mul_acc(&mut self.xhat, &self.q, y);
+        // Skipping exact identities and zeros changes no bit: 1·z = z, and adding +0.0 terms
+        // to a sum that starts from 0.0 or from z leaves it as it was.
+        if self.p_identity {
+            self.xhat.copy_from_slice(&self.z);
+        } else {
+            mul_into(&mut self.xhat, &self.p, &self.z);
+        }
+        if !self.q_zero {
+            mul_acc(&mut self.xhat, &self.q, y);
+        }
         self.y_prev.copy_from_slice(y);
         &self.xhat
     }

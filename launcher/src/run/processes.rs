@@ -258,6 +258,7 @@ fn run_in(space: &RunSpace, cfg: &Configs, session: &mut Session, wait: Wait, pi
 
     // The recorder's subscribers exist before any component can publish.
     let bus = Bus::join(space, "launcher", Wait::Yield).map_err(ipc)?;
+    space.restrict_shm().map_err(ipc)?;
     let plant_reader = bus.reader("plant").map_err(ipc)?;
     let observer_readers = cfg.observers.iter().map(|(n, _)| bus.reader(&format!("observer/{n}"))).collect::<Result<Vec<_>, _>>().map_err(ipc)?;
     let controller_reader = cfg.controller.as_ref().map(|_| bus.reader("controller")).transpose().map_err(ipc)?;
