@@ -35,9 +35,14 @@ pub fn plan(s: &Scenario) -> Result<Plan, PlanError> {
     let mut observers = Vec::new();
     for (i, o) in s.observers.iter().enumerate() {
         let d = design(&s.model, &o.spec, s.dt).map_err(|e| {
-            let sub = if e.condition.ends_with("poles") || e.condition.ends_with("pole placement") { ".poles" } else { "" };
+            let placement = e.condition.ends_with("poles") || e.condition.ends_with("pole placement");
+            let (sub, reason) = if placement {
+                (".poles", format!("{} observer '{}': {}", e.kind, o.name, e.detail))
+            } else {
+                ("", format!("{} observer '{}': {} does not hold: {}", e.kind, o.name, e.condition, e.detail))
+            };
             PlanError {
-                error: locate(format!("observer[{i}]{sub}"), format!("{} observer '{}': {} does not hold: {}", e.kind, o.name, e.condition, e.detail)),
+                error: locate(format!("observer[{i}]{sub}"), reason),
                 conditions: e.conditions.clone(),
                 observer: Some(i),
             }

@@ -116,9 +116,13 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
         }
     }
     let (rrd, summary_path) = if opts.record { prepare_output(&opts.out, &s.name, opts.force).map(|(a, b)| (Some(a), Some(b)))? } else { (None, None) };
+    // The recording is written under a temporary name and renamed when the run ends, however it
+    // ends: a finished `<name>.rrd` is never half-written, and what a killed launcher leaves
+    // (`<name>.rrd.partial`, without footer) does not stand in the next run's way.
+    let partial = rrd.as_ref().map(|p| p.with_extension("rrd.partial"));
     interrupt::install();
     let cfg = configs(s, plan);
-    let mut session = Session::new(s, plan, cfg.layout, rrd.as_deref())?;
+    let mut session = Session::new(s, plan, cfg.layout, partial.as_deref())?;
     let start = Instant::now();
     let stop = match opts.mode {
         Mode::InProcess => in_process::run(&cfg, &mut session),
@@ -129,11 +133,18 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
         Ok(stop) => stop,
         Err(e) => {
             // Close what was recorded so far before reporting.
-            let _ = session.finish();
+            if session.finish().is_ok() {
+                if let (Some(from), Some(to)) = (&partial, &rrd) {
+                    let _ = fs::rename(from, to);
+                }
+            }
             return Err(e);
         }
     };
     let (metrics, latency) = session.finish()?;
+    if let (Some(from), Some(to)) = (&partial, &rrd) {
+        fs::rename(from, to).map_err(|e| LaunchError::BadInput(format!("{}: cannot rename the recording: {e}", to.display())))?;
+    }
     let summary = Summary::new(s, plan, opts, &metrics, &latency, wall, &stop, rrd.as_deref());
     if let Some(path) = &summary_path {
         summary.write(path).map_err(LaunchError::BadInput)?;

@@ -1,0 +1,202 @@
+//! Issue 6: a crashed component, an interrupted launcher, a stale run, parallel runs, and
+//! components started by hand — with real processes, checked from outside.
+
+use std::path::PathBuf;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use tests::*;
+
+/// seed002-sine stretched to `seconds` of simulated time (1000 steps per second).
+fn long_scenario(s: &Scratch, seconds: u32) -> PathBuf {
+    let text = std::fs::read_to_string(scenario("seed002-sine")).unwrap().replace("duration = 20.0", &format!("duration = {seconds}.0"));
+    let text = text.split("\n[expect]").next().unwrap().to_string();
+    let p = s.join("long.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn start(s: &Scratch, scenario: &PathBuf, extra: &[&str]) -> Child {
+    launcher(s).arg("run").arg(scenario).arg("--out").arg(s.join("out")).args(extra).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap()
+}
+
+/// The pid of a component of launcher `pid` whose `--name` is `name`.
+fn component_pid(launcher_pid: u32, name: &str) -> Option<i32> {
+    let run = format!("--run\0{launcher_pid}x");
+    let named = format!("--name\0{name}\0");
+    for e in std::fs::read_dir("/proc").ok()?.flatten() {
+        let Ok(pid) = e.file_name().to_string_lossy().parse::<i32>() else { continue };
+        if let Ok(cmd) = std::fs::read(e.path().join("cmdline")) {
+            let cmd = String::from_utf8_lossy(&cmd);
+            if cmd.contains(&run) && cmd.contains(&named) {
+                return Some(pid);
+            }
+        }
+    }
+    None
+}
+
+/// Waits until every component of the run is up and stepping.
+fn wait_running(launcher_pid: u32, names: &[&str]) {
+    let deadline = Instant::now() + Duration::from_secs(20);
+    while names.iter().any(|n| component_pid(launcher_pid, n).is_none()) {
+        assert!(Instant::now() < deadline, "components did not start");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    std::thread::sleep(Duration::from_millis(100));
+}
+
+/// A reproducible pseudo-random delay (ms) in [lo, hi).
+fn delay(seed: u64, lo: u64, hi: u64) -> Duration {
+    let x = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407) >> 33;
+    Duration::from_millis(lo + x % (hi - lo))
+}
+
+fn signal(pid: i32, sig: i32) {
+    // SAFETY: sending a signal to a process this test started.
+    unsafe { libc::kill(pid, sig) };
+}
+
+/// Waits for the launcher, returning its output and how long it took after `since`.
+fn finish(child: Child, since: Instant) -> (std::process::Output, Duration) {
+    let out = child.wait_with_output().unwrap();
+    (out, since.elapsed())
+}
+
+#[test]
+fn a_killed_component_stops_the_run_cleanly() {
+    let names = ["plant", "uio", "luenberger", "controller"];
+    for (i, victim) in names.iter().enumerate() {
+        for trial in 0..2u64 {
+            let s = Scratch::new(&format!("kill-{victim}-{trial}"));
+            let path = long_scenario(&s, 600);
+            let child = start(&s, &path, &[]);
+            let lpid = child.id();
+            wait_running(lpid, &names);
+            std::thread::sleep(delay(i as u64 * 10 + trial, 50, 500));
+            let pid = component_pid(lpid, victim).expect("victim running");
+            signal(pid, libc::SIGKILL);
+            let killed = Instant::now();
+            let (out, took) = finish(child, killed);
+            let (_, err) = text(&out);
+            assert!(took < Duration::from_secs(2), "{victim}: the launcher took {took:?}");
+            assert_eq!(out.status.code(), Some(3), "{victim}: {err}");
+            let label = match *victim {
+                "uio" | "luenberger" => format!("observer '{victim}'"),
+                other => other.to_string(),
+            };
+            assert!(err.contains(&label) && err.contains("SIGKILL") && err.contains("last completed step"), "{victim}: {err}");
+            assert_clean(&s, lpid);
+            let r = read(&s.join("out/seed002-sine.rrd")).unwrap();
+            assert!(r.complete, "{victim}: recording not finalised");
+            let steps = r.series["/plant/x/0"].values.len();
+            assert!(steps > 0 && steps < 600_000, "{victim}: {steps} steps recorded");
+            let sum = summary(&s, "seed002-sine");
+            assert!(sum["stopped"].as_str().unwrap().contains("SIGKILL"), "{sum}");
+        }
+    }
+}
+
+#[test]
+fn sigint_and_sigterm_stop_the_run_cleanly() {
+    for (sig, name) in [(libc::SIGINT, "SIGINT"), (libc::SIGTERM, "SIGTERM")] {
+        for mode in ["processes", "in-process"] {
+            let s = Scratch::new(&format!("{name}-{mode}"));
+            let path = long_scenario(&s, if mode == "in-process" { 20_000 } else { 600 });
+            let child = start(&s, &path, &["--mode", mode]);
+            let lpid = child.id();
+            if mode == "processes" {
+                wait_running(lpid, &["plant", "uio", "luenberger", "controller"]);
+            } else {
+                std::thread::sleep(Duration::from_millis(500));
+            }
+            signal(lpid as i32, sig);
+            let sent = Instant::now();
+            let (out, took) = finish(child, sent);
+            let (_, err) = text(&out);
+            assert!(took < Duration::from_secs(2), "{name} {mode}: took {took:?}");
+            assert_eq!(out.status.code(), Some(130), "{name} {mode}: {err}");
+            assert!(err.contains(name), "{name} {mode}: {err}");
+            assert_clean(&s, lpid);
+            let r = read(&s.join("out/seed002-sine.rrd")).unwrap();
+            assert!(r.complete && !r.series["/plant/x/0"].values.is_empty(), "{name} {mode}");
+        }
+    }
+}
+
+#[test]
+fn a_run_after_a_dead_one_cleans_up_and_succeeds() {
+    let s = Scratch::new("stale");
+    let path = long_scenario(&s, 100);
+    let child = start(&s, &path, &[]);
+    let dead = child.id();
+    wait_running(dead, &["plant", "uio", "luenberger", "controller"]);
+    signal(dead as i32, libc::SIGKILL);
+    let _ = child.wait_with_output();
+    // The components die with their launcher; what they leave stays until the next run.
+    let deadline = Instant::now() + Duration::from_secs(2);
+    while !processes_of(dead).is_empty() {
+        assert!(Instant::now() < deadline, "components outlived their launcher: {:?}", processes_of(dead));
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    assert!(!shm_of(dead).is_empty(), "the killed run should have left shared memory to clean");
+    assert!(s.join("out/seed002-sine.rrd.partial").exists());
+    // Same scenario, same output directory.
+    let next = start(&s, &path, &[]);
+    let npid = next.id();
+    let out = next.wait_with_output().unwrap();
+    assert!(out.status.success(), "{:?}", text(&out));
+    assert!(shm_of(dead).is_empty(), "stale shared memory left: {:?}", shm_of(dead));
+    assert_clean(&s, npid);
+    assert!(read(&s.join("out/seed002-sine.rrd")).unwrap().complete);
+    // And the killed run's partial recording is still readable, marked incomplete.
+}
+
+#[test]
+fn four_parallel_runs_give_what_each_gives_alone() {
+    let names = ["seed002-sine", "seed003-charlie-open-loop", "seed004-projection-uio-piecewise", "seed001-missile-full-order"];
+    let runs: Vec<(Scratch, Child)> = names
+        .iter()
+        .map(|n| {
+            let s = Scratch::new(&format!("parallel-{n}"));
+            let c = start(&s, &scenario(n), &[]);
+            (s, c)
+        })
+        .collect();
+    let mut done = Vec::new();
+    for (s, c) in runs {
+        let pid = c.id();
+        let out = c.wait_with_output().unwrap();
+        assert!(out.status.success(), "{:?}", text(&out));
+        assert_clean(&s, pid);
+        done.push(s);
+    }
+    for (n, s) in names.iter().zip(&done) {
+        let alone = Scratch::new(&format!("alone-{n}"));
+        let out = run(&alone, &scenario(n), &["--mode", "in-process"]);
+        assert!(out.status.success());
+        let (a, b) = (read(&s.join(&format!("out/{n}.rrd"))).unwrap(), read(&alone.join(&format!("out/{n}.rrd"))).unwrap());
+        let (ta, tb) = (trajectories(&a), trajectories(&b));
+        assert_eq!(ta.len(), tb.len());
+        for ((ka, sa), (_, sb)) in ta.iter().zip(&tb) {
+            assert!(sa.values.iter().zip(&sb.values).all(|(x, y)| x.to_bits() == y.to_bits()) && sa.values.len() == sb.values.len(), "{n}: {ka} differs");
+        }
+    }
+}
+
+#[test]
+fn components_started_by_hand_say_how_to_start_them() {
+    for bin in ["plant", "observer", "controller"] {
+        for args in [&[][..], &["--run", "nosuchrun1", "--name", "x"][..]] {
+            let started = Instant::now();
+            let out = Command::new(bin_dir().join(bin)).args(args).stdin(Stdio::null()).output().unwrap();
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert!(started.elapsed() < Duration::from_secs(1));
+            assert_eq!(out.status.code(), Some(2), "{bin} {args:?}: {err}");
+            assert!(err.contains("started by the launcher"), "{bin} {args:?}: {err}");
+            if !args.is_empty() {
+                assert!(err.contains("no run 'nosuchrun1'"), "{err}");
+            }
+        }
+    }
+}
