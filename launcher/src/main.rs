@@ -76,6 +76,35 @@ enum Command {
         #[arg(long)]
         dir: Option<PathBuf>,
     },
+    /// Show what a recording holds, and recompute its figures from the recorded data.
+    Inspect {
+        /// The recording.
+        recording: PathBuf,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Compare two recordings signal by signal, step by step (bit for bit without tolerances).
+    Compare {
+        /// First recording.
+        a: PathBuf,
+        /// Second recording.
+        b: PathBuf,
+        /// Absolute tolerance.
+        #[arg(long)]
+        abs_tol: Option<f64>,
+        /// Relative tolerance (of the first recording's value).
+        #[arg(long)]
+        rel_tol: Option<f64>,
+    },
+    /// Draw a recording's views as PNG files.
+    Plot {
+        /// The recording.
+        recording: PathBuf,
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Export a recording's signals as CSV, one file per entity group.
     Export {
         /// The recording.
@@ -205,10 +234,63 @@ fn main() -> ExitCode {
             }
             ExitCode::SUCCESS
         }
+        Command::Inspect { recording, json } => match read_recording(&recording) {
+            Ok(r) => {
+                let i = launcher::inspect::inspect(&recording.display().to_string(), &r);
+                if json {
+                    println!("{}", serde_json::to_string_pretty(&i).expect("serialises"));
+                } else {
+                    print!("{}", i.text());
+                }
+                for w in &i.warnings {
+                    eprintln!("warning: {w}");
+                }
+                ExitCode::SUCCESS
+            }
+            Err(code) => code,
+        },
+        Command::Compare { a, b, abs_tol, rel_tol } => {
+            let (ra, rb) = match (read_recording(&a), read_recording(&b)) {
+                (Ok(ra), Ok(rb)) => (ra, rb),
+                (Err(code), _) | (_, Err(code)) => return code,
+            };
+            for (p, r) in [(&a, &ra), (&b, &rb)] {
+                if !r.complete {
+                    eprintln!("warning: {}: incomplete recording", p.display());
+                }
+            }
+            match launcher::compare::compare(&ra, &rb, abs_tol, rel_tol) {
+                Ok(n) => {
+                    println!("same: {n} values of {} signals{}", ra.series.keys().filter(|k| !k.starts_with("/latency")).count(), if abs_tol.is_none() && rel_tol.is_none() { ", bit for bit" } else { ", within tolerance" });
+                    ExitCode::SUCCESS
+                }
+                Err(d) => {
+                    println!("differ: {d}");
+                    ExitCode::from(1)
+                }
+            }
+        }
+        Command::Plot { recording, out } => match read_recording(&recording) {
+            Ok(r) => {
+                if !r.complete {
+                    eprintln!("warning: {}: incomplete recording (its writer did not finish); plotting what it holds", recording.display());
+                }
+                match launcher::plot::plot(&r, &out) {
+                    Ok(files) => {
+                        for f in &files {
+                            println!("{}", f.display());
+                        }
+                        ExitCode::SUCCESS
+                    }
+                    Err(e) => fail(&LaunchError::BadInput(e)),
+                }
+            }
+            Err(code) => code,
+        },
         Command::Export { recording, csv } => {
-            let r = match launcher::recording::read(&recording) {
+            let r = match read_recording(&recording) {
                 Ok(r) => r,
-                Err(e) => return fail(&LaunchError::BadInput(e.to_string())),
+                Err(code) => return code,
             };
             let dt = launcher::tools::recorded_dt(&r);
             if !r.complete {
@@ -224,6 +306,11 @@ fn main() -> ExitCode {
         }
         Command::Component { kind, args } => component(&kind, args),
     }
+}
+
+/// Reads a recording, or reports why not (exit code 2).
+fn read_recording(path: &Path) -> Result<launcher::recording::Recording, ExitCode> {
+    launcher::recording::read(path).map_err(|e| fail(&LaunchError::BadInput(e.to_string())))
 }
 
 /// Runs a component's shell in this process (the fallback when its binary is not installed).

@@ -10,7 +10,7 @@ use std::path::Path;
 use re_log_encoding::DecoderApp;
 use rerun::external::re_log_types::LogMsg;
 use rerun::log::Chunk;
-use rerun::{Scalars, TextDocument};
+use rerun::{Scalars, SeriesLines, TextDocument};
 
 /// One scalar time series.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -28,6 +28,8 @@ pub struct Recording {
     pub series: BTreeMap<String, Series>,
     /// The scenario text stored in the recording, if any.
     pub scenario: Option<String>,
+    /// Legend name of each series (e.g. "plant->observer/uio" for a hop), where recorded.
+    pub names: BTreeMap<String, String>,
     /// False when the file ends without the footer a finished writer leaves.
     pub complete: bool,
     /// What went wrong while reading a damaged tail.
@@ -53,6 +55,7 @@ pub fn read(path: &Path) -> Result<Recording, ReadError> {
     let mut rec = Recording::default();
     let scalars = Scalars::descriptor_scalars().component;
     let text = TextDocument::descriptor_text().component;
+    let legend = SeriesLines::descriptor_names().component;
     let mut seen_any = false;
     for msg in messages.by_ref() {
         let msg = match msg {
@@ -75,6 +78,9 @@ pub fn read(path: &Path) -> Result<Recording, ReadError> {
         if chunk.is_static() {
             if let Some(s) = chunk.iter_slices::<String>(text).next().and_then(|v| v.into_iter().next()) {
                 rec.scenario = Some(s.to_string());
+            }
+            if let Some(n) = chunk.iter_slices::<String>(legend).next().and_then(|v| v.into_iter().next()) {
+                rec.names.insert(path, n.to_string());
             }
             continue;
         }
@@ -102,4 +108,21 @@ pub fn read(path: &Path) -> Result<Recording, ReadError> {
         }
     }
     Ok(rec)
+}
+
+/// Writes series to a new `.rrd` (timeline `step` only), e.g. to make a test recording.
+pub fn write(path: &Path, rec: &Recording) -> Result<(), String> {
+    use rerun::time::Timeline;
+    use rerun::TimeColumn;
+    let sink = crate::record::UncompressedFileSink::create(path)?;
+    let stream = rerun::RecordingStreamBuilder::new("uio-observers").buffered().map_err(|e| e.to_string())?;
+    stream.set_sink(Box::new(sink));
+    for (entity, series) in &rec.series {
+        let steps = TimeColumn::new(Some(true), Timeline::new_sequence("step"), series.steps.clone().into());
+        let columns = Scalars::new(series.values.iter().copied()).columns_of_unit_batches().map_err(|e| e.to_string())?;
+        stream.send_columns(entity.as_str(), [steps], columns).map_err(|e| e.to_string())?;
+    }
+    stream.flush_blocking().map_err(|e| e.to_string())?;
+    drop(stream);
+    Ok(())
 }

@@ -34,8 +34,8 @@ pub struct Latency {
     step: Histogram<u64>,
 }
 
-fn histogram() -> Histogram<u64> {
-    // 1 ns … 100 s at 3 significant digits.
+/// The histogram every latency goes into: 1 ns … 100 s at 3 significant digits.
+pub fn histogram() -> Histogram<u64> {
     Histogram::new_with_bounds(1, 100_000_000_000, 3).expect("valid bounds")
 }
 
@@ -61,7 +61,8 @@ impl Latency {
         self.step.len()
     }
 
-    fn percentiles(h: &Histogram<u64>) -> Percentiles {
+    /// Percentiles of a histogram (all zero when it is empty).
+    pub fn percentiles(h: &Histogram<u64>) -> Percentiles {
         if h.is_empty() {
             return Percentiles::default();
         }

@@ -9,7 +9,8 @@ mod metrics;
 mod rrd;
 
 pub use blueprint::blueprint;
-pub use latency::{Latency, Percentiles};
+pub use file_sink::UncompressedFileSink;
+pub use latency::{histogram, Latency, Percentiles};
 pub use metrics::{Metrics, ObserverFigures};
 pub use rrd::{RrdSink, SeriesId};
 

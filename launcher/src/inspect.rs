@@ -1,0 +1,181 @@
+//! `launcher inspect`: what a recording holds — its entities with their row counts and time
+//! ranges — and the run's figures recomputed from the recorded data alone: per observer the
+//! largest |x − x̂| and |y − Cx̂| over the last quarter of the run, and the latency percentiles.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use crate::record::{histogram, Latency, Percentiles};
+use crate::recording::Recording;
+use crate::tools::recorded_scenario;
+
+/// One entity.
+#[derive(Debug, Clone, Serialize)]
+pub struct EntityInfo {
+    /// Entity path.
+    pub path: String,
+    /// Number of values.
+    pub rows: usize,
+    /// First and last step.
+    pub steps: [i64; 2],
+    /// First and last sim_time, s (when the sample period is known).
+    pub sim_time: Option<[f64; 2]>,
+}
+
+/// One observer's figures.
+#[derive(Debug, Clone, Serialize)]
+pub struct ObserverFigures {
+    /// Name.
+    pub name: String,
+    /// max |x − x̂| over the last quarter of the run.
+    pub tail_max_abs_error: f64,
+    /// max |y − Cx̂| over the last quarter of the run.
+    pub tail_max_abs_residual: f64,
+}
+
+/// Latency percentiles recomputed from the recording, ns.
+#[derive(Debug, Clone, Serialize)]
+pub struct LatencyFigures {
+    /// The step.
+    pub step: Percentiles,
+    /// Per hop, by the name the run gave it.
+    pub hops: BTreeMap<String, Percentiles>,
+}
+
+/// What `inspect` reports.
+#[derive(Debug, Clone, Serialize)]
+pub struct Inspection {
+    /// The file.
+    pub file: String,
+    /// Whether the writer finished (footer present, nothing truncated).
+    pub complete: bool,
+    /// Scenario name, if recorded.
+    pub scenario: Option<String>,
+    /// Steps the scenario asked for, if recorded.
+    pub steps_planned: Option<u64>,
+    /// Steps in the recording.
+    pub steps_recorded: u64,
+    /// Every entity.
+    pub entities: Vec<EntityInfo>,
+    /// Per observer.
+    pub observers: Vec<ObserverFigures>,
+    /// Latency.
+    pub latency_ns: LatencyFigures,
+    /// Incompleteness and the like.
+    pub warnings: Vec<String>,
+}
+
+/// Inspects a decoded recording.
+pub fn inspect(file: &str, r: &Recording) -> Inspection {
+    let scenario = recorded_scenario(r);
+    let dt = scenario.as_ref().map(|s| s.dt);
+    let steps_recorded = r.series.get("/plant/x/0").map_or(0, |s| s.values.len() as u64);
+    let steps_planned = scenario.as_ref().map(|s| s.steps);
+    let mut warnings = Vec::new();
+    if !r.complete {
+        warnings.push(match &r.problem {
+            Some(p) => format!("incomplete recording: {p}"),
+            None => "incomplete recording: its writer did not finish (no footer)".to_string(),
+        });
+    }
+    if let Some(planned) = steps_planned {
+        if steps_recorded < planned {
+            warnings.push(format!("the run stopped early: {steps_recorded} of {planned} steps recorded"));
+        }
+    }
+    let entities = r
+        .series
+        .iter()
+        .map(|(path, s)| {
+            let steps = [s.steps.first().copied().unwrap_or(0), s.steps.last().copied().unwrap_or(0)];
+            EntityInfo { path: path.clone(), rows: s.values.len(), steps, sim_time: dt.map(|dt| [steps[0] as f64 * dt, steps[1] as f64 * dt]) }
+        })
+        .collect();
+    // The tail as the run defined it: the last quarter of the planned steps.
+    let total = steps_planned.unwrap_or(steps_recorded) as i64;
+    let tail_start = total - total / 4;
+    let tail_max = |prefix: &str| -> f64 {
+        r.series
+            .iter()
+            .filter(|(p, _)| p.starts_with(prefix))
+            .flat_map(|(_, s)| s.steps.iter().zip(&s.values).filter(|(k, _)| **k >= tail_start).map(|(_, v)| v.abs()))
+            .fold(0.0, f64::max)
+    };
+    let mut names: Vec<String> = r
+        .series
+        .keys()
+        .filter_map(|p| p.strip_prefix("/observer/").and_then(|rest| rest.split_once('/')).map(|(n, _)| n.to_string()))
+        .collect();
+    names.dedup();
+    let order: Vec<String> = scenario.as_ref().map(|s| s.observers.iter().map(|o| o.name.clone()).collect()).unwrap_or_default();
+    names.sort_by_key(|n| order.iter().position(|o| o == n).unwrap_or(usize::MAX));
+    let observers = names
+        .into_iter()
+        .map(|n| ObserverFigures {
+            tail_max_abs_error: tail_max(&format!("/observer/{n}/error/")),
+            tail_max_abs_residual: tail_max(&format!("/observer/{n}/residual/")),
+            name: n,
+        })
+        .collect();
+    let percentiles = |path: &str| {
+        let mut h = histogram();
+        if let Some(s) = r.series.get(path) {
+            for &v in &s.values {
+                h.saturating_record((v as u64).max(1));
+            }
+        }
+        Latency::percentiles(&h)
+    };
+    let hops = r
+        .series
+        .keys()
+        .filter(|p| p.starts_with("/latency/") && p.as_str() != "/latency/step")
+        .map(|p| (r.names.get(p).cloned().unwrap_or_else(|| p.trim_start_matches("/latency/").to_string()), percentiles(p)))
+        .collect();
+    Inspection {
+        file: file.to_string(),
+        complete: r.complete,
+        scenario: scenario.map(|s| s.name),
+        steps_planned,
+        steps_recorded,
+        entities,
+        observers,
+        latency_ns: LatencyFigures { step: percentiles("/latency/step"), hops },
+        warnings,
+    }
+}
+
+impl Inspection {
+    /// The printed report.
+    pub fn text(&self) -> String {
+        let mut t = format!(
+            "{}: {} ({}), {} steps recorded{}\n",
+            self.file,
+            self.scenario.as_deref().unwrap_or("unknown scenario"),
+            if self.complete { "complete" } else { "INCOMPLETE" },
+            self.steps_recorded,
+            self.steps_planned.map_or(String::new(), |p| format!(" of {p}"))
+        );
+        for w in &self.warnings {
+            t += &format!("warning: {w}\n");
+        }
+        t += &format!("  {:<42} {:>8} {:>18} {:>22}\n", "entity", "rows", "steps", "sim_time [s]");
+        for e in &self.entities {
+            let time = e.sim_time.map_or("-".to_string(), |[a, b]| format!("{a} … {b}"));
+            t += &format!("  {:<42} {:>8} {:>18} {:>22}\n", e.path, e.rows, format!("{} … {}", e.steps[0], e.steps[1]), time);
+        }
+        t += &format!("  {:<14} {:>14} {:>14}\n", "observer", "tail max|e|", "tail max|r|");
+        for o in &self.observers {
+            t += &format!("  {:<14} {:>14.3e} {:>14.3e}\n", o.name, o.tail_max_abs_error, o.tail_max_abs_residual);
+        }
+        let p = &self.latency_ns.step;
+        if p.max > 0 {
+            t += &format!("  step latency [ns]: p50 {}  p90 {}  p99 {}  p99.9 {}  max {}\n", p.p50, p.p90, p.p99, p.p999, p.max);
+            for (h, p) in &self.latency_ns.hops {
+                t += &format!("    {h:<30} p50 {}  p99 {}  max {}\n", p.p50, p.p99, p.max);
+            }
+        }
+        t
+    }
+}
