@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 
-use lti::eig::{format_list, sig, C64};
+use lti::eig::{format_list, sig};
 use lti::Mat;
 use observer::design::{design, Condition};
 use serde::Serialize;
@@ -24,10 +24,6 @@ pub struct DesignReport {
 
 fn rows(m: &Mat) -> Vec<Vec<f64>> {
     (0..m.nrows()).map(|i| m.row(i).iter().copied().collect()).collect()
-}
-
-fn pairs(v: &[C64]) -> Vec<[f64; 2]> {
-    v.iter().map(|z| [z.re, z.im]).collect()
 }
 
 #[derive(Serialize)]
@@ -83,9 +79,9 @@ pub fn report(s: &Scenario) -> DesignReport {
                     "name": o.name, "kind": o.spec.kind(),
                     "conditions": conditions_json(&r.conditions),
                     "matrices": matrices,
-                    "poles": pairs(&r.poles),
-                    "discrete_poles": pairs(&r.discrete_poles),
-                    "fixed_modes": pairs(&r.fixed_modes),
+                    "poles": lti::re_im(&r.poles),
+                    "discrete_poles": lti::re_im(&r.discrete_poles),
+                    "fixed_modes": lti::re_im(&r.fixed_modes),
                 }));
             }
             Err(e) => {
@@ -120,8 +116,8 @@ pub fn report(s: &Scenario) -> DesignReport {
                         "kind": "state-feedback",
                         "observer": c.observer,
                         "matrices": {"G": rows(&fb.g)},
-                        "closed_loop_poles": pairs(&fb.closed_loop),
-                        "discrete_closed_loop_poles": pairs(&fb.discrete_closed_loop),
+                        "closed_loop_poles": lti::re_im(&fb.closed_loop),
+                        "discrete_closed_loop_poles": lti::re_im(&fb.discrete_closed_loop),
                         "stable": fb.stable(),
                     });
                 }

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use crate::record::{histogram, Latency, Percentiles};
+use crate::record::{histogram, nan_max, Latency, Percentiles};
 use crate::recording::Recording;
 use crate::tools::recorded_scenario;
 
@@ -79,10 +79,10 @@ pub fn inspect(file: &str, r: &Recording) -> Inspection {
             None => "incomplete recording: its writer did not finish (no footer)".to_string(),
         });
     }
-    if let Some(planned) = steps_planned {
-        if steps_recorded < planned {
-            warnings.push(format!("the run stopped early: {steps_recorded} of {planned} steps recorded"));
-        }
+    if let Some(planned) = steps_planned
+        && steps_recorded < planned
+    {
+        warnings.push(format!("the run stopped early: {steps_recorded} of {planned} steps recorded"));
     }
     let entities = r
         .series
@@ -100,7 +100,7 @@ pub fn inspect(file: &str, r: &Recording) -> Inspection {
             .iter()
             .filter(|(p, _)| p.starts_with(prefix))
             .flat_map(|(_, s)| s.steps.iter().zip(&s.values).filter(|(k, _)| **k >= tail_start).map(|(_, v)| v.abs()))
-            .fold(0.0, f64::max)
+            .fold(0.0, nan_max)
     };
     let mut names: Vec<String> = r
         .series

@@ -28,7 +28,8 @@ enum Command {
         /// Where the components run.
         #[arg(long, value_parser = ["processes", "in-process"], default_value = "processes")]
         mode: String,
-        /// How components wait for samples: yield, block, spin-then-block[:µs].
+        /// How components wait for samples: yield (default), block, waitset,
+        /// spin-then-block[:µs], spin-then-yield:<ns>, sleep:<µs>.
         #[arg(long)]
         wait: Option<Wait>,
         /// Overwrite an existing recording.
@@ -57,7 +58,8 @@ enum Command {
         /// Print JSON.
         #[arg(long)]
         json: bool,
-        /// How components wait for samples.
+        /// How components wait for samples: yield (default), block, waitset,
+        /// spin-then-block[:µs], spin-then-yield:<ns>, sleep:<µs>.
         #[arg(long)]
         wait: Option<Wait>,
         /// Only this mode (default: both).
@@ -315,29 +317,14 @@ fn read_recording(path: &Path) -> Result<launcher::recording::Recording, ExitCod
 
 /// Runs a component's shell in this process (the fallback when its binary is not installed).
 fn component(kind: &str, args: Vec<String>) -> ExitCode {
-    lockstep::die_with_parent();
     if let Ok(name) = std::ffi::CString::new(kind) {
         // SAFETY: PR_SET_NAME copies at most 16 bytes from a valid C string.
         unsafe { libc::prctl(libc::PR_SET_NAME, name.as_ptr()) };
     }
-    let launch = match lockstep::parse_launch(kind, args) {
-        Ok(l) => l,
-        Err(msg) => {
-            eprintln!("{msg}");
-            return ExitCode::from(lockstep::EXIT_USAGE as u8);
-        }
-    };
-    let code = match kind {
-        "plant" => plant::shell::run(&launch).map_err(|e| (e.exit_code(), e.to_string())),
-        "observer" => observer::shell::run(&launch).map_err(|e| (observer::shell::EXIT_FAILED, e.to_string())),
-        "controller" => controller::shell::run(&launch).map_err(|e| (controller::shell::EXIT_FAILED, e.to_string())),
+    lockstep::component_main(kind, args, |l| match kind {
+        "plant" => plant::shell::run(l).map_err(|e| (e.exit_code(), e.to_string())),
+        "observer" => observer::shell::run(l).map_err(|e| (observer::shell::EXIT_FAILED, e.to_string())),
+        "controller" => controller::shell::run(l).map_err(|e| (controller::shell::EXIT_FAILED, e.to_string())),
         other => Err((lockstep::EXIT_USAGE, format!("unknown component '{other}'"))),
-    };
-    match code {
-        Ok(()) => ExitCode::SUCCESS,
-        Err((c, msg)) => {
-            eprintln!("{kind}: {msg}");
-            ExitCode::from(c as u8)
-        }
-    }
+    })
 }

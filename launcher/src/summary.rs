@@ -91,10 +91,6 @@ pub struct Summary {
     pub recording: Option<String>,
 }
 
-fn pairs(v: &[lti::C64]) -> Vec<[f64; 2]> {
-    v.iter().map(|z| [z.re, z.im]).collect()
-}
-
 impl Summary {
     /// Gathers the summary of a run.
     #[allow(clippy::too_many_arguments)]
@@ -111,8 +107,8 @@ impl Summary {
                 tail_max_abs_residual: f.tail_max_abs_residual,
                 max_abs_error: f.max_abs_error,
                 final_abs_error: f.final_abs_error,
-                poles: pairs(&d.report.poles),
-                discrete_poles: pairs(&d.report.discrete_poles),
+                poles: lti::re_im(&d.report.poles),
+                discrete_poles: lti::re_im(&d.report.discrete_poles),
             })
             .collect();
         let names = s.observer_names();
@@ -135,7 +131,7 @@ impl Summary {
             steps_per_s: m.steps as f64 / wall_s.max(1e-9),
             observers,
             differences,
-            closed_loop_poles: plan.feedback.as_ref().map(|f| pairs(&f.closed_loop)),
+            closed_loop_poles: plan.feedback.as_ref().map(|f| lti::re_im(&f.closed_loop)),
             latency_ns: LatencySummary { step: lat.step_percentiles(), hops: lat.hop_percentiles().into_iter().collect() },
             expectations: Vec::new(),
             stopped,

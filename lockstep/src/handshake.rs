@@ -48,10 +48,43 @@ pub fn parse_launch(component: &str, args: impl IntoIterator<Item = String>) -> 
     }
     let run = run.ok_or_else(|| how.clone())?;
     let run = RunSpace::open(&run).map_err(|e| format!("{how} ({e})"))?;
+    // SAFETY: getppid has no preconditions.
+    let parent = unsafe { libc::getppid() };
+    if run.owner() != Some(parent) {
+        return Err(format!("{how} (its parent, pid {parent}, is not the launcher of run '{}')", run.id()));
+    }
     if std::io::stdin().is_terminal() {
         return Err(format!("{how} (stdin is a terminal, not the launcher's pipe)"));
     }
     Ok(Launch { run, name: name.unwrap_or_else(|| component.to_string()), wait })
+}
+
+/// The `main` of a component: dies with its parent, parses its command line, runs `body`,
+/// and turns a failure `(exit code, message)` into a message on stderr and that exit code.
+pub fn component_main(
+    kind: &str,
+    args: impl IntoIterator<Item = String>,
+    body: impl FnOnce(&Launch) -> Result<(), (i32, String)>,
+) -> std::process::ExitCode {
+    die_with_parent();
+    let launch = match parse_launch(kind, args) {
+        Ok(l) => l,
+        Err(msg) => {
+            eprintln!("{msg}");
+            return std::process::ExitCode::from(EXIT_USAGE as u8);
+        }
+    };
+    match body(&launch) {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err((code, msg)) => {
+            if launch.name == kind {
+                eprintln!("{kind}: {msg}");
+            } else {
+                eprintln!("{kind} {}: {msg}", launch.name);
+            }
+            std::process::ExitCode::from(code as u8)
+        }
+    }
 }
 
 /// Asks the kernel to kill this process when its parent (the launcher) dies.
@@ -60,11 +93,8 @@ pub fn die_with_parent() {
     unsafe {
         libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL);
     }
-    // The parent may have died before the flag was set.
-    // SAFETY: getppid has no preconditions.
-    if unsafe { libc::getppid() } == 1 {
-        std::process::exit(EXIT_USAGE);
-    }
+    // (A parent that died before the flag was set is caught by `parse_launch`: the new parent
+    // is then not the run's launcher.)
 }
 
 /// Writes `ready`, then blocks until the launcher writes `go` (or closes the pipe).

@@ -35,7 +35,7 @@ mod wait;
 
 pub use clock::now_ns;
 pub use error::LockstepError;
-pub use handshake::{die_with_parent, parse_launch, ready_then_wait_for_go, Launch, EXIT_USAGE};
+pub use handshake::{component_main, die_with_parent, parse_launch, ready_then_wait_for_go, Launch, EXIT_USAGE};
 pub use layout::PlantLayout;
 pub use port::{Bus, Inlet, Outlet, Reader, FOLLOWER_LAG, RECORDER_BUFFER};
 pub use run::{cleanup_dead_runs, RunSpace, RUNS_DIR_ENV};

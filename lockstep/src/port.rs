@@ -46,11 +46,6 @@ impl Bus {
         Ok(Self { node, wait })
     }
 
-    /// The wait strategy in use.
-    pub fn wait(&self) -> Wait {
-        self.wait
-    }
-
     fn service(&self, topic: &str) -> Result<PortFactory<Ipc, Sample, ()>, LockstepError> {
         // Every port opens the service with the same settings, so any of them may create it.
         self.node
@@ -120,7 +115,7 @@ impl Bus {
     /// A recording end of `topic` that never makes the publisher drop a sample.
     pub fn reader(&self, topic: &str) -> Result<Reader, LockstepError> {
         let subscriber = self.service(topic)?.subscriber_builder().buffer_size(RECORDER_BUFFER).create().map_err(LockstepError::ipc)?;
-        Ok(Reader { subscriber, topic: topic.to_string() })
+        Ok(Reader { subscriber })
     }
 }
 
@@ -179,14 +174,10 @@ pub struct Inlet {
 }
 
 impl Inlet {
-    /// The service this inlet reads.
-    pub fn topic(&self) -> &str {
-        &self.topic
-    }
-
-    /// How long [`Inlet::wait_step`] waits before giving up.
-    pub fn set_timeout(&mut self, timeout: Duration) {
-        self.timeout = timeout;
+    /// Waits by sleep-polling instead of the bus's strategy (for processes off the critical
+    /// path). Their outlets still notify as the run's strategy requires.
+    pub fn sleep_between_polls(&mut self, us: u32) {
+        self.wait = Wait::Sleep(us);
     }
 
     /// Takes a pending sample, if any, checking its step and copying its values into `out`.
@@ -217,7 +208,7 @@ impl Inlet {
             match self.wait {
                 Wait::Yield => {
                     std::thread::yield_now();
-                    if polls % 1024 == 0 && now_ns() - start > limit {
+                    if polls.is_multiple_of(1024) && now_ns() - start > limit {
                         return Err(self.timed_out(step));
                     }
                 }
@@ -246,7 +237,7 @@ impl Inlet {
                         }
                     } else {
                         std::thread::yield_now();
-                        if polls % 1024 == 0 && now_ns() - start > limit {
+                        if polls.is_multiple_of(1024) && now_ns() - start > limit {
                             return Err(self.timed_out(step));
                         }
                     }
@@ -288,15 +279,9 @@ impl Inlet {
 /// Drains a service without blocking (the recorder).
 pub struct Reader {
     subscriber: Subscriber<Ipc, Sample, ()>,
-    topic: String,
 }
 
 impl Reader {
-    /// The service this reader drains.
-    pub fn topic(&self) -> &str {
-        &self.topic
-    }
-
     /// Calls `f` for every pending sample, in order; returns how many there were.
     pub fn drain(&self, mut f: impl FnMut(&Sample)) -> Result<usize, LockstepError> {
         let mut count = 0;

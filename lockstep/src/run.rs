@@ -49,12 +49,16 @@ impl RunSpace {
             COUNTER.fetch_add(1, Ordering::Relaxed),
             crate::now_ns() % 1_000_000
         );
+        // Built under a hidden name and renamed into place, so a concurrent launcher cleaning
+        // up dead runs never sees a run directory without its owner.
+        let tmp = base.join(format!(".new-{id}"));
+        fs::DirBuilder::new().mode(0o700).create(&tmp).map_err(|e| io("cannot create", &tmp, e))?;
+        fs::DirBuilder::new().mode(0o700).create(tmp.join("iox2")).map_err(|e| io("cannot create", &tmp, e))?;
+        let mut f = fs::File::create(tmp.join("owner.pid")).map_err(|e| io("cannot write", &tmp, e))?;
+        writeln!(f, "{}", std::process::id()).map_err(|e| io("cannot write", &tmp, e))?;
+        fs::set_permissions(tmp.join("owner.pid"), fs::Permissions::from_mode(0o600)).map_err(|e| io("cannot chmod", &tmp, e))?;
         let dir = base.join(&id);
-        fs::DirBuilder::new().mode(0o700).create(&dir).map_err(|e| io("cannot create", &dir, e))?;
-        fs::DirBuilder::new().mode(0o700).create(dir.join("iox2")).map_err(|e| io("cannot create", &dir, e))?;
-        let mut f = fs::File::create(dir.join("owner.pid")).map_err(|e| io("cannot write", &dir, e))?;
-        writeln!(f, "{}", std::process::id()).map_err(|e| io("cannot write", &dir, e))?;
-        fs::set_permissions(dir.join("owner.pid"), fs::Permissions::from_mode(0o600)).map_err(|e| io("cannot chmod", &dir, e))?;
+        fs::rename(&tmp, &dir).map_err(|e| io("cannot create", &dir, e))?;
         Self::at(id, dir)
     }
 
@@ -77,6 +81,11 @@ impl RunSpace {
         let root = format!("{}/", dir.join("iox2").display());
         config.global.set_root_path(&IoxPath::new(root.as_bytes()).map_err(LockstepError::ipc)?);
         Ok(Self { id, dir, config })
+    }
+
+    /// The pid of the launcher that owns the run.
+    pub fn owner(&self) -> Option<i32> {
+        fs::read_to_string(self.dir.join("owner.pid")).ok().and_then(|s| s.trim().parse().ok())
     }
 
     /// The run id (alphanumeric).
@@ -159,6 +168,14 @@ pub fn cleanup_dead_runs() -> usize {
     if let Ok(entries) = fs::read_dir(runs_dir()) {
         for entry in entries.flatten() {
             let id = entry.file_name().to_string_lossy().to_string();
+            if let Some(rest) = id.strip_prefix(".new-") {
+                // A directory still being set up; left over only if its launcher died doing it.
+                let owner = rest.split('x').next().and_then(|p| p.parse::<i32>().ok());
+                if !owner.is_some_and(alive) {
+                    let _ = fs::remove_dir_all(entry.path());
+                }
+                continue;
+            }
             let owner = fs::read_to_string(entry.path().join("owner.pid")).ok().and_then(|s| s.trim().parse::<i32>().ok());
             if !owner.is_some_and(alive) {
                 for f in shm_files_with_prefix(&format!("uio{id}_")) {

@@ -11,7 +11,7 @@ use core::fmt::Debug;
 use core::marker::PhantomData;
 use core::ops::Deref;
 use core::ptr::NonNull;
-use std::alloc::{alloc, handle_alloc_error, Layout};
+use std::alloc::{alloc, dealloc, handle_alloc_error, Layout};
 use std::cell::{Cell, RefCell};
 
 use iceoryx2::prelude::ZeroCopySend;
@@ -46,10 +46,14 @@ impl iceoryx2::service::Service for Service {
 
 impl iceoryx2::service::internal::ServiceInternal<Service> for Service {}
 
+/// Free blocks, keyed by (size, align).
+type FreeLists = Vec<((usize, usize), Vec<NonNull<u8>>)>;
+
 thread_local! {
     /// Free memory blocks by (size, align); a block leaves the list when a cell is created and
-    /// returns when its last reference drops.
-    static FREE: RefCell<Vec<((usize, usize), Vec<NonNull<u8>>)>> = const { RefCell::new(Vec::new()) };
+    /// returns when its last reference drops. The few blocks still listed when a thread ends
+    /// (a handful per port) are not returned to the allocator.
+    static FREE: RefCell<FreeLists> = const { RefCell::new(Vec::new()) };
 }
 
 fn take(layout: Layout) -> NonNull<u8> {
@@ -64,13 +68,18 @@ fn take(layout: Layout) -> NonNull<u8> {
 
 fn give(p: NonNull<u8>, layout: Layout) {
     let key = (layout.size(), layout.align());
-    FREE.with(|f| {
+    let kept = FREE.try_with(|f| {
         let mut f = f.borrow_mut();
         match f.iter_mut().find(|(k, _)| *k == key) {
             Some((_, v)) => v.push(p),
             None => f.push((key, vec![p])),
         }
     });
+    if kept.is_err() {
+        // The thread's free list is already gone (thread exit): hand the block back.
+        // SAFETY: `p` came from `alloc` with this layout in `take`.
+        unsafe { dealloc(p.as_ptr(), layout) };
+    }
 }
 
 struct Slot<T> {

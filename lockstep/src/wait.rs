@@ -2,7 +2,8 @@
 //!
 //! Only one component has work at any moment of a lockstep step, and on a machine with fewer
 //! cores than processes a waiting process must give its core away: every strategy here either
-//! yields between polls or sleeps in the kernel, none spins without yielding.
+//! yields between polls or sleeps in the kernel. The one exception, `spin-then-yield`, spins
+//! only for a bounded few nanoseconds before it starts yielding.
 
 use std::str::FromStr;
 
@@ -30,8 +31,9 @@ impl Wait {
         matches!(self, Wait::Block | Wait::WaitSet | Wait::SpinThenBlock(_))
     }
 
-    /// The default for this machine: yielding polls (measured fastest on 2 cores and up; a
-    /// yielding process never starves the one with work).
+    /// The default: yielding polls, whatever the machine (measured fastest on 2 cores and up;
+    /// a yielding process never starves the one with work). A function, not a constant, so a
+    /// choice by core count can be added without touching the callers.
     pub fn default_for_machine() -> Wait {
         Wait::Yield
     }

@@ -139,7 +139,7 @@ pub fn format_list(v: &[C64]) -> String {
 /// One eigenvalue; with `pair`, a complex value is shown as "re ± j·|im|".
 pub fn format_one(e: C64, pair: bool) -> String {
     if e.im == 0.0 {
-        format!("{}", sig(e.re))
+        sig(e.re)
     } else if pair {
         format!("{} ± j{}", sig(e.re), sig(e.im.abs()))
     } else if e.im > 0.0 {

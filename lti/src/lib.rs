@@ -28,7 +28,7 @@ pub use eig::C64;
 pub use error::{LtiError, Result};
 pub use nalgebra::DMatrix;
 pub use model::{Discrete, MatData, Model};
-pub use poles::{PoleSpec, Poles};
+pub use poles::{re_im, PoleSpec, Poles};
 
 /// A real matrix.
 pub type Mat = nalgebra::DMatrix<f64>;

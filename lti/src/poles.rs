@@ -99,11 +99,11 @@ impl Poles {
     pub fn to_discrete(&self, dt: f64) -> Poles {
         Poles(self.0.iter().map(|p| (p * dt).exp()).collect())
     }
+}
 
-    /// The poles as [re, im] pairs.
-    pub fn pairs(&self) -> Vec<[f64; 2]> {
-        self.0.iter().map(|p| [p.re, p.im]).collect()
-    }
+/// Complex numbers as [re, im] pairs (how reports and JSON write poles).
+pub fn re_im(v: &[C64]) -> Vec<[f64; 2]> {
+    v.iter().map(|p| [p.re, p.im]).collect()
 }
 
 /// One entry of a pole list as a user writes it.

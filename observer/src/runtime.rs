@@ -123,8 +123,8 @@ impl ObserverState {
             std::mem::swap(&mut self.z, &mut self.z_next);
         }
         self.started = true;
-        // Skipping exact identities and zeros changes no bit: 1·z = z, and adding +0.0 terms
-        // to a sum that starts from 0.0 or from z leaves it as it was.
+        // Exact identities and zeros are skipped: for finite values the result differs from the
+        // full product only in the sign of a zero, and both run modes execute this same code.
         if self.p_identity {
             self.xhat.copy_from_slice(&self.z);
         } else {

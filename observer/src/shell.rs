@@ -34,10 +34,14 @@ impl ObserverLoop {
     /// Creates the observer `name` and its ports on `bus`.
     pub fn new(cfg: &ObserverRun, name: &str, bus: &Bus) -> Result<Self, LockstepError> {
         cfg.observer.check().map_err(LockstepError::Io)?;
+        let mut inlet = bus.inlet("plant")?;
+        if let Some(us) = cfg.follower_sleep_us {
+            inlet.sleep_between_polls(us);
+        }
         Ok(Self {
             obs: cfg.observer.instantiate(),
             outlet: bus.outlet(&format!("observer/{name}"))?,
-            inlet: bus.inlet("plant")?,
+            inlet,
             layout: cfg.layout,
             sample: vec![0.0; cfg.layout.len()],
         })
@@ -58,8 +62,7 @@ pub fn run(launch: &Launch) -> Result<(), LockstepError> {
     let component = format!("observer-{}", launch.name);
     let cfg: ObserverRun =
         serde_json::from_str(&launch.run.read_config(&component)?).map_err(|e| LockstepError::Io(format!("configuration: {e}")))?;
-    let wait = cfg.follower_sleep_us.map_or(launch.wait, lockstep::Wait::Sleep);
-    let bus = Bus::join(&launch.run, &component, wait)?;
+    let bus = Bus::join(&launch.run, &component, launch.wait)?;
     let mut lp = ObserverLoop::new(&cfg, &launch.name, &bus)?;
     ready_then_wait_for_go()?;
     for k in 0..cfg.steps {

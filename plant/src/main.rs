@@ -1,16 +1,5 @@
 //! `plant`: the plant process of a co-simulation (started by the launcher).
 
-fn main() {
-    lockstep::die_with_parent();
-    let launch = match lockstep::parse_launch("plant", std::env::args().skip(1)) {
-        Ok(l) => l,
-        Err(msg) => {
-            eprintln!("{msg}");
-            std::process::exit(lockstep::EXIT_USAGE);
-        }
-    };
-    if let Err(e) = plant::shell::run(&launch) {
-        eprintln!("plant: {e}");
-        std::process::exit(e.exit_code());
-    }
+fn main() -> std::process::ExitCode {
+    lockstep::component_main("plant", std::env::args().skip(1), |l| plant::shell::run(l).map_err(|e| (e.exit_code(), e.to_string())))
 }

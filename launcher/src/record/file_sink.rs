@@ -43,10 +43,10 @@ impl UncompressedFileSink {
 impl LogSink for UncompressedFileSink {
     fn send(&self, msg: LogMsg) {
         let mut guard = self.encoder.lock().expect("encoder lock");
-        if let Some(enc) = guard.as_mut() {
-            if let Err(e) = enc.append(&msg) {
-                self.fail(e);
-            }
+        if let Some(enc) = guard.as_mut()
+            && let Err(e) = enc.append(&msg)
+        {
+            self.fail(e);
         }
     }
 
@@ -64,11 +64,11 @@ impl LogSink for UncompressedFileSink {
 
 impl Drop for UncompressedFileSink {
     fn drop(&mut self) {
-        if let Ok(mut guard) = self.encoder.lock() {
-            if let Some(mut enc) = guard.take() {
-                let _ = enc.finish();
-                let _ = enc.flush_blocking();
-            }
+        if let Ok(mut guard) = self.encoder.lock()
+            && let Some(mut enc) = guard.take()
+        {
+            let _ = enc.finish();
+            let _ = enc.flush_blocking();
         }
     }
 }

@@ -21,6 +21,13 @@ pub struct ObserverFigures {
     pub final_abs_error: f64,
 }
 
+/// max(a, b) that propagates NaN (`f64::max` ignores it): a non-finite estimate must not score
+/// as a perfect one.
+#[inline]
+pub fn nan_max(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() { f64::NAN } else { a.max(b) }
+}
+
 /// Accumulates [`ObserverFigures`] and pairwise differences.
 #[derive(Debug, Clone)]
 pub struct Metrics {
@@ -75,26 +82,26 @@ impl Metrics {
             for i in 0..self.layout.n {
                 let e = x[i] - xhat[i];
                 self.error[o][i] = e;
-                emax = emax.max(e.abs());
+                emax = nan_max(emax, e.abs());
             }
             let mut rmax: f64 = 0.0;
             let res = &mut self.residual[o];
             mul_into(res, &self.c, xhat);
             for (r, &yj) in res.iter_mut().zip(y) {
                 *r = yj - *r;
-                rmax = rmax.max(r.abs());
+                rmax = nan_max(rmax, r.abs());
             }
             let f = &mut self.observers[o];
-            f.max_abs_error = f.max_abs_error.max(emax);
+            f.max_abs_error = nan_max(f.max_abs_error, emax);
             f.final_abs_error = emax;
             if tail {
-                f.tail_max_abs_error = f.tail_max_abs_error.max(emax);
-                f.tail_max_abs_residual = f.tail_max_abs_residual.max(rmax);
+                f.tail_max_abs_error = nan_max(f.tail_max_abs_error, emax);
+                f.tail_max_abs_residual = nan_max(f.tail_max_abs_residual, rmax);
             }
         }
         for ((a, b), d) in self.differences.iter_mut() {
             for i in 0..self.layout.n {
-                *d = d.max((row.xhat[*a][i] - row.xhat[*b][i]).abs());
+                *d = nan_max(*d, (row.xhat[*a][i] - row.xhat[*b][i]).abs());
             }
         }
         self.steps += 1;

@@ -11,7 +11,7 @@ mod rrd;
 pub use blueprint::blueprint;
 pub use file_sink::UncompressedFileSink;
 pub use latency::{histogram, Latency, Percentiles};
-pub use metrics::{Metrics, ObserverFigures};
+pub use metrics::{nan_max, Metrics, ObserverFigures};
 pub use rrd::{RrdSink, SeriesId};
 
 use lockstep::{Header, PlantLayout};

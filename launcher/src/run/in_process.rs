@@ -21,10 +21,10 @@ pub fn run(cfg: &Configs, session: &mut Session) -> Result<Stop, LaunchError> {
     let mut row = StepRow::new(lay, observers.len(), controller.is_some());
     let mut u = vec![0.0; lay.l];
     for k in 0..cfg.plant.plant.steps {
-        if k % 1024 == 0 {
-            if let Some(sig) = interrupt::received() {
-                return Ok(Stop::Interrupted(sig));
-            }
+        if k % 1024 == 0
+            && let Some(sig) = interrupt::received()
+        {
+            return Ok(Stop::Interrupted(sig));
         }
         // Timing every step would cost two clock reads per ~0.2 µs step: sample one in 16.
         let timed = k % 16 == 0;

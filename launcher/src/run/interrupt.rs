@@ -6,7 +6,12 @@ use std::sync::atomic::{AtomicI32, Ordering};
 static SIGNAL: AtomicI32 = AtomicI32::new(0);
 
 extern "C" fn on_signal(sig: libc::c_int) {
-    SIGNAL.store(sig, Ordering::SeqCst);
+    // A second signal means the clean stop is not wanted (or is stuck): leave at once. The
+    // components die with the launcher, and the next run removes what this one left.
+    if SIGNAL.swap(sig, Ordering::SeqCst) != 0 {
+        // SAFETY: _exit is async-signal-safe.
+        unsafe { libc::_exit(130) };
+    }
 }
 
 /// Installs the handlers (idempotent).
@@ -16,6 +21,8 @@ pub fn install() {
         unsafe {
             let mut action: libc::sigaction = std::mem::zeroed();
             action.sa_sigaction = on_signal as *const () as usize;
+            // Restart interrupted reads (the component stderr collectors) instead of failing them.
+            action.sa_flags = libc::SA_RESTART;
             libc::sigemptyset(&mut action.sa_mask);
             libc::sigaction(sig, &action, std::ptr::null_mut());
         }

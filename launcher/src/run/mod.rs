@@ -108,12 +108,11 @@ fn prepare_output(out: &Path, name: &str, force: bool) -> Result<(PathBuf, PathB
 
 /// Runs a designed scenario.
 pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchError> {
-    if let Some(fb) = &plan.feedback {
-        if let Some(why) = fb.instability() {
-            if !opts.allow_unstable {
-                return Err(LaunchError::BadInput(format!("{}: controller: {why}; pass --allow-unstable to run it anyway", s.path.display())));
-            }
-        }
+    if let Some(fb) = &plan.feedback
+        && let Some(why) = fb.instability()
+        && !opts.allow_unstable
+    {
+        return Err(LaunchError::BadInput(format!("{}: controller: {why}; pass --allow-unstable to run it anyway", s.path.display())));
     }
     let (rrd, summary_path) = if opts.record { prepare_output(&opts.out, &s.name, opts.force).map(|(a, b)| (Some(a), Some(b)))? } else { (None, None) };
     // The recording is written under a temporary name and renamed when the run ends, however it
@@ -122,24 +121,19 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
     let partial = rrd.as_ref().map(|p| p.with_extension("rrd.partial"));
     interrupt::install();
     let cfg = configs(s, plan);
-    let mut session = Session::new(s, plan, cfg.layout, partial.as_deref())?;
+    let mut session = Session::new(s, cfg.layout, partial.as_deref())?;
     let start = Instant::now();
     let stop = match opts.mode {
         Mode::InProcess => in_process::run(&cfg, &mut session),
         Mode::Processes => processes::run(&cfg, &mut session, opts.wait, opts.pin),
     };
     let wall = start.elapsed().as_secs_f64();
+    // An error once the recording has started ends the run like a failed component: the
+    // recording is closed and a summary says why, so the outputs stay consistent.
     let stop = match stop {
         Ok(stop) => stop,
-        Err(e) => {
-            // Close what was recorded so far before reporting.
-            if session.finish().is_ok() {
-                if let (Some(from), Some(to)) = (&partial, &rrd) {
-                    let _ = fs::rename(from, to);
-                }
-            }
-            return Err(e);
-        }
+        Err(LaunchError::Interrupted(_)) => Stop::Interrupted(interrupt::received().unwrap_or("SIGINT")),
+        Err(e) => Stop::Failed(e.to_string()),
     };
     let (metrics, latency) = session.finish()?;
     if let (Some(from), Some(to)) = (&partial, &rrd) {

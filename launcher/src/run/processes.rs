@@ -24,8 +24,9 @@ use crate::record::StepRow;
 
 /// How long components may take to report ready.
 const READY_TIMEOUT: Duration = Duration::from_secs(20);
-/// How long the run may make no progress before it is declared stuck.
-const STALL_TIMEOUT: Duration = Duration::from_secs(10);
+/// How long the run may make no progress before it is declared stuck: shorter than a
+/// component's own inlet timeout (10 s), so the launcher names the stall first.
+const STALL_TIMEOUT: Duration = Duration::from_secs(5);
 /// Sleep between drains. The launcher shares the cores with the lockstep ring, and every
 /// wake-up takes a core from it for a moment: drain rarely, in large batches. At the fastest
 /// step rate measured (~250k steps/s) 5 ms is ~1300 samples, well inside the recorder's buffer.
@@ -106,13 +107,15 @@ fn allowed_cpus() -> Vec<usize> {
     }
 }
 
-/// Restricts process `pid` to one CPU (best effort: a refusal leaves it where it is).
-fn pin_to(pid: u32, cpu: usize) {
-    // SAFETY: the set is initialised before use; sched_setaffinity only reads it.
+/// Restricts the calling process to one CPU (best effort: a refusal leaves it where it is).
+/// Called in the child between fork and exec, so the component starts where it will run.
+fn pin_self(cpu: usize) {
+    // SAFETY: the set is initialised before use; sched_setaffinity is a plain system call
+    // (async-signal-safe) and only reads it.
     unsafe {
         let mut set: libc::cpu_set_t = std::mem::zeroed();
         libc::CPU_SET(cpu, &mut set);
-        libc::sched_setaffinity(pid as i32, std::mem::size_of::<libc::cpu_set_t>(), &set);
+        libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &set);
     }
 }
 
@@ -122,7 +125,8 @@ fn pin_to(pid: u32, cpu: usize) {
 /// its observers) — is placed; followers sleep between batches and float. With a CPU per ring
 /// process each gets its own. With two, the plant gets one to itself and the rest of the ring
 /// shares the other: only one process switch then lies on each step's critical path (a switch
-/// between processes costs ~2.5 µs on the 2-vCPU machines this was measured on).
+/// between processes costs ~2.5 µs on the 2-vCPU machines this was measured on). In between,
+/// the plant keeps the first CPU and the rest of the ring takes the others in turn.
 fn placement(cfg: &Configs, pin: bool) -> (Option<usize>, Vec<Option<usize>>, Option<usize>) {
     let cpus = allowed_cpus();
     let nobs = cfg.observers.len();
@@ -133,7 +137,7 @@ fn placement(cfg: &Configs, pin: bool) -> (Option<usize>, Vec<Option<usize>>, Op
     let ring = 1 + ring_observers.iter().filter(|&&r| r).count() + usize::from(cfg.controller.is_some());
     let mut next = 1;
     let mut cpu_for = |_: ()| {
-        let c = if cpus.len() >= ring { cpus[next.min(cpus.len() - 1)] } else { cpus[1] };
+        let c = if cpus.len() >= ring { cpus[next] } else { cpus[1 + (next - 1) % (cpus.len() - 1)] };
         next += 1;
         Some(c)
     };
@@ -150,10 +154,16 @@ fn spawn(kind: &str, label: String, name: &str, space: &RunSpace, wait: Wait, cp
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .process_group(0);
-    let mut child = cmd.spawn().map_err(|e| LaunchError::Component(format!("cannot start {label}: {e}")))?;
     if let Some(cpu) = cpu {
-        pin_to(child.id(), cpu);
+        // SAFETY: the closure makes one async-signal-safe system call and allocates nothing.
+        unsafe {
+            cmd.pre_exec(move || {
+                pin_self(cpu);
+                Ok(())
+            });
+        }
     }
+    let mut child = cmd.spawn().map_err(|e| LaunchError::Component(format!("cannot start {label}: {e}")))?;
     let out = child.stdout.take().expect("piped");
     let tx = tx.clone();
     std::thread::spawn(move || {
@@ -202,27 +212,34 @@ impl Assembly {
                 return Ok(done);
             }
             let k = self.next;
-            let check = |h: &Header, topic: &str| {
-                if h.step == k { Ok(()) } else { Err(LaunchError::Component(format!("lockstep broken on {topic}: expected step {k}, got {}", h.step))) }
+            // The step and the number of values must be what this run's layout says.
+            let check = |h: &Header, s: &Sample, len: usize, topic: &str| {
+                if h.step != k {
+                    Err(LaunchError::Component(format!("lockstep broken on {topic}: expected step {k}, got {}", h.step)))
+                } else if s.len as usize != len {
+                    Err(LaunchError::Component(format!("{topic} sent {} values at step {k}, expected {len}", s.len)))
+                } else {
+                    Ok(())
+                }
             };
             let (ph, ps) = self.plant.pop_front().expect("non-empty");
-            check(&ph, "plant")?;
+            let len = row.plant.len();
+            check(&ph, &ps, len, "plant")?;
             row.k = k;
             row.t = ps.sim_time;
-            let len = row.plant.len();
             row.plant.copy_from_slice(&ps.values[..len]);
             row.plant_hdr = ph;
             for (i, q) in self.observers.iter_mut().enumerate() {
                 let (h, s) = q.pop_front().expect("non-empty");
-                check(&h, "observer")?;
                 let n = row.xhat[i].len();
+                check(&h, &s, n, "observer")?;
                 row.xhat[i].copy_from_slice(&s.values[..n]);
                 row.xhat_hdr[i] = h;
             }
             if let Some(q) = &mut self.controller {
                 let (h, s) = q.pop_front().expect("non-empty");
-                check(&h, "controller")?;
                 let l = row.u.len();
+                check(&h, &s, l, "controller")?;
                 row.u.copy_from_slice(&s.values[..l]);
                 row.u_hdr = h;
             }
@@ -235,6 +252,27 @@ impl Assembly {
 
 fn drain(reader: &Reader, q: &mut VecDeque<(Header, Sample)>) -> Result<usize, LaunchError> {
     reader.drain(|s| q.push_back((header(s), *s))).map_err(|e| LaunchError::Component(e.to_string()))
+}
+
+/// The launcher's recording subscribers, one per topic.
+struct Readers<'a> {
+    plant: &'a Reader,
+    observers: &'a [Reader],
+    controller: Option<&'a Reader>,
+}
+
+impl Readers<'_> {
+    /// Moves every pending sample into its queue; returns how many there were.
+    fn drain_all(&self, asm: &mut Assembly) -> Result<usize, LaunchError> {
+        let mut got = drain(self.plant, &mut asm.plant)?;
+        for (r, q) in self.observers.iter().zip(asm.observers.iter_mut()) {
+            got += drain(r, q)?;
+        }
+        if let (Some(r), Some(q)) = (self.controller, asm.controller.as_mut()) {
+            got += drain(r, q)?;
+        }
+        Ok(got)
+    }
 }
 
 /// Runs the scenario across processes.
@@ -277,7 +315,8 @@ fn run_in(space: &RunSpace, cfg: &Configs, session: &mut Session, wait: Wait, pi
             procs.push(spawn("controller", "controller".into(), "controller", space, wait, controller_cpu, &tx, i)?);
         }
         handshake(&mut procs, &rx)?;
-        supervise(cfg, session, &mut procs, &plant_reader, &observer_readers, controller_reader.as_ref())
+        let readers = Readers { plant: &plant_reader, observers: &observer_readers, controller: controller_reader.as_ref() };
+        supervise(cfg, session, &mut procs, &readers)
     })();
     stop_all(&mut procs);
     drop((plant_reader, observer_readers, controller_reader, bus));
@@ -293,13 +332,13 @@ fn handshake(procs: &mut [Proc], rx: &mpsc::Receiver<(usize, String)>) -> Result
             return Err(LaunchError::Interrupted(format!("{sig} received while the components started")));
         }
         for p in procs.iter_mut() {
-            if p.status.is_none() {
-                if let Ok(Some(st)) = p.child.try_wait() {
-                    p.status = Some(st);
-                    // Give its stderr reader a moment to collect the message.
-                    std::thread::sleep(Duration::from_millis(20));
-                    return Err(LaunchError::Component(format!("{} before the run began", p.describe_exit())));
-                }
+            if p.status.is_none()
+                && let Ok(Some(st)) = p.child.try_wait()
+            {
+                p.status = Some(st);
+                // Give its stderr reader a moment to collect the message.
+                std::thread::sleep(Duration::from_millis(20));
+                return Err(LaunchError::Component(format!("{} before the run began", p.describe_exit())));
             }
         }
         match rx.recv_timeout(Duration::from_millis(20)) {
@@ -319,31 +358,18 @@ fn handshake(procs: &mut [Proc], rx: &mpsc::Receiver<(usize, String)>) -> Result
     Ok(())
 }
 
-fn supervise(
-    cfg: &Configs,
-    session: &mut Session,
-    procs: &mut [Proc],
-    plant: &Reader,
-    observers: &[Reader],
-    controller: Option<&Reader>,
-) -> Result<Stop, LaunchError> {
+fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: &Readers) -> Result<Stop, LaunchError> {
     let steps = cfg.plant.plant.steps;
     let mut asm = Assembly {
         plant: VecDeque::new(),
-        observers: observers.iter().map(|_| VecDeque::new()).collect(),
-        controller: controller.map(|_| VecDeque::new()),
+        observers: readers.observers.iter().map(|_| VecDeque::new()).collect(),
+        controller: readers.controller.map(|_| VecDeque::new()),
         next: 0,
     };
-    let mut row = StepRow::new(cfg.layout, observers.len(), controller.is_some());
+    let mut row = StepRow::new(cfg.layout, readers.observers.len(), readers.controller.is_some());
     let mut last_progress = Instant::now();
     loop {
-        let mut got = drain(plant, &mut asm.plant)?;
-        for (r, q) in observers.iter().zip(asm.observers.iter_mut()) {
-            got += drain(r, q)?;
-        }
-        if let (Some(r), Some(q)) = (controller, asm.controller.as_mut()) {
-            got += drain(r, q)?;
-        }
+        let got = readers.drain_all(&mut asm)?;
         if asm.assemble(&mut row, session)? > 0 {
             last_progress = Instant::now();
         }
@@ -365,13 +391,7 @@ fn supervise(
             }
             // Collect what it published before it went, then stop the others.
             std::thread::sleep(Duration::from_millis(20));
-            let _ = drain(plant, &mut asm.plant);
-            for (r, q) in observers.iter().zip(asm.observers.iter_mut()) {
-                let _ = drain(r, q);
-            }
-            if let (Some(r), Some(q)) = (controller, asm.controller.as_mut()) {
-                let _ = drain(r, q);
-            }
+            let _ = readers.drain_all(&mut asm);
             asm.assemble(&mut row, session)?;
             stop_all(procs);
             let what = procs[i].describe_exit();

@@ -5,7 +5,6 @@ use std::path::Path;
 use lockstep::PlantLayout;
 
 use crate::error::LaunchError;
-use crate::plan::Plan;
 use crate::record::{blueprint, Latency, Metrics, RrdSink, SeriesId, StepRow};
 use crate::scenario::Scenario;
 
@@ -68,7 +67,7 @@ pub fn hop_entity(hop: &str) -> String {
 
 impl Session {
     /// Starts a session; with `rrd`, opens the recording there.
-    pub fn new(s: &Scenario, plan: &Plan, layout: PlantLayout, rrd: Option<&Path>) -> Result<Self, LaunchError> {
+    pub fn new(s: &Scenario, layout: PlantLayout, rrd: Option<&Path>) -> Result<Self, LaunchError> {
         let controller_observer = s.controller.as_ref().and_then(|c| s.observers.iter().position(|o| o.name == c.observer));
         let hops = hop_names(s);
         let sink = match rrd {
@@ -107,7 +106,6 @@ impl Session {
             }
             None => None,
         };
-        let _ = plan;
         Ok(Session {
             layout,
             metrics: Metrics::new(layout, s.model.c.clone(), s.observers.len(), s.steps),

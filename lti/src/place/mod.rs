@@ -148,7 +148,7 @@ fn place_pair(
     };
     let achieved = eigenvalues(&(a - b * &gain))?;
     let error = match_error(values, &achieved);
-    if !(error <= PLACEMENT_RTOL) {
+    if error.is_nan() || error > PLACEMENT_RTOL {
         return Err(LtiError::PlacementMissed {
             requested: format_list(values),
             achieved: format_list(&achieved),

@@ -170,7 +170,7 @@ fn real_pair(es: &Eigenstructure, x: &mut DMatrix<C64>, i: usize, j: usize) {
 fn complex_pair(es: &Eigenstructure, x: &mut DMatrix<C64>, i: usize) {
     let (a, b) = complement(x, i, i + 1);
     let s2 = C64::new(2f64.sqrt(), 0.0);
-    let u: DVector<C64> = a.zip_map(&b, |p, q| C64::new(p, q)) * s2;
+    let u: DVector<C64> = a.zip_map(&b, C64::new) * s2;
     let s = &es.s[i];
     let m = s.adjoint() * (&u * u.adjoint() - u.map(|e| e.conj()) * u.transpose()) * s;
     // M is Hermitian: real eigenvalues; order them by modulus.

@@ -65,11 +65,11 @@ struct Core {
     fixed: Vec<C64>,
 }
 
-/// Free poles when none are given: each real, at least twice as fast as the slowest fixed mode,
-/// faster than the decay rate, and no slower than −1.
+/// Free poles when none are given (continuous): real, twice as fast as the fastest fixed mode so
+/// that the fixed modes set the error's decay, faster than the decay rate, and no slower than −1.
 fn default_poles(count: usize, fixed: &[C64], decay: f64) -> Poles {
-    let slowest = fixed.iter().map(|z| z.re.abs()).fold(0.0, f64::max);
-    let base = (2.0 * slowest).max(decay).max(1.0);
+    let fastest = fixed.iter().map(|z| z.re.abs()).fold(0.0, f64::max);
+    let base = (2.0 * fastest).max(decay).max(1.0);
     Poles::new((0..count).map(|i| PoleSpec::Real(-base * (1.0 + 0.1 * i as f64)))).expect("finite")
 }
 
@@ -79,7 +79,6 @@ fn core(
     c: &Mat,
     b2: &Mat,
     d: &Mat,
-    decay: f64,
     poles: Option<&Poles>,
     method: Method,
     lmi_l: Option<&Mat>,
@@ -102,17 +101,13 @@ fn core(
         if fixed.is_empty() { "none".into() } else if unstable.is_empty() { format_list(&fixed) } else { format!("unstable zero(s) {}", format_list(&unstable)) },
     )?;
     let nc = &dec.n * c;
-    let l = match lmi_l {
-        Some(l) => l.clone(),
-        None => {
-            let free = dec.staircase.no;
-            let continuous_poles = match poles {
-                Some(p) => p.clone(),
-                None => default_poles(free, &fixed, decay),
-            };
-            let (lt, _) = place_detectable(checks, &dec.a1, &nc, &domain.poles(&continuous_poles), method, "(A1, NC)", domain)?;
+    let l = match (lmi_l, poles) {
+        (Some(l), _) => l.clone(),
+        (None, Some(p)) => {
+            let (lt, _) = place_detectable(checks, &dec.a1, &nc, &domain.poles(p), method, "(A1, NC)", domain)?;
             lt * &dec.n
         }
+        (None, None) => return Err(checks.error("poles", "no free poles given (a design bug: the caller supplies the default)")),
     };
     let res_ld = (&l * d).amax();
     checks.require("LD = 0", res_ld <= 1e-9 * l.amax().max(1.0), format!("max |LD| = {res_ld:.1e}"))?;
@@ -161,7 +156,19 @@ pub(super) fn design(model: &Model, decay: f64, poles: Option<&Poles>, method: M
         Path::Lmi => Some(solve_lmi(model, decay, &mut checks)?),
     };
     let lmi_l = lmi.as_ref().map(|s| s.p.clone().lu().solve(&s.y).expect("P ≻ 0 is invertible"));
-    let ct = core(&model.a, &model.c, b2, d, decay, poles, method, lmi_l.as_ref(), Domain::Continuous, &mut checks)?;
+    // Without given poles the free ones default from the continuous fixed modes, once, and the
+    // sampled design then places their images e^{p·dt}.
+    let free_default;
+    let poles = match poles {
+        Some(p) => Some(p),
+        None if lmi.is_none() => {
+            let dec = decoupling(&model.a, b2, &model.c, d).map_err(|e| checks.error("decoupling", e.to_string()))?;
+            free_default = default_poles(dec.staircase.no, &dec.zeros, decay);
+            Some(&free_default)
+        }
+        None => None,
+    };
+    let ct = core(&model.a, &model.c, b2, d, poles, method, lmi_l.as_ref(), Domain::Continuous, &mut checks)?;
     let poles_c = eig(&ct.acl);
     let slowest = poles_c.iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
     checks.require(
@@ -195,7 +202,7 @@ pub(super) fn design(model: &Model, decay: f64, poles: Option<&Poles>, method: M
         }
         (None, p) => p.cloned(),
     };
-    let d_core = core(&dm.a, &dm.c, &dm.e, d, decay, free_poles.as_ref(), method, None, Domain::Discrete(dt), &mut sampled)?;
+    let d_core = core(&dm.a, &dm.c, &dm.e, d, free_poles.as_ref(), method, None, Domain::Discrete(dt), &mut sampled)?;
     let (rho, worst_d) = discrete_certificate(&d_core.acl, decay, dt).map_err(|e| sampled.error("Lyapunov certificate", e))?;
     notes.push(format!("sampled decay certificate: ρ = e^(−α·dt/2) = {}, λmax(AᵀPA − ρ²P) = {}", sig(rho), sig(worst_d)));
     let n = model.n();

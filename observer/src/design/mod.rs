@@ -178,11 +178,6 @@ impl Checks {
         DesignError { kind: self.kind, condition, detail: detail.into(), conditions: self.list.clone() }
     }
 
-    /// The last recorded condition (to record an informative verdict that does not stop the design).
-    pub(crate) fn list_last_mut(&mut self) -> &mut Condition {
-        self.list.last_mut().expect("a condition was recorded")
-    }
-
     pub(crate) fn into_list(self) -> Vec<Condition> {
         self.list
     }
