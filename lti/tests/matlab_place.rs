@@ -1,9 +1,10 @@
 //! The MATLAB-compatible placement reproduces the gains the seed papers print, which MATLAB's
 //! `place` produced (reference values: fixtures/seed-models.json, computed independently).
 
+#[path = "../../fixtures/reader.rs"]
 mod common;
 
-use common::{load, mat, max_diff};
+use common::{mat, max_diff, seeds};
 use lti::pinv::pinv;
 use lti::place::{place_observer, Method};
 use lti::{Mat, PoleSpec, Poles};
@@ -14,7 +15,7 @@ fn real_poles(v: &[f64]) -> Poles {
 
 #[test]
 fn seed002_k1_is_matlabs() {
-    let s = &load("../fixtures/seed-models.json")["seed_002"];
+    let s = &seeds()["seed_002"];
     let (a, c, e) = (mat(&s["model"]["A"]), mat(&s["model"]["C"]), mat(&s["model"]["E"]));
     let h = &e * pinv(&(&c * &e));
     let ta = (Mat::identity(3, 3) - &h * &c) * &a;
@@ -29,7 +30,7 @@ fn seed002_k1_is_matlabs() {
 
 #[test]
 fn seed001_k_is_matlabs() {
-    let s = &load("../fixtures/seed-models.json")["seed_001"];
+    let s = &seeds()["seed_001"];
     let (a, c) = (mat(&s["model"]["A"]), mat(&s["model"]["C"]));
     let ca = &c * &a;
     let k = place_observer(&a, &ca, &real_poles(&[-47.0, -52.0, -600.0, -700.0]), Method::Matlab).unwrap();

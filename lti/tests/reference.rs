@@ -1,6 +1,7 @@
 //! The math core against independent numpy/scipy values
 //! (tests/fixtures/reference.json, made by scripts/fixtures/make_reference.py).
 
+#[path = "../../fixtures/reader.rs"]
 mod common;
 
 use common::{complex_list, load, mat, max_diff};

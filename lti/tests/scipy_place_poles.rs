@@ -2,6 +2,7 @@
 //! and the function's docstring): every case must be placed, checked by achieved eigenvalues.
 //! Fixture: tests/fixtures/scipy_place_poles.json (scripts/fixtures/scipy_place_poles.py).
 
+#[path = "../../fixtures/reader.rs"]
 mod common;
 
 use common::{complex_list, load, mat, max_diff};

@@ -6,15 +6,9 @@ use lti::{Mat, Model, PoleSpec, Poles, C64};
 use observer::design::{design, Path, Spec};
 use serde_json::Value;
 
-fn seeds() -> Value {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../fixtures/seed-models.json");
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
-}
-
-fn mat(v: &Value) -> Mat {
-    let rows: Vec<Vec<f64>> = serde_json::from_value(v.clone()).unwrap();
-    Mat::from_fn(rows.len(), rows[0].len(), |i, j| rows[i][j])
-}
+#[path = "../../fixtures/reader.rs"]
+mod reader;
+use reader::{mat, seeds};
 
 fn real(v: &[f64]) -> Poles {
     Poles::new(v.iter().map(|&x| PoleSpec::Real(x))).unwrap()

@@ -5,14 +5,16 @@ use lti::signal::Signal;
 use lti::{Mat, MatData};
 use plant::{Plant, PlantConfig};
 
+#[path = "../../fixtures/reader.rs"]
+mod reader;
+
 fn md(rows: usize, cols: usize, v: &[f64]) -> MatData {
     (&Mat::from_row_slice(rows, cols, v)).into()
 }
 
 #[test]
 fn sinusoidal_disturbance_matches_scipy() {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../lti/tests/fixtures/reference.json");
-    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let r = reader::load("../lti/tests/fixtures/reference.json");
     let r = &r["sine_step"];
     let cfg = PlantConfig {
         a: md(3, 3, &[0.0, 1.0, 0.0, -2.0, -3.0, 0.0, 0.0, 0.0, -2.0]),

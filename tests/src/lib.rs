@@ -17,9 +17,11 @@ pub fn bin_dir() -> PathBuf {
     dir
 }
 
-/// The repository root.
+/// The repository root. `cargo test` sets `CARGO_MANIFEST_DIR` at run time too; preferring it
+/// keeps a test binary built in another checkout (a shared target directory) on this one.
 pub fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("workspace root").to_path_buf()
+    let dir = std::env::var_os("CARGO_MANIFEST_DIR").map_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")), PathBuf::from);
+    dir.parent().expect("workspace root").to_path_buf()
 }
 
 /// A shipped scenario.
