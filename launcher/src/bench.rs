@@ -8,9 +8,9 @@ use serde::Serialize;
 
 use crate::error::LaunchError;
 use crate::plan::plan;
-use crate::record::Percentiles;
+use recording::write::Percentiles;
 use crate::run::{run, Mode, Options, Stop};
-use crate::scenario::Scenario;
+use scenario::Scenario;
 
 /// One benchmark run.
 #[derive(Debug, Clone, Serialize)]
@@ -38,7 +38,7 @@ pub fn bench(scenario: &Path, steps: u64, wait: Wait, pin: bool, modes: &[Mode],
     let mut out = Vec::new();
     for &mode in modes {
         for &record in recording {
-            let opts = Options { out: tmp.clone(), mode, wait, force: true, allow_unstable: false, record, pin };
+            let opts = Options { out: tmp.clone(), mode, wait, force: true, allow_unstable: false, record, pin, select: Default::default() };
             let o = run(&s, &p, &opts)?;
             if o.stop != Stop::Completed {
                 return Err(LaunchError::Component(format!("benchmark run stopped: {:?}", o.stop)));

@@ -10,7 +10,7 @@ use serde::Serialize;
 use serde_json::{json, Value};
 
 use crate::plan::plan;
-use crate::scenario::Scenario;
+use scenario::Scenario;
 
 /// The report, in both renderings.
 pub struct DesignReport {
@@ -82,6 +82,7 @@ pub fn report(s: &Scenario) -> DesignReport {
                     "poles": lti::re_im(&r.poles),
                     "discrete_poles": lti::re_im(&r.discrete_poles),
                     "fixed_modes": lti::re_im(&r.fixed_modes),
+                    "sampled": sampled_json(&d.runtime, s.dt),
                 }));
             }
             Err(e) => {
@@ -142,4 +143,15 @@ pub fn report(s: &Scenario) -> DesignReport {
         "warnings": warnings,
     });
     DesignReport { json, text, ok }
+}
+
+/// The sampled observer that actually runs, z_{k+1} = F z_k + G u_k + K y_k, x̂_k = P z_k + Q y_k
+/// (z_0 = 0), so that a user can check or reuse exactly what the observer process computes.
+fn sampled_json(o: &observer::LinearObserver, dt: f64) -> Value {
+    let m = |d: &lti::MatData| rows(&Mat::from(d));
+    json!({
+        "form": "z[k+1] = F z[k] + G u[k] + K y[k], xhat[k] = P z[k] + Q y[k], z[0] = 0",
+        "dt": dt,
+        "F": m(&o.f), "G": m(&o.g), "K": m(&o.k), "P": m(&o.p), "Q": m(&o.q),
+    })
 }

@@ -2,7 +2,7 @@
 
 use thiserror::Error;
 
-use crate::scenario::ScenarioError;
+use scenario::ScenarioError;
 
 /// Exit code: bad input (scenario, unmet condition, refused unstable loop, output in the way).
 pub const EXIT_BAD_INPUT: i32 = 2;
@@ -12,7 +12,9 @@ pub const EXIT_COMPONENT: i32 = 3;
 pub const EXIT_DIVERGED: i32 = 4;
 /// Exit code: the run finished but missed its `[expect]` table.
 pub const EXIT_EXPECT: i32 = 5;
-/// Exit code: interrupted by SIGINT or SIGTERM.
+/// Exit code: a recording read back does not match the digest written with it.
+pub const EXIT_DAMAGED: i32 = 6;
+/// Exit code: interrupted by SIGINT or SIGTERM (SIGHUP gives 129, SIGQUIT 131).
 pub const EXIT_INTERRUPTED: i32 = 130;
 
 /// Why the launcher stopped.
@@ -33,7 +35,10 @@ pub enum LaunchError {
     /// The run missed its expectations.
     #[error("{0}")]
     Expect(String),
-    /// SIGINT or SIGTERM.
+    /// A recording is damaged.
+    #[error("{0}")]
+    Damaged(String),
+    /// SIGINT, SIGTERM, SIGHUP or SIGQUIT.
     #[error("{0}")]
     Interrupted(String),
 }
@@ -46,7 +51,8 @@ impl LaunchError {
             LaunchError::Component(_) => EXIT_COMPONENT,
             LaunchError::Diverged(_) => EXIT_DIVERGED,
             LaunchError::Expect(_) => EXIT_EXPECT,
-            LaunchError::Interrupted(_) => EXIT_INTERRUPTED,
+            LaunchError::Damaged(_) => EXIT_DAMAGED,
+            LaunchError::Interrupted(_) => crate::run::interrupt::exit_code(),
         }
     }
 }

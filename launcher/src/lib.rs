@@ -5,17 +5,11 @@
 pub mod bench;
 pub mod design_report;
 pub mod error;
-pub mod export;
-pub mod compare;
-pub mod inspect;
-pub mod plot;
+pub mod output;
 pub mod plan;
-pub mod record;
-pub mod recording;
 pub mod run;
-pub mod scenario;
+pub mod shipped;
 pub mod summary;
-pub mod tools;
 
 pub use error::LaunchError;
 pub use scenario::Scenario;

@@ -5,8 +5,12 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use launcher::error::{LaunchError, EXIT_BAD_INPUT, EXIT_EXPECT};
+// Printing that neither panics on a closed stdout nor passes control characters through.
+use launcher::{eprintln, print, println};
+use launcher::shipped;
 use launcher::run::{Mode, Options, Stop};
-use launcher::{design_report, plan, run, Scenario};
+use launcher::{design_report, plan, run};
+use scenario::Scenario;
 use lockstep::Wait;
 
 #[derive(Parser)]
@@ -20,7 +24,7 @@ struct Cli {
 enum Command {
     /// Run a scenario and record it to DIR/<name>.rrd and DIR/<name>.summary.json.
     Run {
-        /// The scenario file.
+        /// The scenario file, or the name of a shipped scenario (see `list`).
         scenario: PathBuf,
         /// Output directory.
         #[arg(long, default_value = "runs")]
@@ -41,10 +45,17 @@ enum Command {
         /// Place the lockstep ring's processes on CPUs (auto) or leave it to the scheduler (off).
         #[arg(long, value_parser = ["auto", "off"], default_value = "auto")]
         pin: String,
+        /// Record only every N-th step (steps 0, N, 2N, …); the summary still sees every step.
+        #[arg(long, value_name = "N", default_value_t = 1)]
+        record_every: u64,
+        /// Record only the entities matching this glob, e.g. '/observer/uio/**' (`*` within a
+        /// path segment, `**` across segments); repeat for several.
+        #[arg(long = "record", value_name = "GLOB")]
+        record: Vec<String>,
     },
     /// Check the existence conditions and show the designs of a scenario.
     Design {
-        /// The scenario file.
+        /// The scenario file, or the name of a shipped scenario (see `list`).
         scenario: PathBuf,
         /// Print JSON instead of text.
         #[arg(long)]
@@ -106,6 +117,16 @@ enum Command {
         /// Output directory.
         #[arg(long)]
         out: PathBuf,
+        /// Only entities matching this glob, e.g. '/observer/uio/**' (`*` within a path
+        /// segment, `**` across segments); repeat for several.
+        #[arg(long = "signals", value_name = "GLOB")]
+        signals: Vec<String>,
+        /// Start of the time window, s (steps for a recording without its scenario).
+        #[arg(long, value_name = "T", allow_negative_numbers = true)]
+        from: Option<f64>,
+        /// End of the time window, s.
+        #[arg(long, value_name = "T", allow_negative_numbers = true)]
+        to: Option<f64>,
     },
     /// Export a recording's signals as CSV, one file per entity group.
     Export {
@@ -126,34 +147,35 @@ enum Command {
     },
 }
 
-/// The shipped scenarios: ./scenarios, else the repository's.
-fn scenarios_dir() -> PathBuf {
-    let local = PathBuf::from("scenarios");
-    if local.is_dir() { local } else { Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios") }
-}
-
 fn fail(e: &LaunchError) -> ExitCode {
     eprintln!("error: {e}");
     ExitCode::from(e.exit_code() as u8)
 }
 
-fn load(path: &Path) -> Result<Scenario, LaunchError> {
-    Ok(Scenario::load(path)?)
+/// Loads the scenario a command-line argument names (a path, or a shipped scenario's name).
+fn load(arg: &Path) -> Result<Scenario, LaunchError> {
+    Ok(Scenario::load(&shipped::resolve(arg)?)?)
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let command = cli.command.unwrap_or_else(|| Command::Run {
-        scenario: scenarios_dir().join("seed002-sine.toml"),
+        scenario: shipped::dir().join("seed002-sine.toml"),
         out: "runs".into(),
         mode: "processes".into(),
         wait: None,
         force: true,
         allow_unstable: false,
         pin: "auto".into(),
+        record_every: 1,
+        record: Vec::new(),
     });
     match command {
-        Command::Run { scenario, out, mode, wait, force, allow_unstable, pin } => {
+        Command::Run { scenario, out, mode, wait, force, allow_unstable, pin, record_every, record } => {
+            let select = match recording::write::Selection::new(record_every, &record) {
+                Ok(x) => x,
+                Err(e) => return fail(&LaunchError::BadInput(e)),
+            };
             let s = match load(&scenario) {
                 Ok(s) => s,
                 Err(e) => return fail(&e),
@@ -166,7 +188,7 @@ fn main() -> ExitCode {
                 eprintln!("warning: {w}");
             }
             let mode = if mode == "in-process" { Mode::InProcess } else { Mode::Processes };
-            let opts = Options { out, mode, wait: wait.unwrap_or_else(Wait::default_for_machine), force, allow_unstable, record: true, pin: pin == "auto" };
+            let opts = Options { out, mode, wait: wait.unwrap_or_else(Wait::default_for_machine), force, allow_unstable, record: true, pin: pin == "auto", select };
             match run::run(&s, &p, &opts) {
                 Ok(o) => {
                     print!("{}", o.summary.table());
@@ -212,7 +234,7 @@ fn main() -> ExitCode {
                 Some(_) => vec![false],
                 None => vec![false, true],
             };
-            match launcher::bench::bench(&scenarios_dir().join("seed002-sine.toml"), steps, wait, pin == "auto", &modes, &rec) {
+            match launcher::bench::bench(&shipped::dir().join("seed002-sine.toml"), steps, wait, pin == "auto", &modes, &rec) {
                 Ok(runs) => {
                     if json {
                         println!("{}", serde_json::to_string_pretty(&serde_json::json!({ "runs": runs })).expect("serialises"));
@@ -224,21 +246,18 @@ fn main() -> ExitCode {
                 Err(e) => fail(&e),
             }
         }
-        Command::List { dir } => {
-            let dir = dir.unwrap_or_else(scenarios_dir);
-            let mut files: Vec<PathBuf> = std::fs::read_dir(&dir).map(|d| d.flatten().map(|e| e.path()).filter(|p| p.extension().is_some_and(|x| x == "toml")).collect()).unwrap_or_default();
-            files.sort();
-            for f in files {
-                match Scenario::load(&f) {
-                    Ok(s) => println!("{:<34} {}", s.name, s.description),
-                    Err(e) => println!("{:<34} (invalid: {e})", f.display()),
+        Command::List { dir } => match shipped::list(&dir.unwrap_or_else(shipped::dir)) {
+            Ok(entries) => {
+                for e in &entries {
+                    println!("{}", e.line());
                 }
+                ExitCode::SUCCESS
             }
-            ExitCode::SUCCESS
-        }
+            Err(e) => fail(&e),
+        },
         Command::Inspect { recording, json } => match read_recording(&recording) {
             Ok(r) => {
-                let i = launcher::inspect::inspect(&recording.display().to_string(), &r);
+                let i = recording::inspect::inspect(&recording.display().to_string(), &r);
                 if json {
                     println!("{}", serde_json::to_string_pretty(&i).expect("serialises"));
                 } else {
@@ -261,7 +280,7 @@ fn main() -> ExitCode {
                     eprintln!("warning: {}: incomplete recording", p.display());
                 }
             }
-            match launcher::compare::compare(&ra, &rb, abs_tol, rel_tol) {
+            match recording::compare::compare(&ra, &rb, abs_tol, rel_tol) {
                 Ok(n) => {
                     println!("same: {n} values of {} signals{}", ra.series.keys().filter(|k| !k.starts_with("/latency")).count(), if abs_tol.is_none() && rel_tol.is_none() { ", bit for bit" } else { ", within tolerance" });
                     ExitCode::SUCCESS
@@ -272,33 +291,39 @@ fn main() -> ExitCode {
                 }
             }
         }
-        Command::Plot { recording, out } => match read_recording(&recording) {
+        Command::Plot { recording, out, signals, from, to } => {
+            let selection = recording::plot::Selection { signals, from, to };
+            if let Err(e) = selection.validate() {
+                return fail(&LaunchError::BadInput(e));
+            }
+            match read_recording(&recording) {
             Ok(r) => {
                 if !r.complete {
                     eprintln!("warning: {}: incomplete recording (its writer did not finish); plotting what it holds", recording.display());
                 }
-                match launcher::plot::plot(&r, &out) {
+                match recording::plot::plot(&r, &out, &selection) {
                     Ok(files) => {
                         for f in &files {
                             println!("{}", f.display());
                         }
                         ExitCode::SUCCESS
                     }
-                    Err(e) => fail(&LaunchError::BadInput(e)),
+                    Err(e) => fail(&LaunchError::BadInput(format!("{}: {e}", recording.display()))),
                 }
             }
             Err(code) => code,
-        },
+            }
+        }
         Command::Export { recording, csv } => {
             let r = match read_recording(&recording) {
                 Ok(r) => r,
                 Err(code) => return code,
             };
-            let dt = launcher::tools::recorded_dt(&r);
+            let dt = recording::tools::recorded_dt(&r);
             if !r.complete {
                 eprintln!("warning: {}: incomplete recording (its writer did not finish); exporting what it holds", recording.display());
             }
-            match launcher::export::export(&r, &csv, dt) {
+            match recording::export::export(&r, &csv, dt) {
                 Ok(files) => {
                     println!("{} files in {}", files.len(), csv.display());
                     ExitCode::SUCCESS
@@ -310,9 +335,19 @@ fn main() -> ExitCode {
     }
 }
 
-/// Reads a recording, or reports why not (exit code 2).
-fn read_recording(path: &Path) -> Result<launcher::recording::Recording, ExitCode> {
-    launcher::recording::read(path).map_err(|e| fail(&LaunchError::BadInput(e.to_string())))
+/// Reads a recording, or reports why not: exit code 2 when it cannot be read at all, 6 when
+/// it does not match the digest written with it (nothing is then written from it).
+fn read_recording(path: &Path) -> Result<recording::Recording, ExitCode> {
+    let r = recording::read(path).map_err(|e| fail(&LaunchError::BadInput(e.to_string())))?;
+    if let recording::Integrity::Damaged(what) = &r.integrity {
+        let why = if what.starts_with('/') || what == recording::digest::SCENARIO_KEY {
+            format!("{}: its data does not match the digest written with the recording", scenario::quoted(what))
+        } else {
+            what.clone()
+        };
+        return Err(fail(&LaunchError::Damaged(format!("{}: damaged: {why}", path.display()))));
+    }
+    Ok(r)
 }
 
 /// Runs a component's shell in this process (the fallback when its binary is not installed).

@@ -5,7 +5,7 @@ use controller::design::{design as design_feedback, FeedbackDesign, FeedbackSpec
 use lti::eig::{eigenvalues, format_list, sig, C64};
 use observer::{design, Designed};
 
-use crate::scenario::{Scenario, ScenarioError};
+use scenario::{Scenario, ScenarioError};
 
 /// The designs of a scenario.
 #[derive(Debug, Clone)]
@@ -31,7 +31,7 @@ pub struct PlanError {
 
 /// Designs every observer and the controller.
 pub fn plan(s: &Scenario) -> Result<Plan, PlanError> {
-    let locate = |field: String, reason: String| crate::scenario::locate_error(s, &field, reason);
+    let locate = |field: String, reason: String| scenario::locate_error(s, &field, reason);
     let mut observers = Vec::new();
     for (i, o) in s.observers.iter().enumerate() {
         let d = design(&s.model, &o.spec, s.dt).map_err(|e| {

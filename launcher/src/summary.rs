@@ -7,9 +7,9 @@ use lti::eig::sig;
 use serde::Serialize;
 
 use crate::plan::Plan;
-use crate::record::{Latency, Metrics, Percentiles};
+use recording::write::{Latency, Metrics, Percentiles};
 use crate::run::{Options, Stop};
-use crate::scenario::Scenario;
+use scenario::Scenario;
 
 /// One observer's line.
 #[derive(Debug, Clone, Serialize)]
@@ -18,10 +18,10 @@ pub struct ObserverSummary {
     pub name: String,
     /// Kind.
     pub kind: String,
-    /// max |x − x̂| over the last quarter of the run.
-    pub tail_max_abs_error: f64,
-    /// max |y − Cx̂| over the last quarter of the run.
-    pub tail_max_abs_residual: f64,
+    /// max |x − x̂| over the last quarter of the steps completed (null: fewer than 4 steps).
+    pub tail_max_abs_error: Option<f64>,
+    /// max |y − Cx̂| over the last quarter of the steps completed.
+    pub tail_max_abs_residual: Option<f64>,
     /// max |x − x̂| over the run.
     pub max_abs_error: f64,
     /// max |x − x̂| at the last step.
@@ -39,9 +39,10 @@ pub struct Expectation {
     pub what: String,
     /// The bound.
     pub limit: f64,
-    /// The value reached.
-    pub value: f64,
-    /// value ≤ limit.
+    /// The value reached (null when the run did not complete or the figure does not exist).
+    pub value: Option<f64>,
+    /// value ≤ limit, in a run that completed all its steps: a run that stopped early has only
+    /// part of its tail, and no expectation can hold for it.
     pub ok: bool,
 }
 
@@ -89,6 +90,10 @@ pub struct Summary {
     pub stopped: Option<String>,
     /// The recording.
     pub recording: Option<String>,
+    /// The recording's digest, entity → XXH64 (see `recording::digest`), also stored in the
+    /// recording, against which readers detect a damaged file.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub recording_digest: Option<BTreeMap<String, String>>,
 }
 
 impl Summary {
@@ -136,8 +141,9 @@ impl Summary {
             expectations: Vec::new(),
             stopped,
             recording: rrd.map(|p| p.display().to_string()),
+            recording_digest: None,
         };
-        summary.expectations = summary.check(s);
+        summary.expectations = summary.check(s, matches!(stop, Stop::Completed));
         summary
     }
 
@@ -145,19 +151,19 @@ impl Summary {
         self.observers.iter().find(|o| o.name == name)
     }
 
-    /// Checks the scenario's `[expect]` table against this run.
-    pub fn check(&self, s: &Scenario) -> Vec<Expectation> {
+    /// Checks the scenario's `[expect]` table against this run; none holds unless it `completed`.
+    pub fn check(&self, s: &Scenario, completed: bool) -> Vec<Expectation> {
         let e = &s.expect;
         let mut out = Vec::new();
         let mut add = |what: String, limit: f64, value: Option<f64>| {
-            let value = value.unwrap_or(f64::INFINITY);
-            out.push(Expectation { what, limit, value, ok: value <= limit });
+            let value = value.filter(|_| completed);
+            out.push(Expectation { what, limit, value, ok: value.is_some_and(|v| v <= limit) });
         };
         for (name, &limit) in &e.tail_max_abs_error {
-            add(format!("tail_max_abs_error.{name}"), limit, self.observer(name).map(|o| o.tail_max_abs_error));
+            add(format!("tail_max_abs_error.{name}"), limit, self.observer(name).and_then(|o| o.tail_max_abs_error));
         }
         for (name, &limit) in &e.tail_max_abs_residual {
-            add(format!("tail_max_abs_residual.{name}"), limit, self.observer(name).map(|o| o.tail_max_abs_residual));
+            add(format!("tail_max_abs_residual.{name}"), limit, self.observer(name).and_then(|o| o.tail_max_abs_residual));
         }
         for (pair, &limit) in &e.max_abs_difference {
             let (a, b) = pair.split_once('/').unwrap_or((pair, pair));
@@ -167,7 +173,7 @@ impl Summary {
         for (pair, &limit) in &e.tail_error_ratio {
             let (a, b) = pair.split_once('/').unwrap_or((pair, pair));
             let v = match (self.observer(a), self.observer(b)) {
-                (Some(x), Some(y)) => Some(x.tail_max_abs_error / y.tail_max_abs_error),
+                (Some(x), Some(y)) => x.tail_max_abs_error.zip(y.tail_max_abs_error).map(|(a, b)| a / b),
                 _ => None,
             };
             add(format!("tail_error_ratio.{pair}"), limit, v);
@@ -201,9 +207,10 @@ impl Summary {
             self.wall_s,
             sig(self.steps_per_s.round())
         );
-        t += &format!("  {:<14} {:<16} {:>14} {:>14}\n", "observer", "kind", "tail max|e|", "tail max|r|");
+        let tail = if self.steps < self.steps_planned { "tail of the steps completed" } else { "tail: last quarter" };
+        t += &format!("  {:<14} {:<16} {:>14} {:>14}   ({tail})\n", "observer", "kind", "tail max|e|", "tail max|r|");
         for o in &self.observers {
-            t += &format!("  {:<14} {:<16} {:>14.3e} {:>14.3e}\n", o.name, o.kind, o.tail_max_abs_error, o.tail_max_abs_residual);
+            t += &format!("  {:<14} {:<16} {:>14} {:>14}\n", o.name, o.kind, figure(o.tail_max_abs_error), figure(o.tail_max_abs_residual));
         }
         let p = &self.latency_ns.step;
         if p.max > 0 {
@@ -213,11 +220,20 @@ impl Summary {
             }
         }
         for e in &self.expectations {
-            t += &format!("  expect {} ≤ {:.3e}: {:.3e} {}\n", e.what, e.limit, e.value, if e.ok { "ok" } else { "MISSED" });
+            t += &match e.value {
+                Some(v) => format!("  expect {} ≤ {:.3e}: {:.3e} {}\n", e.what, e.limit, v, if e.ok { "ok" } else { "MISSED" }),
+                None if self.stopped.is_some() => format!("  expect {} ≤ {:.3e}: not checked (the run did not complete)\n", e.what, e.limit),
+                None => format!("  expect {} ≤ {:.3e}: MISSED (no such figure)\n", e.what, e.limit),
+            };
         }
         if let Some(why) = &self.stopped {
             t += &format!("  stopped: {why}\n");
         }
         t
     }
+}
+
+/// A figure for the table: "—" where there is none (a run of fewer than 4 steps has no tail).
+pub fn figure(v: Option<f64>) -> String {
+    v.map_or_else(|| "—".to_string(), |v| format!("{v:.3e}"))
 }

@@ -37,6 +37,7 @@ pub struct Bus {
 impl Bus {
     /// Joins the run's bus as `name` (a node name for diagnostics).
     pub fn join(space: &RunSpace, name: &str, wait: Wait) -> Result<Self, LockstepError> {
+        crate::quiet_iceoryx2();
         let node = NodeBuilder::new()
             .name(&NodeName::new(name).map_err(LockstepError::ipc)?)
             .config(space.config())

@@ -10,8 +10,13 @@
 //! W = 0 is the zero-order hold (w constant over the step; Γ = ∫₀ʰ e^{As} ds G); a 2×2 rotation
 //! block W = [0 ω; −ω 0] generates [sin(ωt+φ), cos(ωt+φ)], so a sinusoidal disturbance is
 //! integrated exactly rather than held.
+//!
+//! The exponential is [`crate::expm::expm`]: every entry of Φ and Γ within its final rounding of
+//! the exact value, however small beside the rest (the stiff missile's Φ has entries 10⁻⁸ … 3).
 
 use nalgebra::DMatrix;
+
+use crate::expm::expm;
 
 /// Top block row [Φ, Γ] of exp([[A, G], [0, W]]·h).
 pub fn exp_upper(a: &DMatrix<f64>, g: &DMatrix<f64>, w: &DMatrix<f64>, h: f64) -> (DMatrix<f64>, DMatrix<f64>) {
@@ -21,7 +26,7 @@ pub fn exp_upper(a: &DMatrix<f64>, g: &DMatrix<f64>, w: &DMatrix<f64>, h: f64) -
     big.view_mut((0, 0), (n, n)).copy_from(a);
     big.view_mut((0, n), (n, k)).copy_from(g);
     big.view_mut((n, n), (k, k)).copy_from(w);
-    let e = (big * h).exp();
+    let e = expm(&big, h);
     (e.view((0, 0), (n, n)).into_owned(), e.view((0, n), (n, k)).into_owned())
 }
 

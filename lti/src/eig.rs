@@ -124,10 +124,28 @@ pub fn match_error(requested: &[C64], achieved: &[C64]) -> f64 {
     worst
 }
 
-/// "−1, −2 ± 3j" style formatting of an eigenvalue list (one member per conjugate pair).
+/// Parts of an eigenvalue within this of zero, relative to the largest modulus shown (at least 1),
+/// print as 0. The Schur form gives eigenvalues to ~ε‖A‖ absolute, and ‖A‖ can exceed the
+/// largest |λ| by orders of magnitude (the missile: ‖A‖ ≈ 3·10⁴, |λ| ≤ 180), so a zero or a
+/// marginal mode comes out as ±(a few 10⁻¹⁶ … 10⁻¹³): its sign is rounding noise, and printing it
+/// ("unstable zero −2.2e-16") says more than the computation knows. 10⁻¹² ≈ 4500ε, far below the
+/// six significant digits [`sig`] shows of the largest value.
+pub const DISPLAY_ZERO: f64 = 1e-12;
+
+/// `e` with each part within `DISPLAY_ZERO · scale` of zero set to 0.
+fn snap(e: C64, scale: f64) -> C64 {
+    let tol = DISPLAY_ZERO * scale;
+    let part = |x: f64| if x.abs() <= tol { 0.0 } else { x };
+    C64::new(part(e.re), part(e.im))
+}
+
+/// "−1, −2 ± 3j" style formatting of an eigenvalue list (one member per conjugate pair); parts
+/// within [`DISPLAY_ZERO`] of zero, relative to the list's largest modulus, print as 0.
 pub fn format_list(v: &[C64]) -> String {
+    let scale = v.iter().map(|e| e.norm()).fold(1.0, f64::max);
+    let v: Vec<C64> = v.iter().map(|&e| snap(e, scale)).collect();
     let mut out = Vec::new();
-    for e in v {
+    for e in &v {
         if e.im < 0.0 && v.iter().any(|o| o.re == e.re && o.im == -e.im) {
             continue;
         }
@@ -136,8 +154,10 @@ pub fn format_list(v: &[C64]) -> String {
     out.join(", ")
 }
 
-/// One eigenvalue; with `pair`, a complex value is shown as "re ± j·|im|".
+/// One eigenvalue; with `pair`, a complex value is shown as "re ± j·|im|". Parts within
+/// [`DISPLAY_ZERO`] of zero, relative to max(1, |e|), print as 0.
 pub fn format_one(e: C64, pair: bool) -> String {
+    let e = snap(e, e.norm().max(1.0));
     if e.im == 0.0 {
         sig(e.re)
     } else if pair {
@@ -151,7 +171,10 @@ pub fn format_one(e: C64, pair: bool) -> String {
 
 /// Six significant digits, trailing zeros trimmed.
 pub fn sig(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() {
+    if x == 0.0 {
+        return "0".into(); // −0 too: a sign on zero is noise
+    }
+    if !x.is_finite() {
         return format!("{x}");
     }
     let mag = x.abs().log10().floor() as i32;
@@ -189,5 +212,22 @@ mod tests {
     fn formatting() {
         let v = [C64::new(-84.2607, -127.9594), C64::new(-84.2607, 127.9594), C64::new(-1.0, 0.0)];
         assert_eq!(format_list(&v), "-84.2607 ± j127.959, -1");
+    }
+
+    /// Issue 10 item 14: a zero computed as −2.2e-16 is a zero, not an unstable or stable one.
+    #[test]
+    fn rounding_noise_around_zero_prints_as_zero() {
+        assert_eq!(format_list(&[C64::new(-2.220446049250313e-16, 0.0)]), "0");
+        assert_eq!(format_one(C64::new(2.220446049250313e-16, 0.0), true), "0");
+        assert_eq!(format_list(&[C64::new(-0.0, 0.0)]), "0");
+        // The missile's undamped airframe pair ±j11.77 next to the actuator: the real part's noise
+        // is relative to the largest modulus (180) and the conjugate pair still prints once.
+        let v = [C64::new(3e-14, 11.77), C64::new(3e-14, -11.77), C64::new(-108.0, 144.0), C64::new(-108.0, -144.0)];
+        assert_eq!(format_list(&v), "0 ± j11.77, -108 ± j144");
+        // Imaginary noise on a real value, and a conjugate pair whose noise differs in sign.
+        assert_eq!(format_list(&[C64::new(-5.0, 1e-14)]), "-5");
+        assert_eq!(format_list(&[C64::new(-1e-15, 2.0), C64::new(1e-15, -2.0)]), "0 ± j2");
+        // Small but real values are not hidden.
+        assert_eq!(format_list(&[C64::new(-1e-3, 0.0), C64::new(-3e-9, 0.0)]), "-0.001, -3.00000e-9");
     }
 }

@@ -6,12 +6,14 @@
 //! * [`zeros`] — invariant zeros that decide whether an unknown-input observer exists;
 //! * [`lyapunov`] — continuous and discrete Lyapunov equations (decay-rate certificates);
 //! * [`place`] — eigenvalue assignment (Tits–Yang, KNV0, MATLAB-compatible, Ackermann);
-//! * [`model`], [`discretize`] — the plant model and its exact zero-order-hold sampling;
+//! * [`model`], [`discretize`], [`expm`] — the plant model, its exact zero-order-hold sampling and
+//!   the matrix exponential behind it;
 //! * [`signal`] — the known-input and disturbance signals of a scenario.
 
 pub mod discretize;
 pub mod eig;
 pub mod error;
+pub mod expm;
 pub mod householder;
 pub mod kernel;
 pub mod lyapunov;

@@ -4,11 +4,154 @@
 //! right-continuous (a value holds from its time on). The plant integrates the sine part exactly
 //! through its generator and splits each step at the breakpoints of c, so no signal is
 //! approximated inside a step.
+//!
+//! # Where a switching time falls
+//!
+//! Sample k is at t_k = k·dt. A scenario writes dt and every switching time T as decimals, and
+//! they are compared as the decimals written, exactly: T is **on sample k** when T = k·dt in
+//! decimal arithmetic (T/dt an integer), and the new value is in effect from that sample on
+//! (T = 5.0, dt = 0.001: sample 5000; T = 0.3, dt = 0.1: sample 3, although 3·0.1 ≠ 0.3 in
+//! binary floating point). Otherwise T lies strictly inside step k = ⌊T/dt⌋: sample k still sees
+//! the old value, and the plant splits the step at T − k·dt (T = 5.0000000000001: the old value
+//! at sample 5000, a switch 10⁻¹³ s into the step, the new value at sample 5001). There is no
+//! tolerance: the decimal of a double is its shortest round-trip form, which is the decimal
+//! written whenever it has at most 15 significant digits (see [`locate`]).
+
+use std::cmp::Ordering;
+use std::fmt::Write as _;
 
 use serde::{Deserialize, Serialize};
 
-/// Relative tolerance (in steps) within which a switching time counts as falling on a sample.
-pub const SAMPLE_NUDGE: f64 = 1e-9;
+/// Where a switching time falls on the sample grid t_k = k·dt (see the module documentation).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Switch {
+    /// On sample k (T = k·dt exactly), or at or before t₀ (k = 0): in effect from sample k on.
+    OnSample(u64),
+    /// Strictly inside step k, `offset` = T − k·dt seconds after t_k (0 < offset < dt).
+    Inside {
+        /// The step t_k … t_{k+1} that contains T.
+        step: u64,
+        /// T − k·dt, exact in decimals, then rounded to the nearest double.
+        offset: f64,
+    },
+    /// Beyond sample 2⁵³: after any run.
+    Beyond,
+}
+
+/// Locates a switching time T on the sample grid k·dt, comparing the decimals exactly.
+pub fn locate(time: f64, dt: f64) -> Switch {
+    if time.is_nan() || time <= 0.0 {
+        return Switch::OnSample(0);
+    }
+    let q = time / dt;
+    if q.is_nan() || q >= 9.0e15 {
+        return Switch::Beyond;
+    }
+    // q is within a few ulps of the exact ratio, so T lies within half a step of sample k.
+    let k = q.round() as u64;
+    let inside = |step: u64| match decimal_offset(time, step, dt) {
+        Some((_, d, e)) => decimal_to_f64(d, e),
+        None => time - step as f64 * dt,
+    };
+    match decimal_offset(time, k, dt).map(|o| o.0) {
+        Some(Ordering::Equal) => Switch::OnSample(k),
+        Some(Ordering::Greater) => Switch::Inside { step: k, offset: inside(k) },
+        // (k ≥ 1 here: T > 0 = 0·dt.)
+        Some(Ordering::Less) => Switch::Inside { step: k - 1, offset: inside(k - 1) },
+        // Too many digits for 128-bit integers: fall back to the binary values.
+        None if q == q.floor() => Switch::OnSample(q as u64),
+        None => Switch::Inside { step: q.floor() as u64, offset: time - q.floor() * dt },
+    }
+}
+
+/// Whether a switch at T is in effect at sample k: T ≤ k·dt, the decimals compared exactly.
+/// Allocation-free (the plant and controller call it every step); the exact comparison runs only
+/// when T/dt is within 10⁻¹² (relative) of k, where the binary quotient could be on the wrong side.
+pub fn in_effect(time: f64, k: u64, dt: f64) -> bool {
+    if time.is_nan() || time <= 0.0 {
+        return true;
+    }
+    let q = time / dt;
+    let kf = k as f64;
+    let tol = 1e-12 * q.max(1.0);
+    if q < kf - tol {
+        true
+    } else if q > kf + tol {
+        false
+    } else {
+        decimal_offset(time, k, dt).map_or(q <= kf, |(o, ..)| o != Ordering::Greater)
+    }
+}
+
+/// A fixed stack buffer for formatting numbers without allocating.
+struct StackText {
+    buf: [u8; 64],
+    len: usize,
+}
+
+impl StackText {
+    fn new() -> Self {
+        StackText { buf: [0; 64], len: 0 }
+    }
+
+    fn as_str(&self) -> &str {
+        std::str::from_utf8(&self.buf[..self.len]).unwrap_or("")
+    }
+}
+
+impl std::fmt::Write for StackText {
+    fn write_str(&mut self, s: &str) -> std::fmt::Result {
+        let end = self.len + s.len();
+        if end > self.buf.len() {
+            return Err(std::fmt::Error);
+        }
+        self.buf[self.len..end].copy_from_slice(s.as_bytes());
+        self.len = end;
+        Ok(())
+    }
+}
+
+/// x = m·10^e with m·10^e the shortest decimal that reads back as x (x finite, > 0).
+fn decimal(x: f64) -> (u64, i32) {
+    let mut t = StackText::new();
+    // `{:e}` prints the shortest round-trip digits: "5.0000000000001e0", "1e-3".
+    let _ = write!(t, "{x:e}");
+    let (mantissa, exp) = t.as_str().split_once('e').unwrap_or(("0", "0"));
+    let mut m = 0u64;
+    let mut frac = 0i32;
+    let mut point = false;
+    for c in mantissa.bytes() {
+        match c {
+            b'.' => point = true,
+            b'0'..=b'9' => {
+                m = m * 10 + (c - b'0') as u64;
+                frac += point as i32;
+            }
+            _ => {}
+        }
+    }
+    (m, exp.parse::<i32>().unwrap_or(0) - frac)
+}
+
+/// T − k·dt = ±D·10^e exactly, as (sign, D, e), for T, dt > 0 read as their decimals; None if
+/// the integers do not fit in 128 bits (not for any T/dt below 2⁵³ with ≤ 17-digit decimals
+/// whose exponents differ by less than ~20).
+fn decimal_offset(time: f64, k: u64, dt: f64) -> Option<(Ordering, u128, i32)> {
+    let (mt, et) = decimal(time);
+    let (md, ed) = decimal(dt);
+    let e = et.min(ed);
+    let pow10 = |p: i32| 10u128.checked_pow(p as u32);
+    let lhs = (mt as u128).checked_mul(pow10(et - e)?)?;
+    let rhs = (md as u128).checked_mul(k as u128)?.checked_mul(pow10(ed - e)?)?;
+    Some((lhs.cmp(&rhs), lhs.abs_diff(rhs), e))
+}
+
+/// D·10^e correctly rounded (the standard library's parser), without allocating.
+fn decimal_to_f64(d: u128, e: i32) -> f64 {
+    let mut t = StackText::new();
+    let _ = write!(t, "{d}e{e}");
+    t.as_str().parse().unwrap_or(f64::NAN)
+}
 
 /// A scalar signal as a scenario describes it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -100,11 +243,45 @@ impl Signal {
         self.sine_at(t) + self.held(t)
     }
 
-    /// The value a sampler sees at t_k = k·dt: the sine at t_k and the held part just after
-    /// t_k, so that a switch scheduled at t_k (but computed a rounding error later) counts as
-    /// already made — the same convention the plant's step splitting uses.
+    /// The value a sampler sees at a sample time t = k·dt: the sine at t and the held part at
+    /// sample k ([`Signal::held_at_step`]).
     pub fn sample(&self, t: f64, dt: f64) -> f64 {
-        self.sine_at(t) + self.held(t + SAMPLE_NUDGE * dt)
+        // t = fl(k·dt), so t/dt is within a few ulps of k.
+        let k = (t / dt).round().max(0.0) as u64;
+        self.sample_step(k, dt)
+    }
+
+    /// The value at sample k: the sine at t_k = k·dt and the held part at sample k.
+    pub fn sample_step(&self, k: u64, dt: f64) -> f64 {
+        self.sine_at(k as f64 * dt) + self.held_at_step(k, dt)
+    }
+
+    /// c at sample k: a switch is made at sample k when its time T ≤ k·dt, the decimals compared
+    /// exactly (module documentation). A switch strictly inside step k − 1 shows from sample k.
+    pub fn held_at_step(&self, k: u64, dt: f64) -> f64 {
+        match self {
+            Signal::Step { time, before, after } => {
+                if in_effect(*time, k, dt) {
+                    *after
+                } else {
+                    *before
+                }
+            }
+            Signal::Piecewise { times, values } => match times.iter().rposition(|&ti| in_effect(ti, k, dt)) {
+                Some(i) => values[i],
+                None => 0.0,
+            },
+            _ => self.held(0.0),
+        }
+    }
+
+    /// The held value from breakpoint j (of [`Signal::breakpoints`]) on.
+    pub fn held_after(&self, j: usize) -> f64 {
+        match self {
+            Signal::Step { after, .. } => *after,
+            Signal::Piecewise { values, .. } => values[j],
+            _ => self.held(0.0),
+        }
     }
 
     /// The sinusoidal part: (amplitude, ω in rad/s, phase), if any.
@@ -121,7 +298,8 @@ impl Signal {
         self.sine().map_or(0.0, |(a, w, p)| a * (w * t + p).sin())
     }
 
-    /// The piecewise-constant part c(t), right-continuous.
+    /// The piecewise-constant part c(t), right-continuous, comparing t with the switching times
+    /// as binary numbers (for plots; sampling and the plant use [`Signal::held_at_step`]).
     pub fn held(&self, t: f64) -> f64 {
         match self {
             Signal::Constant { value } => *value,
@@ -171,6 +349,50 @@ mod tests {
         assert_eq!(s.value(5.0), 1.0);
         assert_eq!(s.value(12.0), -0.5);
         assert_eq!(s.value(-1.0), 0.0);
+    }
+
+    #[test]
+    fn switching_times_are_located_as_the_decimals_written() {
+        // 5000·0.001 and 3·0.1 are not 5.0 and 0.3 in binary; as decimals they are.
+        assert_eq!(locate(5.0, 0.001), Switch::OnSample(5000));
+        assert_eq!(locate(0.3, 0.1), Switch::OnSample(3));
+        assert_eq!(locate(0.7, 0.1), Switch::OnSample(7));
+        assert_eq!(locate(0.0003, 1e-4), Switch::OnSample(3));
+        // A time computed as 3·10⁻⁴ in binary is another decimal, 3.0000000000000003e-4.
+        assert_eq!(locate(1e-4 * 3.0, 1e-4), Switch::Inside { step: 3, offset: 3e-20 });
+        // 10⁻¹³ after sample 5000, and 10⁻¹³ before it: inside the neighbouring steps.
+        assert_eq!(locate(5.0000000000001, 0.001), Switch::Inside { step: 5000, offset: 1e-13 });
+        assert_eq!(locate(4.9999999999999, 0.001), Switch::Inside { step: 4999, offset: 0.0009999999999 });
+        assert_eq!(locate(0.00105, 0.001), Switch::Inside { step: 1, offset: 5e-5 });
+        assert_eq!(locate(0.0, 0.001), Switch::OnSample(0));
+        assert_eq!(locate(-2.0, 0.001), Switch::OnSample(0));
+        assert_eq!(locate(1e300, 0.001), Switch::Beyond);
+    }
+
+    #[test]
+    fn a_switch_shows_from_its_sample_on_and_no_earlier() {
+        let at = |time: f64| Signal::Step { time, before: 0.0, after: 1.0 };
+        // On sample 5000: made there.
+        assert_eq!(at(5.0).sample(5000.0 * 0.001, 0.001), 1.0);
+        assert_eq!(at(5.0).sample_step(4999, 0.001), 0.0);
+        // 10⁻¹³ later: not yet at sample 5000, made by sample 5001.
+        assert_eq!(at(5.0000000000001).sample(5000.0 * 0.001, 0.001), 0.0);
+        assert_eq!(at(5.0000000000001).sample_step(5001, 0.001), 1.0);
+        // 10⁻¹³ earlier: made by sample 5000.
+        assert_eq!(at(4.9999999999999).sample_step(5000, 0.001), 1.0);
+        assert_eq!(at(4.9999999999999).sample_step(4999, 0.001), 0.0);
+        // 3·0.1 = 0.30000000000000004 > 0.3, 0.3 itself on sample 3 all the same.
+        let p = Signal::Piecewise { times: vec![0.1, 0.3], values: vec![2.0, 3.0] };
+        assert_eq!([0, 1, 2, 3].map(|k| p.sample_step(k, 0.1)), [0.0, 2.0, 2.0, 3.0]);
+        assert_eq!(p.held_after(1), 3.0);
+    }
+
+    #[test]
+    fn decimals_are_the_shortest_round_trip_digits() {
+        assert_eq!(decimal(5.0000000000001), (50000000000001, -13));
+        assert_eq!(decimal(0.001), (1, -3));
+        assert_eq!(decimal(1234.5), (12345, -1));
+        assert_eq!(decimal(0.30000000000000004), (30000000000000004, -17));
     }
 
     #[test]

@@ -10,8 +10,8 @@
 //!          ⎣0    A_u ⎦           ⎣ 0 ⎦    eig(A_u) = the uncontrollable modes.
 //! ```
 //!
-//! Rank decisions use the absolute tolerance n·ε·max(‖A‖₁, ‖B‖₁), as MATLAB's `ctrbf` does, so a
-//! block that is tiny compared with the whole model counts as zero.
+//! Rank decisions use the absolute tolerance n²·ε·max(‖A‖₁, ‖B‖₁) (SLICOT's default; see
+//! [`tolerance`]), so a block that is tiny compared with the whole model counts as zero.
 
 use nalgebra::DMatrix;
 
@@ -76,7 +76,7 @@ pub fn controllability_staircase(a: &DMatrix<f64>, b: &DMatrix<f64>) -> Controll
     let norm1 = |m: &DMatrix<f64>| {
         (0..m.ncols()).map(|j| m.column(j).iter().map(|x| x.abs()).sum::<f64>()).fold(0.0, f64::max)
     };
-    let tol = n as f64 * f64::EPSILON * norm1(a).max(norm1(b)).max(f64::MIN_POSITIVE);
+    let tol = tolerance(n, norm1(a).max(norm1(b)));
     let mut q = DMatrix::<f64>::identity(n, n);
     let mut at = a.clone();
     let mut bt = b.clone();
@@ -127,6 +127,14 @@ pub fn observability_staircase(a: &DMatrix<f64>, c: &DMatrix<f64>) -> Observabil
 }
 
 /// Orthonormal basis of the range of `m`, counting singular values above an absolute `tol`.
+/// The rank tolerance n²·ε·max(‖A‖₁, ‖B‖₁): SLICOT's default for its staircase (AB01ND, TOLDEF
+/// = N²·ε·norm), not MATLAB `ctrbf`'s n·ε. The blocks that should vanish carry the rounding of
+/// every product that formed A — a plant given in other coordinates, TA = (I − HC)A — a few tens
+/// of ε·‖A‖ for small n, which n·ε misjudges as rank and so hides invariant zeros.
+fn tolerance(n: usize, norm: f64) -> f64 {
+    (n * n) as f64 * f64::EPSILON * norm.max(f64::MIN_POSITIVE)
+}
+
 fn range_with_tol(m: &DMatrix<f64>, tol: f64) -> DMatrix<f64> {
     if m.is_empty() {
         return DMatrix::zeros(m.nrows(), 0);

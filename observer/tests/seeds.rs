@@ -204,6 +204,11 @@ fn seed004_hui_zak(path: Path) {
     let free: Vec<_> = r.poles.iter().filter(|z| z.im == 0.0).collect();
     assert_eq!(free.len(), 1);
     assert!(free[0].re < -0.025);
+    // The sampled observer keeps its own fixed modes — the invariant zeros of the sampled
+    // (A_d, B2_d, C, D), which sit within ~1e-9 of e^{(−0.5 ± j√7)·dt} (in s, within ~1e-6 of
+    // −0.5 ± j√7) — and places the free pole at e^{p·dt}.
+    let images: Vec<C64> = r.poles.iter().map(|z| (z * 1e-3).exp()).collect();
+    assert!(eig_close(&r.discrete_poles, &images, 1e-8), "{:?} vs {images:?}", r.discrete_poles);
     let p = matrix(&r, "P");
     assert!(lti::lyapunov::min_eigenvalue(p) >= 0.01 - 1e-12);
     assert!(r.conditions.iter().all(|c| c.ok), "{:?}", r.conditions);
@@ -227,7 +232,7 @@ fn existence_conditions_refuse_with_the_condition_named() {
     };
     let err = design(&m, &Spec::ChenPatton { poles: real(&[-1.0]), placement: Method::YangTits }, 1e-3).unwrap_err();
     assert_eq!(err.condition, "invariant zeros of (A, E, C) stable");
-    assert!(err.detail.contains('1'), "{}", err.detail);
+    assert!(err.detail.contains('1') && err.detail.contains("(TA, C) is not detectable"), "{}", err.detail);
     // (A, CA) with an unobservable unstable mode: the generalized-inverse observer is refused.
     let m = Model {
         a: Mat::from_row_slice(2, 2, &[0.0, 1.0, 0.0, 0.0]),

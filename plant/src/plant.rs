@@ -14,13 +14,15 @@
 //! designs compute them; each generator's columns by its own block exponential.)
 //!
 //! is exact: nothing inside the step is approximated. A step that contains a switching time of
-//! some c(t) is split there; its pieces' exponentials are computed once, at construction. The
-//! generator is re-evaluated from t at every step rather than propagated, so it cannot drift.
+//! some c(t) strictly inside it is split there; its pieces' exponentials and held values are
+//! computed once, at construction. Whether a switching time is on a sample or inside a step is
+//! decided exactly, on the decimals the scenario writes ([`lti::signal::locate`]): no tolerance.
+//! The generator is re-evaluated from t at every step rather than propagated, so it cannot drift.
 
 use lockstep::PlantLayout;
 use lti::discretize::exp_upper;
 use lti::kernel::{mul_acc, mul_into};
-use lti::signal::{Signal, SAMPLE_NUDGE};
+use lti::signal::{locate, Signal, Switch};
 use nalgebra::{DMatrix, DVector};
 
 use crate::config::PlantConfig;
@@ -30,10 +32,11 @@ use crate::config::PlantConfig;
 struct Piece {
     /// Offset of the stretch from t_k, s.
     offset: f64,
-    /// Length, s.
-    h: f64,
     phi: DMatrix<f64>,
     gamma: DMatrix<f64>,
+    /// c(t) of each disturbance on this piece of a split step (empty for the whole step, whose
+    /// held values are those of its first sample).
+    held: Vec<f64>,
 }
 
 /// A state left its bound or became non-finite.
@@ -129,7 +132,7 @@ impl Plant {
                 let (_, gj) = exp_upper(&a, &g, &w, h);
                 gamma.columns_mut(l + q + 2 * j, 2).copy_from(&gj);
             }
-            Piece { offset, h, phi: dm.a, gamma }
+            Piece { offset, phi: dm.a, gamma, held: Vec::new() }
         };
         let full = piece(0.0, cfg.dt);
         let splits = split_steps(cfg, &piece);
@@ -180,16 +183,16 @@ impl Plant {
                 Some(&(d, _, _)) if d == i => {
                     let amplitude = s.sine().map_or(0.0, |a| a.0);
                     next_sine += 1;
-                    amplitude * self.generators[next_sine - 1].0 + s.held(t + SAMPLE_NUDGE * dt)
+                    amplitude * self.generators[next_sine - 1].0 + s.held_at_step(k, dt)
                 }
-                _ => s.sample(t, dt),
+                _ => s.sample_step(k, dt),
             };
         }
         for (o, s) in out[lay.v()].iter_mut().zip(&self.measurement) {
-            *o = s.sample(t, dt);
+            *o = s.sample_step(k, dt);
         }
         for (o, s) in out[lay.r()].iter_mut().zip(&self.inputs) {
-            *o = s.sample(t, dt);
+            *o = s.sample_step(k, dt);
         }
         // y = C x + D v, written in place.
         let (head, tail) = out.split_at_mut(lay.w().start);
@@ -218,7 +221,17 @@ impl Plant {
         };
         for piece in pieces {
             let at_tk = (piece.offset == 0.0).then_some(self.generators.as_slice());
-            integrate(piece, t, u, &self.disturbances, &self.sines, at_tk, &mut self.xi, &mut self.x, &mut self.x_next);
+            let (l, q) = (u.len(), self.disturbances.len());
+            // c(t) on the piece: precomputed for a split step; the first sample's otherwise.
+            let held = &mut self.xi.as_mut_slice()[l..l + q];
+            if piece.held.is_empty() {
+                for (c, s) in held.iter_mut().zip(&self.disturbances) {
+                    *c = s.held_at_step(k, self.dt);
+                }
+            } else {
+                held.copy_from_slice(&piece.held);
+            }
+            integrate(piece, t, u, &self.sines, at_tk, &mut self.xi, &mut self.x, &mut self.x_next);
         }
         for (i, &v) in self.x.iter().enumerate() {
             if !v.is_finite() || v.abs() > self.bound {
@@ -229,13 +242,13 @@ impl Plant {
     }
 }
 
-/// x ← Φ_h x + Γ_h ξ(t₀) for one piece starting at t_k + offset.
+/// x ← Φ_h x + Γ_h ξ(t₀) for one piece starting at t_k + offset; ξ's held part c is set by the
+/// caller.
 #[allow(clippy::too_many_arguments)]
 fn integrate(
     piece: &Piece,
     tk: f64,
     u: &[f64],
-    disturbances: &[Signal],
     sines: &[(usize, f64, f64)],
     generators_at_tk: Option<&[(f64, f64)]>,
     xi: &mut DVector<f64>,
@@ -244,13 +257,8 @@ fn integrate(
 ) {
     let t0 = tk + piece.offset;
     let l = u.len();
-    let q = disturbances.len();
+    let q = xi.len() - l - 2 * sines.len();
     xi.as_mut_slice()[..l].copy_from_slice(u);
-    // c(t) is constant on the piece: read it at the middle, away from the switching instants.
-    let mid = t0 + 0.5 * piece.h;
-    for (i, s) in disturbances.iter().enumerate() {
-        xi[l + i] = s.held(mid);
-    }
     for (j, &(_, omega, phase)) in sines.iter().enumerate() {
         let (sin, cos) = match generators_at_tk {
             Some(g) => g[j],
@@ -264,21 +272,16 @@ fn integrate(
     std::mem::swap(x, x_next);
 }
 
-/// The steps that contain a switching time strictly inside them, with their pieces.
+/// The steps that contain a switching time strictly inside them, with their pieces: each piece
+/// holds, for every disturbance, the value of its first sample changed by the switches in the
+/// step up to the piece's start.
 fn split_steps(cfg: &PlantConfig, piece: &dyn Fn(f64, f64) -> Piece) -> Vec<(u64, Vec<Piece>)> {
     let dt = cfg.dt;
-    let mut cuts: Vec<(u64, f64)> = Vec::new();
-    for s in &cfg.disturbances {
-        for tb in s.breakpoints() {
-            let kf = tb / dt;
-            let k = kf.floor();
-            let frac = kf - k;
-            if k < 0.0 || k >= cfg.steps as f64 || frac < SAMPLE_NUDGE || 1.0 - frac < SAMPLE_NUDGE {
-                continue; // outside the run, or on a sample (handled by the sampling convention)
-            }
-            cuts.push((k as u64, tb - k * dt));
-        }
-    }
+    let inside = |tb: f64| match locate(tb, dt) {
+        Switch::Inside { step, offset } if step < cfg.steps && offset > 0.0 && offset < dt => Some((step, offset)),
+        _ => None, // on a sample (the sampling rule makes it there) or outside the run
+    };
+    let mut cuts: Vec<(u64, f64)> = cfg.disturbances.iter().flat_map(|s| s.breakpoints()).filter_map(inside).collect();
     cuts.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
     cuts.dedup();
     let mut out: Vec<(u64, Vec<Piece>)> = Vec::new();
@@ -291,7 +294,21 @@ fn split_steps(cfg: &PlantConfig, piece: &dyn Fn(f64, f64) -> Piece) -> Vec<(u64
             i += 1;
         }
         offsets.push(dt);
-        let pieces = offsets.windows(2).map(|w| piece(w[0], w[1] - w[0])).collect();
+        let pieces = offsets
+            .windows(2)
+            .map(|w| {
+                let mut p = piece(w[0], w[1] - w[0]);
+                p.held = cfg
+                    .disturbances
+                    .iter()
+                    .map(|s| {
+                        let switched = s.breakpoints().iter().rposition(|&tb| inside(tb).is_some_and(|(st, off)| st == k && off <= w[0]));
+                        switched.map_or_else(|| s.held_at_step(k, dt), |j| s.held_after(j))
+                    })
+                    .collect();
+                p
+            })
+            .collect();
         out.push((k, pieces));
     }
     out

@@ -128,5 +128,8 @@ pub fn run(launch: &Launch) -> Result<(), ShellError> {
         lp.publish(k)?;
         lp.complete(k)?;
     }
-    lp.finish()
+    lp.finish()?;
+    // The end sample: x_K, and when the plant had u_{K−1} — the last step's latency. Sent once
+    // every follower has taken step K − 1, so it never crowds a trailing subscriber's buffer.
+    lp.publish(cfg.plant.steps)
 }

@@ -111,3 +111,56 @@ fn divergence_names_the_state_and_step() {
     assert_eq!(err.step, 1); // e^{10} ≈ 2.2e4, e^{20} ≈ 4.9e8 > 1e6
     assert!(err.to_string().contains("step 2"), "{err}");
 }
+
+/// ẋ = −x + w, x(0) = 0, w a step 0 → 1 at `time`, dt = 1 ms, run to sample 5001.
+fn scalar_step_plant(time: f64) -> (Vec<f64>, Vec<f64>) {
+    let cfg = PlantConfig {
+        a: md(1, 1, &[-1.0]),
+        b: md(1, 1, &[0.0]),
+        c: md(1, 1, &[1.0]),
+        e: md(1, 1, &[1.0]),
+        d: md(1, 0, &[]),
+        x0: vec![0.0],
+        disturbances: vec![Signal::Step { time, before: 0.0, after: 1.0 }],
+        measurement_disturbances: vec![],
+        inputs: vec![Signal::Constant { value: 0.0 }],
+        dt: 1e-3,
+        steps: 5002,
+        state_bound: 1e9,
+    };
+    let mut plant = Plant::new(&cfg).unwrap();
+    let w_at = plant.layout().w().start;
+    let (mut x, mut w) = (Vec::new(), Vec::new());
+    for k in 0..=5001u64 {
+        let row = plant.sample(k);
+        x.push(row[0]);
+        w.push(row[w_at]);
+        plant.advance(k, &[0.0]).unwrap();
+    }
+    (x, w)
+}
+
+/// Issue 10 item 13: a switching time 10⁻¹³ s after sample 5000 is not on it. Sample 5000 shows
+/// the old value, and step 5000 integrates the switch inside it: by hand, x(t₅₀₀₁) =
+/// 1 − e^{−(dt − δ)} with δ = 10⁻¹³ (x = 0 up to the switch), which differs from the on-sample
+/// value 1 − e^{−dt} by e^{−dt}·δ ≈ 10⁻¹³, a million times the tolerance.
+#[test]
+fn a_switch_just_after_a_sample_is_made_inside_the_step() {
+    let (x, w) = scalar_step_plant(5.0000000000001);
+    assert_eq!(w[5000], 0.0, "w at sample 5000 is the value before the switch");
+    assert_eq!(w[5001], 1.0);
+    assert_eq!(x[5000], 0.0);
+    let exact = -(-(1e-3 - 1e-13f64)).exp_m1();
+    assert!((x[5001] - exact).abs() < 1e-18, "x(t_5001) = {:e}, exact {exact:e}", x[5001]);
+}
+
+/// A switching time written 5.0 with dt = 0.001 is on sample 5000 (5000 × 0.001 as decimals),
+/// whatever binary rounding does: w(t₅₀₀₀) = 1, and step 5000 is a whole step at w = 1.
+#[test]
+fn a_switch_on_a_sample_is_made_at_that_sample() {
+    let (x, w) = scalar_step_plant(5.0);
+    assert_eq!((w[4999], w[5000]), (0.0, 1.0));
+    assert_eq!(x[5000], 0.0);
+    let exact = -(-1e-3f64).exp_m1();
+    assert!((x[5001] - exact).abs() < 1e-18, "x(t_5001) = {:e}, exact {exact:e}", x[5001]);
+}

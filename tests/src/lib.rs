@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-pub use launcher::recording::{read, Recording, Series};
+pub use recording::{read, Recording, Series};
 
 /// The directory holding the built binaries (next to this test executable's `deps/`).
 pub fn bin_dir() -> PathBuf {
@@ -123,4 +123,56 @@ pub fn assert_clean(scratch: &Scratch, pid: u32) {
 /// Every series except latency (which is timing, not trajectory).
 pub fn trajectories(r: &Recording) -> Vec<(&String, &Series)> {
     r.series.iter().filter(|(k, _)| !k.starts_with("/latency")).collect()
+}
+
+/// The pid of a component of launcher `launcher_pid` whose `--name` is `name`.
+pub fn component_pid(launcher_pid: u32, name: &str) -> Option<i32> {
+    let run = format!("--run\0{launcher_pid}x");
+    let named = format!("--name\0{name}\0");
+    for e in std::fs::read_dir("/proc").ok()?.flatten() {
+        let Ok(pid) = e.file_name().to_string_lossy().parse::<i32>() else { continue };
+        if let Ok(cmd) = std::fs::read(e.path().join("cmdline")) {
+            let cmd = String::from_utf8_lossy(&cmd);
+            if cmd.contains(&run) && cmd.contains(&named) {
+                return Some(pid);
+            }
+        }
+    }
+    None
+}
+
+/// Waits until every named component of launcher `launcher_pid` is up, and a little longer.
+pub fn wait_running(launcher_pid: u32, names: &[&str]) {
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(20);
+    while names.iter().any(|n| component_pid(launcher_pid, n).is_none()) {
+        assert!(std::time::Instant::now() < deadline, "components did not start");
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    std::thread::sleep(std::time::Duration::from_millis(100));
+}
+
+/// Sends `sig` to `pid` (a process the test started).
+pub fn signal(pid: i32, sig: i32) {
+    // SAFETY: kill(2) with a pid and signal number; no memory is shared.
+    unsafe { libc::kill(pid, sig) };
+}
+
+/// A shipped scenario rewritten for a test: `duration` replaced, `[expect]` kept or dropped.
+pub fn variant(s: &Scratch, name: &str, seconds: f64, keep_expect: bool) -> PathBuf {
+    let text = std::fs::read_to_string(scenario(name)).unwrap();
+    let mut out = String::new();
+    for line in text.lines() {
+        if line.starts_with("duration") {
+            out += &format!("duration = {seconds:?}\n");
+        } else {
+            out += line;
+            out += "\n";
+        }
+    }
+    if !keep_expect {
+        out = out.split("\n[expect]").next().unwrap().to_string();
+    }
+    let p = s.join(&format!("{name}-{seconds}.toml"));
+    std::fs::write(&p, out).unwrap();
+    p
 }

@@ -1,6 +1,8 @@
 //! Issue 6: each kind of bad input gets exit code 2, one line naming the file and the field
 //! (with line:column where the parser knows it) and the reason, no panic, and no output files.
 
+use std::ffi::OsStr;
+
 use tests::*;
 
 const BASE: &str = r#"name = "bad"
@@ -147,4 +149,134 @@ fn outputs_in_the_way_are_refused() {
     assert!(err.contains("bad.rrd") && err.contains("--force"), "{err}");
     assert_eq!(std::fs::metadata(s.join("out/bad.rrd")).unwrap().modified().unwrap(), before);
     assert!(run(&s, &path, &["--force"]).status.success());
+}
+
+/// Runs `launcher <args>` and kills it if it has not finished within 10 s (a blocked read).
+fn run_bounded(s: &Scratch, args: &[&OsStr]) -> std::process::Output {
+    use std::process::Stdio;
+    let mut child = launcher(s).args(args).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);
+    while child.try_wait().unwrap().is_none() {
+        if std::time::Instant::now() > deadline {
+            let _ = child.kill();
+            let out = child.wait_with_output().unwrap();
+            panic!("launcher {args:?} blocked: {:?}", text(&out));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+#[test]
+fn names_are_bounded_before_anything_is_created() {
+    let s = Scratch::new("long-names");
+    for (case, body, field) in [
+        ("name-250", BASE.replacen("name = \"bad\"", &format!("name = \"{}\"", "n".repeat(250)), 1), "name"),
+        ("observer-name-300", BASE.replacen("name = \"luenberger\"", &format!("name = \"{}\"", "l".repeat(300)), 1), "observer[1].name"),
+    ] {
+        let path = s.join(&format!("{case}.toml"));
+        std::fs::write(&path, &body).unwrap();
+        let out_dir = s.join(&format!("out-{case}"));
+        let out = launcher(&s).arg("run").arg(&path).arg("--out").arg(&out_dir).output().unwrap();
+        let (_, err) = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{case}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{case}: {err}");
+        assert!(err.contains(&format!("{case}.toml")) && err.contains(&format!("{field}:")) && err.contains("64"), "{case}: {err}");
+        assert!(err.len() < 400, "{case}: the message repeats the whole name: {err}");
+        assert!(!out_dir.exists(), "{case}: output directory created");
+    }
+}
+
+#[test]
+fn untrusted_text_is_escaped_in_messages() {
+    let s = Scratch::new("escapes");
+    let evil = r#"x\n\u001b[2J\u001b]0;owned\u0007"#;
+    let r = |a: &str, b: String| {
+        assert!(BASE.contains(a), "{a}");
+        BASE.replacen(a, &b, 1)
+    };
+    let cases = [
+        ("name", r("name = \"bad\"", format!("name = \"{evil}\""))),
+        ("observer-name", r("name = \"uio\"", format!("name = \"{evil}\""))),
+        ("kind", r("kind = \"luenberger\"", format!("kind = \"{evil}\""))),
+        ("controller-observer", r("observer = \"uio\"", format!("observer = \"{evil}\""))),
+        ("unknown-key", r("x0 = [1.0, -1.0, 2.0]", format!("x0 = [1.0, -1.0, 2.0]\n\"{evil}\" = 1"))),
+        ("expect-key", format!("{BASE}\n[expect]\ntail_max_abs_error = {{ \"{evil}\" = 1.0 }}\n")),
+        ("description-in-list", r("name = \"bad\"", format!("name = \"bad\"\ndescription = \"{evil}\""))),
+    ];
+    for (case, body) in cases {
+        let path = s.join(&format!("{case}.toml"));
+        std::fs::write(&path, &body).unwrap();
+        let out = if case == "description-in-list" {
+            let dir = s.join("list");
+            std::fs::create_dir_all(&dir).unwrap();
+            std::fs::write(dir.join("d.toml"), &body).unwrap();
+            launcher(&s).arg("list").arg("--dir").arg(&dir).output().unwrap()
+        } else {
+            launcher(&s).arg("run").arg(&path).output().unwrap()
+        };
+        let (stdout, err) = text(&out);
+        let shown = if case == "description-in-list" { stdout } else { err };
+        assert!(!shown.contains('\u{1b}') && !shown.contains('\u{7}'), "{case}: raw control characters: {shown:?}");
+        assert_eq!(shown.trim_end().lines().count(), 1, "{case}: {shown:?}");
+        assert!(shown.contains(r"\u{1b}"), "{case}: escape not shown: {shown:?}");
+        if case != "description-in-list" {
+            assert_eq!(out.status.code(), Some(2), "{case}: {shown}");
+        }
+    }
+    // A file name with a newline and an escape in it.
+    let path = s.join("evil\n\u{1b}[31m.toml");
+    std::fs::write(&path, BASE.replacen("dt = 0.001", "dt = 0.0", 1)).unwrap();
+    let out = launcher(&s).arg("run").arg(&path).output().unwrap();
+    let (_, err) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(!err.contains('\u{1b}') && err.trim_end().lines().count() == 1, "{err:?}");
+}
+
+#[test]
+fn only_regular_files_of_bounded_size_are_read() {
+    let s = Scratch::new("special-files");
+    let fifo = s.join("fifo.toml");
+    let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+    // SAFETY: mkfifo with a valid C path.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    let dir = s.join("dir.toml");
+    std::fs::create_dir_all(&dir).unwrap();
+    let big = s.join("big.toml");
+    std::fs::write(&big, format!("{}{BASE}", "# padding padding padding padding padding padding\n".repeat(40_000))).unwrap();
+    for (file, why) in [(&fifo, "not a regular file"), (&dir, "not a regular file"), (&big, "1 MiB")] {
+        let out_dir = s.join("out");
+        let run_args = [OsStr::new("run"), file.as_os_str(), OsStr::new("--out"), out_dir.as_os_str()];
+        let design_args = [OsStr::new("design"), file.as_os_str()];
+        for args in [&run_args[..], &design_args[..]] {
+            let out = run_bounded(&s, args);
+            let (_, err) = text(&out);
+            assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+            assert!(err.contains(file.file_name().unwrap().to_str().unwrap()) && err.contains(why), "{args:?}: {err}");
+            assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+            assert!(!out_dir.exists());
+        }
+    }
+    // Recordings: a FIFO or a directory is refused by every tool, at once.
+    let fifo_rrd = s.join("fifo.rrd");
+    let c = std::ffi::CString::new(fifo_rrd.to_str().unwrap()).unwrap();
+    // SAFETY: as above.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    for file in [&fifo_rrd, &dir] {
+        let (f, outs) = (file.as_os_str(), s.join("tool-out"));
+        let o = outs.as_os_str();
+        let commands: [&[&OsStr]; 4] = [
+            &[OsStr::new("inspect"), f],
+            &[OsStr::new("compare"), f, f],
+            &[OsStr::new("export"), f, OsStr::new("--csv"), o],
+            &[OsStr::new("plot"), f, OsStr::new("--out"), o],
+        ];
+        for args in commands {
+            let out = run_bounded(&s, args);
+            let (_, err) = text(&out);
+            assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+            assert!(err.contains("not a regular file"), "{args:?}: {err}");
+            assert!(!outs.exists(), "{args:?}: output written");
+        }
+    }
 }

@@ -89,7 +89,7 @@ fn a_killed_component_stops_the_run_cleanly() {
             assert_clean(&s, lpid);
             let r = read(&s.join("out/seed002-sine.rrd")).unwrap();
             assert!(r.complete, "{victim}: recording not finalised");
-            let steps = r.series["/plant/x/0"].values.len();
+            let steps = r.series["/plant/x/1"].values.len();
             assert!(steps > 0 && steps < 600_000, "{victim}: {steps} steps recorded");
             let sum = summary(&s, "seed002-sine");
             assert!(sum["stopped"].as_str().unwrap().contains("SIGKILL"), "{sum}");
@@ -119,7 +119,7 @@ fn sigint_and_sigterm_stop_the_run_cleanly() {
             assert!(err.contains(name), "{name} {mode}: {err}");
             assert_clean(&s, lpid);
             let r = read(&s.join("out/seed002-sine.rrd")).unwrap();
-            assert!(r.complete && !r.series["/plant/x/0"].values.is_empty(), "{name} {mode}");
+            assert!(r.complete && !r.series["/plant/x/1"].values.is_empty(), "{name} {mode}");
         }
     }
 }
@@ -197,6 +197,82 @@ fn components_started_by_hand_say_how_to_start_them() {
             if !args.is_empty() {
                 assert!(err.contains("no run 'nosuchrun1'"), "{err}");
             }
+        }
+    }
+}
+
+/// Issue 10, item 16: a closed terminal (SIGHUP) or Ctrl-\ (SIGQUIT) stops the run like
+/// SIGTERM — components stopped, recording closed, nothing left behind — with exit code 128 +
+/// the signal's number.
+#[test]
+fn sighup_and_sigquit_stop_the_run_cleanly() {
+    for (sig, name, code) in [(libc::SIGHUP, "SIGHUP", 129), (libc::SIGQUIT, "SIGQUIT", 131)] {
+        for mode in ["processes", "in-process"] {
+            let s = Scratch::new(&format!("{name}-{mode}"));
+            let path = long_scenario(&s, if mode == "in-process" { 20_000 } else { 600 });
+            let child = start(&s, &path, &["--mode", mode]);
+            let lpid = child.id();
+            if mode == "processes" {
+                wait_running(lpid, &["plant", "uio", "luenberger", "controller"]);
+            } else {
+                std::thread::sleep(Duration::from_millis(500));
+            }
+            signal(lpid as i32, sig);
+            let sent = Instant::now();
+            let (out, took) = finish(child, sent);
+            let (_, err) = text(&out);
+            assert!(took < Duration::from_secs(2), "{name} {mode}: took {took:?}");
+            assert_eq!(out.status.code(), Some(code), "{name} {mode}: {err}");
+            assert!(err.contains(name), "{name} {mode}: {err}");
+            assert_clean(&s, lpid);
+            let r = read(&s.join("out/seed002-sine.rrd")).unwrap();
+            let x = r.series.keys().find(|k| k.starts_with("/plant/x/")).unwrap();
+            assert!(r.complete && !r.series[x].values.is_empty(), "{name} {mode}");
+            let sum = summary(&s, "seed002-sine");
+            assert!(sum["stopped"].as_str().unwrap().contains(name), "{sum}");
+        }
+    }
+}
+
+/// Mounts a tmpfs of `size` at `dir`; false when mounting is not permitted here.
+fn mount_tmpfs(dir: &std::path::Path, size: &str) -> bool {
+    std::fs::create_dir_all(dir).unwrap();
+    Command::new("mount").args(["-t", "tmpfs", "-o", &format!("size={size}"), "tmpfs"]).arg(dir).status().is_ok_and(|s| s.success())
+}
+
+/// Issue 10, item 21: a full disk stops the run cleanly, naming the file and saying what of
+/// the recording was kept.
+#[test]
+fn a_full_disk_stops_the_run_and_says_what_was_kept() {
+    // 200 kB holds no whole step (the partial file is removed), 3 MB a few thousand (kept).
+    for (mode, size) in [("processes", "200k"), ("in-process", "200k"), ("processes", "3m"), ("in-process", "3m")] {
+        let s = Scratch::new(&format!("disk-full-{mode}-{size}"));
+        let full = s.join("full");
+        if !mount_tmpfs(&full, size) {
+            eprintln!("skipped: cannot mount a tmpfs here (needs root)");
+            return;
+        }
+        let path = long_scenario(&s, 60);
+        let child = launcher(&s).arg("run").arg(&path).args(["--mode", mode, "--out"]).arg(&full).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+        let lpid = child.id();
+        let out = child.wait_with_output().unwrap();
+        let (_, err) = text(&out);
+        let listing: Vec<String> = std::fs::read_dir(&full).unwrap().flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect();
+        let partial = full.join("seed002-sine.rrd.partial");
+        let kept = partial.exists().then(|| read(&partial));
+        let _ = Command::new("umount").arg(&full).status();
+        assert_eq!(out.status.code(), Some(3), "{mode}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{mode}: {err}");
+        assert!(err.contains("seed002-sine.rrd.partial") && err.contains("No space left on device"), "{mode}: {err}");
+        assert_clean(&s, lpid);
+        assert!(!listing.contains(&"seed002-sine.rrd".to_string()), "{mode}: {listing:?}");
+        match kept {
+            Some(r) => {
+                assert!(err.contains("was kept") && size == "3m", "{mode}: {err}");
+                let r = r.expect("the kept partial recording is readable");
+                assert!(!r.complete && r.series.values().any(|s| !s.values.is_empty()), "{mode}");
+            }
+            None => assert!(err.contains("was removed") && size == "200k", "{mode}: {err}"),
         }
     }
 }

@@ -9,7 +9,7 @@ use controller::shell::ControllerLoop;
 use controller::Controller;
 use launcher::plan::plan;
 use launcher::run::configs;
-use launcher::Scenario;
+use scenario::Scenario;
 use lockstep::{Bus, RunSpace, Wait};
 use observer::shell::ObserverLoop;
 use plant::shell::PlantLoop;

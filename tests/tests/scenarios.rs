@@ -84,7 +84,7 @@ fn the_printed_gain_is_refused_then_stops_cleanly_when_allowed() {
         assert_clean(&s, pid);
         let r = read(&s.join("out").join("seed000-printed-gain.rrd")).unwrap();
         assert!(r.complete, "{mode}: the recording is finalised");
-        let steps = r.series["/plant/x/0"].values.len();
+        let steps = r.series["/plant/x/1"].values.len();
         assert!(steps > 100 && steps < 10_000, "{mode}: {steps} steps recorded");
         let sum = summary(&s, "seed000-printed-gain");
         assert!(sum["stopped"].as_str().unwrap().contains("diverged"));

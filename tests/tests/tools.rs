@@ -31,7 +31,7 @@ fn inspect_recomputes_the_summary() {
     assert_eq!(sum["latency_ns"]["step"], ins["latency_ns"]["step"]);
     assert_eq!(sum["latency_ns"]["hops"], ins["latency_ns"]["hops"]);
     let entities = ins["entities"].as_array().unwrap();
-    let x0 = entities.iter().find(|e| e["path"] == "/plant/x/0").unwrap();
+    let x0 = entities.iter().find(|e| e["path"] == "/plant/x/1").unwrap();
     assert_eq!(x0["rows"], 20_000);
     assert_eq!(x0["sim_time"][1].as_f64().unwrap(), 19.999);
 }
@@ -52,7 +52,7 @@ fn compare_demands_bits_and_names_the_first_difference() {
     let series = r.series.get_mut("/observer/dgo/xhat/2").unwrap();
     series.values[4321] = f64::from_bits(series.values[4321].to_bits() + 1);
     let changed = s.join("changed.rrd");
-    launcher::recording::write(&changed, &r).unwrap();
+    recording::read::write(&changed, &r).unwrap();
     let out = launcher(&s).arg("compare").arg(&a).arg(&changed).output().unwrap();
     let (stdout, _) = text(&out);
     assert_eq!(out.status.code(), Some(1), "{stdout}");
@@ -77,15 +77,16 @@ fn export_round_trips_every_bit() {
     let out = launcher(&s).arg("export").arg(&rrd).arg("--csv").arg(s.join("csv")).output().unwrap();
     assert!(out.status.success(), "{:?}", text(&out));
     let r = read(&rrd).unwrap();
+    let scenario = recording::tools::recorded_scenario(&r);
     let mut checked = 0;
-    for (group, members) in launcher::export::groups(&r) {
-        let csv = std::fs::read_to_string(s.join("csv").join(launcher::export::file_name(&group))).unwrap();
+    for (group, members) in recording::export::groups(&r) {
+        let csv = std::fs::read_to_string(s.join("csv").join(recording::export::file_name(&group))).unwrap();
         let mut lines = csv.lines();
         let header: Vec<&str> = lines.next().unwrap().split(',').collect();
         assert_eq!(&header[..2], &["step", "sim_time"]);
         let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
         for (col, (member, series)) in members.iter().enumerate() {
-            assert_eq!(header[2 + col], member);
+            assert_eq!(header[2 + col], recording::export::header(scenario.as_ref(), &r, &group, member));
             let by_step: std::collections::HashMap<i64, &Vec<&str>> = rows.iter().map(|r| (r[0].parse().unwrap(), r)).collect();
             for (k, v) in series.steps.iter().zip(&series.values) {
                 let parsed: f64 = by_step[k][2 + col].parse().unwrap();
@@ -112,8 +113,9 @@ fn plot_draws_one_png_per_view() {
     assert!(out.status.success(), "{:?}", text(&out));
     let mut files: Vec<String> = std::fs::read_dir(s.join("png")).unwrap().flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect();
     files.sort();
-    // 4 states, error and residual for 2 observers, unknown inputs, inputs, outputs, latency.
-    let expected = ["error_dgo-uio.png", "error_luenberger.png", "inputs.png", "latency.png", "outputs.png", "residual_dgo-uio.png", "residual_luenberger.png", "state_1_gamma_dot.png", "state_2_q.png", "state_3_eta.png", "state_4_eta_dot.png", "unknown_inputs.png"];
+    // 4 states, max |e| of both observers, error and residual for 2 observers, unknown inputs,
+    // inputs, outputs, latency.
+    let expected = ["error_dgo-uio.png", "error_luenberger.png", "errors_log.png", "inputs.png", "latency.png", "outputs.png", "residual_dgo-uio.png", "residual_luenberger.png", "state_1_gamma_dot.png", "state_2_q.png", "state_3_eta.png", "state_4_eta_dot.png", "unknown_inputs.png"];
     assert_eq!(files, expected);
     for f in &files {
         let frac = non_white_fraction(&s.join("png").join(f));
@@ -139,7 +141,7 @@ fn a_killed_writers_recording_is_read_with_a_warning() {
     child.wait().unwrap();
     let r = read(&partial).unwrap();
     assert!(!r.complete);
-    assert!(!r.series["/plant/x/0"].values.is_empty());
+    assert!(!r.series["/plant/x/1"].values.is_empty());
     let (ins, warnings) = inspect_json(&s, &partial);
     assert_eq!(ins["complete"], false);
     assert!(warnings.contains("incomplete"), "{warnings}");

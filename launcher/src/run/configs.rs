@@ -7,7 +7,7 @@ use observer::shell::ObserverRun;
 use plant::{PlantConfig, PlantRun};
 
 use crate::plan::Plan;
-use crate::scenario::Scenario;
+use scenario::Scenario;
 
 /// Every component's configuration.
 #[derive(Debug, Clone)]

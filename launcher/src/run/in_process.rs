@@ -9,7 +9,7 @@ use super::configs::Configs;
 use super::session::Session;
 use super::{interrupt, Stop};
 use crate::error::LaunchError;
-use crate::record::StepRow;
+use recording::write::StepRow;
 
 /// Runs every step; returns how it ended.
 pub fn run(cfg: &Configs, session: &mut Session) -> Result<Stop, LaunchError> {

@@ -4,6 +4,8 @@ mod configs;
 pub mod interrupt;
 mod in_process;
 mod processes;
+mod progress;
+mod salvage;
 mod session;
 
 use std::fs;
@@ -17,7 +19,7 @@ pub use session::{hop_entity, hop_names, Session};
 
 use crate::error::LaunchError;
 use crate::plan::Plan;
-use crate::scenario::Scenario;
+use scenario::Scenario;
 use crate::summary::Summary;
 
 /// Where the components run.
@@ -56,6 +58,8 @@ pub struct Options {
     pub record: bool,
     /// Place the lockstep ring's processes on CPUs (processes mode).
     pub pin: bool,
+    /// Which steps and entities are written to the recording (`--record-every`, `--record`).
+    pub select: recording::write::Selection,
 }
 
 /// How a run ended.
@@ -121,7 +125,15 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
     let partial = rrd.as_ref().map(|p| p.with_extension("rrd.partial"));
     interrupt::install();
     let cfg = configs(s, plan);
-    let mut session = Session::new(s, cfg.layout, partial.as_deref())?;
+    let mut session = Session::new(s, cfg.layout, partial.as_deref(), &opts.select).inspect_err(|_| {
+        // A recording that could not even be started is of no use to anyone.
+        if let Some(p) = &partial {
+            let _ = fs::remove_file(p);
+        }
+    })?;
+    if opts.record {
+        session.progress = progress::Progress::new(s.steps);
+    }
     let start = Instant::now();
     let stop = match opts.mode {
         Mode::InProcess => in_process::run(&cfg, &mut session),
@@ -135,11 +147,14 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
         Err(LaunchError::Interrupted(_)) => Stop::Interrupted(interrupt::received().unwrap_or("SIGINT")),
         Err(e) => Stop::Failed(e.to_string()),
     };
-    let (metrics, latency) = session.finish()?;
+    let steps_done = session.steps;
+    let (mut metrics, latency, digest) = session.finish().map_err(|e| salvage::recording_failed(&s.name, partial.as_deref(), &e.to_string(), steps_done))?;
+    metrics.finish();
     if let (Some(from), Some(to)) = (&partial, &rrd) {
         fs::rename(from, to).map_err(|e| LaunchError::BadInput(format!("{}: cannot rename the recording: {e}", to.display())))?;
     }
-    let summary = Summary::new(s, plan, opts, &metrics, &latency, wall, &stop, rrd.as_deref());
+    let mut summary = Summary::new(s, plan, opts, &metrics, &latency, wall, &stop, rrd.as_deref());
+    summary.recording_digest = digest;
     if let Some(path) = &summary_path {
         summary.write(path).map_err(LaunchError::BadInput)?;
     }

@@ -20,7 +20,7 @@ use super::configs::Configs;
 use super::session::Session;
 use super::{interrupt, Stop};
 use crate::error::LaunchError;
-use crate::record::StepRow;
+use recording::write::StepRow;
 
 /// How long components may take to report ready.
 const READY_TIMEOUT: Duration = Duration::from_secs(20);
@@ -50,6 +50,24 @@ impl Proc {
         };
         let err = self.stderr.lock().map(|s| s.trim().lines().last().unwrap_or("").to_string()).unwrap_or_default();
         if err.is_empty() { format!("{} (pid {}) {how}", self.label, self.child.id()) } else { format!("{} (pid {}) {how}: {err}", self.label, self.child.id()) }
+    }
+}
+
+impl Proc {
+    /// "observer 'uio' (pid N, stopped)": the process named with the state the kernel reports.
+    fn describe_stall(&self) -> String {
+        let pid = self.child.id();
+        // /proc/<pid>/stat: "pid (comm) S ..."; the state letter follows the last ')'.
+        let state = std::fs::read_to_string(format!("/proc/{pid}/stat"))
+            .ok()
+            .and_then(|s| s.rsplit_once(')').and_then(|(_, rest)| rest.trim_start().chars().next()));
+        let state = match state {
+            Some('T') | Some('t') => ", stopped",
+            Some('D') => ", in uninterruptible sleep",
+            Some('Z') => ", exited",
+            _ => "",
+        };
+        format!("{} (pid {pid}{state})", self.label)
     }
 }
 
@@ -203,6 +221,19 @@ fn header(s: &Sample) -> Header {
 }
 
 impl Assembly {
+    /// The component whose sample for the next step is missing, first in the order samples flow
+    /// within a step (plant, observers, controller): the others wait on it. Indices as the
+    /// launcher spawns them.
+    fn missing(&self) -> Option<usize> {
+        if self.plant.is_empty() {
+            return Some(0);
+        }
+        if let Some(i) = self.observers.iter().position(|q| q.is_empty()) {
+            return Some(1 + i);
+        }
+        self.controller.as_ref().filter(|q| q.is_empty()).map(|_| 1 + self.observers.len())
+    }
+
     /// Moves every complete step into the session.
     fn assemble(&mut self, row: &mut StepRow, session: &mut Session) -> Result<usize, LaunchError> {
         let mut done = 0;
@@ -374,7 +405,15 @@ fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: 
             last_progress = Instant::now();
         }
         if asm.next == steps {
-            return Ok(Stop::Completed);
+            // The plant's end sample (step K) closes the last step's timing; a plant that has
+            // exited without one ends the run all the same.
+            if let Some((h, _)) = asm.plant.front().filter(|(h, _)| h.step == steps) {
+                session.close_last(h)?;
+                return Ok(Stop::Completed);
+            }
+            if procs[0].status.is_some() {
+                return Ok(Stop::Completed);
+            }
         }
         if let Some(sig) = interrupt::received() {
             return Ok(Stop::Interrupted(sig));
@@ -405,8 +444,10 @@ fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: 
             return Ok(Stop::Failed(format!("every component finished but only {} of {steps} steps arrived", asm.next)));
         }
         if last_progress.elapsed() > STALL_TIMEOUT {
+            let who = asm.missing().map_or_else(|| "a component".to_string(), |i| procs[i].describe_stall());
             stop_all(procs);
-            return Ok(Stop::Failed(format!("no step completed for {} s after step {}", STALL_TIMEOUT.as_secs(), asm.next as i64 - 1)));
+            let last = if asm.next == 0 { "no step completed".to_string() } else { format!("last completed step {}", asm.next - 1) };
+            return Ok(Stop::Failed(format!("{who} published no sample for step {} within {} s; {last}", asm.next, STALL_TIMEOUT.as_secs())));
         }
         std::thread::sleep(POLL);
     }

@@ -4,15 +4,21 @@ use std::path::Path;
 
 use lockstep::PlantLayout;
 
+use super::progress::Progress;
 use crate::error::LaunchError;
-use crate::record::{blueprint, Latency, Metrics, RrdSink, SeriesId, StepRow};
-use crate::scenario::Scenario;
+use recording::write::Selection;
+use recording::palette;
+use recording::signals as sig;
+use recording::write::{blueprint, nan_max, Latency, Metrics, RrdSink, SeriesId, StepRow};
+use scenario::Scenario;
 
 /// Series of one observer.
 struct ObserverChannels {
     xhat: Vec<SeriesId>,
     error: Vec<SeriesId>,
     residual: Vec<SeriesId>,
+    /// log10 max_i |e_i| (see [`sig::log_error`]).
+    log_error: SeriesId,
 }
 
 /// The recording's series, in three groups by time stamp: the signals of step k, the hops
@@ -48,7 +54,12 @@ pub struct Session {
     /// Steps recorded.
     pub steps: u64,
     dt: f64,
+    /// The progress bar, when the run shows one.
+    pub progress: Option<Progress>,
 }
+
+/// A recording's digest: entity → 16 hex digits.
+pub type Digest = std::collections::BTreeMap<String, String>;
 
 /// Hop names of a run, in the order [`Session`] records them.
 pub fn hop_names(s: &Scenario) -> Vec<String> {
@@ -67,32 +78,43 @@ pub fn hop_entity(hop: &str) -> String {
 
 impl Session {
     /// Starts a session; with `rrd`, opens the recording there.
-    pub fn new(s: &Scenario, layout: PlantLayout, rrd: Option<&Path>) -> Result<Self, LaunchError> {
+    /// `select` thins and filters what is written; the figures see every step.
+    pub fn new(s: &Scenario, layout: PlantLayout, rrd: Option<&Path>, select: &Selection) -> Result<Self, LaunchError> {
         let controller_observer = s.controller.as_ref().and_then(|c| s.observers.iter().position(|o| o.name == c.observer));
         let hops = hop_names(s);
         let sink = match rrd {
             Some(path) => {
                 let mut sink = RrdSink::create(path, &s.name, blueprint(s), &s.source).map_err(LaunchError::BadInput)?;
+                sink.select(select.clone());
                 let (signals, hops_now, hops_late) = (sink.group(), sink.group(), sink.group());
-                let name = |i: usize| s.state_names[i].clone();
-                let mut series = |g: usize, path: String, legend: String| sink.series(g, &path, &legend);
-                let x = (0..layout.n).map(|i| series(signals, format!("/plant/x/{i}"), format!("{} (true)", name(i)))).collect();
-                let y = (0..layout.p).map(|j| series(signals, format!("/plant/y/{j}"), format!("y{}", j + 1))).collect();
-                let w = (0..layout.q).map(|k| series(signals, format!("/disturbance/{k}"), format!("w{}", k + 1))).collect();
-                let v = (0..layout.r).map(|k| series(signals, format!("/measurement_disturbance/{k}"), format!("v{}", k + 1))).collect();
-                let r = (0..layout.l).map(|k| series(signals, format!("/input/{k}"), format!("r{}", k + 1))).collect();
+                let names = &s.names;
+                let observer_names: Vec<String> = s.observers.iter().map(|o| o.name.clone()).collect();
+                // Colours and widths by the palette's rule, which the PNG plots follow too.
+                let mut series = |g: usize, path: String, legend: String| {
+                    let line = palette::line(&path, &observer_names);
+                    sink.series(g, &path, &legend, line.color, palette::viewer_width(&path))
+                };
+                let x = (0..layout.n).map(|i| series(signals, sig::state(i), format!("{} (true)", names.state[i].name))).collect();
+                let y = (0..layout.p).map(|j| series(signals, sig::output(j), names.output[j].name.clone())).collect();
+                let w = (0..layout.q).map(|k| series(signals, sig::disturbance(k), names.disturbance[k].name.clone())).collect();
+                let v = (0..layout.r).map(|k| series(signals, sig::measurement_disturbance(k), names.measurement_disturbance[k].name.clone())).collect();
+                let r = (0..layout.l).map(|k| series(signals, sig::input(k), names.input[k].name.clone())).collect();
                 let u = if s.controller.is_some() {
-                    (0..layout.l).map(|k| series(signals, format!("/controller/u/{k}"), format!("u{}", k + 1))).collect()
+                    (0..layout.l).map(|k| series(signals, sig::control(k), sig::control_name(s, k))).collect()
                 } else {
                     Vec::new()
                 };
                 let observers = s
                     .observers
                     .iter()
-                    .map(|o| ObserverChannels {
-                        xhat: (0..layout.n).map(|i| series(signals, format!("/observer/{}/xhat/{i}", o.name), format!("{} ({})", name(i), o.name))).collect(),
-                        error: (0..layout.n).map(|i| series(signals, format!("/observer/{}/error/{i}", o.name), format!("e{} ({})", i + 1, o.name))).collect(),
-                        residual: (0..layout.p).map(|j| series(signals, format!("/observer/{}/residual/{j}", o.name), format!("r{} ({})", j + 1, o.name))).collect(),
+                    .map(|o| {
+                        let name = &o.name;
+                        ObserverChannels {
+                            xhat: (0..layout.n).map(|i| series(signals, sig::estimate(name, i), format!("{} ({name})", names.state[i].name))).collect(),
+                            error: (0..layout.n).map(|i| series(signals, sig::error(name, i), format!("e{} ({name})", i + 1))).collect(),
+                            residual: (0..layout.p).map(|j| series(signals, sig::residual(name, j), format!("r{} ({name})", j + 1))).collect(),
+                            log_error: series(signals, sig::log_error(name), format!("log10 max|e| ({name})")),
+                        }
                     })
                     .collect();
                 let step_latency = series(hops_late, "/latency/step".into(), "step".into());
@@ -115,6 +137,7 @@ impl Session {
             prev: None,
             steps: 0,
             dt: s.dt,
+            progress: None,
         })
     }
 
@@ -147,6 +170,26 @@ impl Session {
         self.push(row, step_ns.map(|ns| (row.k - 1, ns)), &hop_values)
     }
 
+    /// Closes the timing of the last step K − 1 with the plant's end sample (step K, published
+    /// after the run, carrying when the plant had u_{K−1}): its step time and controller→plant hop.
+    pub fn close_last(&mut self, end: &lockstep::Header) -> Result<(), LaunchError> {
+        let Some((plant_sent, ctrl_sent)) = self.prev.take() else { return Ok(()) };
+        let step_ns = end.taken_ns.saturating_sub(plant_sent);
+        self.latency.step(step_ns);
+        let late = self.controller_observer.map(|_| (self.metrics.observers.len() + 1, end.taken_ns.saturating_sub(ctrl_sent)));
+        if let Some((i, ns)) = late {
+            self.latency.hop(i, ns);
+        }
+        let Some((sink, ch)) = &mut self.sink else { return Ok(()) };
+        let k = end.step.saturating_sub(1);
+        sink.row(ch.hops_late, k, k as f64 * self.dt);
+        sink.push(ch.step_latency, step_ns as f64);
+        if let Some((i, ns)) = late {
+            sink.push(ch.hops[i], ns as f64);
+        }
+        sink.flush_full().map_err(LaunchError::Component)
+    }
+
     /// Records one step of the in-process loop, with its step time when it was measured.
     pub fn record_in_process(&mut self, row: &StepRow, step_ns: Option<u64>) -> Result<(), LaunchError> {
         if let Some(ns) = step_ns {
@@ -158,6 +201,9 @@ impl Session {
     fn push(&mut self, row: &StepRow, step_ns: Option<(u64, u64)>, hops: &[(usize, u64)]) -> Result<(), LaunchError> {
         self.metrics.push(row);
         self.steps += 1;
+        if let Some(p) = &mut self.progress {
+            p.tick(self.steps);
+        }
         let Some((sink, ch)) = &mut self.sink else { return Ok(()) };
         let (k, t) = (row.k, row.t);
         let lay = self.layout;
@@ -177,6 +223,8 @@ impl Session {
             put(sink, &oc.xhat, &row.xhat[o]);
             put(sink, &oc.error, &self.metrics.error[o]);
             put(sink, &oc.residual, &self.metrics.residual[o]);
+            let max_abs = self.metrics.error[o].iter().fold(0.0, |m, e| nan_max(m, e.abs()));
+            sink.push(oc.log_error, sig::log10_floored(max_abs));
         }
         // Latencies are recorded at the step they belong to: the step time and the
         // controller→plant hop of step k−1 complete with row k (in-process: step k itself).
@@ -193,11 +241,16 @@ impl Session {
         sink.flush_full().map_err(LaunchError::Component)
     }
 
-    /// Closes the recording (footer written); returns the figures.
-    pub fn finish(self) -> Result<(Metrics, Latency), LaunchError> {
-        if let Some((sink, _)) = self.sink {
-            sink.finish().map_err(LaunchError::Component)?;
+    /// Closes the recording (footer written); returns the figures and the recording's digest.
+    /// Fails, naming the file, when the recording could not be written whole.
+    pub fn finish(self) -> Result<(Metrics, Latency, Option<Digest>), LaunchError> {
+        if let Some(p) = self.progress {
+            p.finish();
         }
-        Ok((self.metrics, self.latency))
+        let digest = match self.sink {
+            Some((sink, _)) => Some(sink.finish().map_err(LaunchError::Component)?),
+            None => None,
+        };
+        Ok((self.metrics, self.latency, digest))
     }
 }

@@ -38,6 +38,7 @@ pub(super) fn core(
     c: &Mat,
     e: &Mat,
     poles: &Poles,
+    carried: &[C64],
     method: Method,
     domain: Domain,
     checks: &mut Checks,
@@ -56,13 +57,16 @@ pub(super) fn core(
         } else if unstable.is_empty() {
             format_list(&zeros.zeros)
         } else {
-            format!("unstable zero(s) {}", format_list(&unstable))
+            format!(
+                "unstable zero(s) {z}: (TA, C) is not detectable — its unobservable mode(s) s = {z} stay in F = TA − K1C whatever K1 is",
+                z = format_list(&unstable)
+            )
         },
     )?;
     let h = e * pinv(&ce);
     let t = Mat::identity(n, n) - &h * c;
     let ta = &t * a;
-    let (k1, fixed) = place_detectable(checks, &ta, c, &domain.poles(poles), method, "(TA, C)", domain)?;
+    let (k1, fixed) = place_detectable(checks, &ta, c, poles, carried, method, "(TA, C)", domain)?;
     let f = &ta - &k1 * c;
     require_stable(checks, "F = TA − K1C stable", &eig(&f), domain)?;
     let k2 = &f * &h;
@@ -71,10 +75,10 @@ pub(super) fn core(
 
 pub(super) fn design(model: &Model, poles: &Poles, method: Method, dt: f64) -> Result<Designed, DesignError> {
     let mut checks = Checks::new(KIND);
-    let ct = core(&model.a, &model.c, &model.e, poles, method, Domain::Continuous, &mut checks)?;
+    let ct = core(&model.a, &model.c, &model.e, poles, &[], method, Domain::Continuous, &mut checks)?;
     let dm = model.discretize(dt);
     let mut sampled = Checks::sampled(KIND, dt);
-    let d = core(&dm.a, &dm.c, &dm.e, poles, method, Domain::Discrete(dt), &mut sampled)?;
+    let d = core(&dm.a, &dm.c, &dm.e, poles, &ct.fixed, method, Domain::Discrete(dt), &mut sampled)?;
     let n = model.n();
     let runtime = LinearObserver::new(&d.f, &(&d.t * &dm.b), &(&d.k1 + &d.k2), &Mat::identity(n, n), &d.h);
     Ok(Designed {

@@ -33,7 +33,7 @@ struct Core {
 }
 
 #[allow(clippy::too_many_arguments)]
-fn core(a: &Mat, b: &Mat, c: &Mat, h: &Mat, poles: &Poles, method: Method, domain: Domain, checks: &mut Checks) -> Result<Core, DesignError> {
+fn core(a: &Mat, b: &Mat, c: &Mat, h: &Mat, poles: &Poles, carried: &[C64], method: Method, domain: Domain, checks: &mut Checks) -> Result<Core, DesignError> {
     let n = a.nrows();
     let p = c.nrows();
     let mut ch = Mat::zeros(n, n);
@@ -46,7 +46,7 @@ fn core(a: &Mat, b: &Mat, c: &Mat, h: &Mat, poles: &Poles, method: Method, domai
     let f = inv.columns(p, n - p).into_owned();
     let haf = h * a * &f;
     let caf = c * a * &f;
-    let (k, fixed) = place_detectable(checks, &haf, &caf, &domain.poles(poles), method, "(HAF, CAF)", domain)?;
+    let (k, fixed) = place_detectable(checks, &haf, &caf, poles, carried, method, "(HAF, CAF)", domain)?;
     let fo = &haf - &k * &caf;
     require_stable(checks, "HAF − KCAF stable", &eig(&fo), domain)?;
     let ky = &fo * &k + h * a * &e - &k * c * a * &e;
@@ -67,10 +67,10 @@ pub(super) fn design(model: &Model, poles: &Poles, method: Method, h: Option<&Ma
     if h.nrows() != n - p {
         return Err(checks.error("C", format!("must have full row rank {p} for Cumming's observer")));
     }
-    let ct = core(&model.a, &model.b, &model.c, &h, poles, method, Domain::Continuous, &mut checks)?;
+    let ct = core(&model.a, &model.b, &model.c, &h, poles, &[], method, Domain::Continuous, &mut checks)?;
     let dm = model.discretize(dt);
     let mut sampled = Checks::sampled(KIND, dt);
-    let d = core(&dm.a, &dm.b, &dm.c, &h, poles, method, Domain::Discrete(dt), &mut sampled)?;
+    let d = core(&dm.a, &dm.b, &dm.c, &h, poles, &ct.fixed, method, Domain::Discrete(dt), &mut sampled)?;
     let q = &d.e + &d.f * &d.k;
     let runtime = LinearObserver::new(&d.fo, &d.ku, &d.ky, &d.f, &q);
     Ok(Designed {

@@ -76,6 +76,7 @@ pub(super) fn core(
     e: &Mat,
     gain: &Gain,
     uio: bool,
+    carried: &[C64],
     domain: Domain,
     checks: &mut Checks,
 ) -> Result<Core, DesignError> {
@@ -110,7 +111,7 @@ pub(super) fn core(
                 let at = &lgal - &k0 * &cal;
                 let ct = &pi * &cal;
                 notes.push("H placed on the pair (LgAL − K0·CAL, Π·CAL)".to_string());
-                place_detectable(checks, &at, &ct, &domain.poles(poles), *method, "(LgAL − K0CAL, ΠCAL)", domain)?
+                place_detectable(checks, &at, &ct, poles, carried, *method, "(LgAL − K0CAL, ΠCAL)", domain)?
             }
         };
         let k = k0 + h * pi;
@@ -119,7 +120,7 @@ pub(super) fn core(
         (k, fixed)
     } else {
         match gain {
-            Gain::Poles(poles, method) => place_detectable(checks, &lgal, &cal, &domain.poles(poles), *method, "(LgAL, CAL)", domain)?,
+            Gain::Poles(poles, method) => place_detectable(checks, &lgal, &cal, poles, carried, *method, "(LgAL, CAL)", domain)?,
             Gain::Free(_) => return Err(checks.error("H", "only the unknown-input form takes H")),
         }
     };
@@ -133,10 +134,10 @@ pub(super) fn core(
 pub(super) fn design(model: &Model, gain: Gain, uio: bool, dt: f64) -> Result<Designed, DesignError> {
     let kind = if uio { "das-ghosal-uio" } else { "das-ghosal" };
     let mut checks = Checks::new(kind);
-    let ct = core(&model.a, &model.b, &model.c, &model.e, &gain, uio, Domain::Continuous, &mut checks)?;
+    let ct = core(&model.a, &model.b, &model.c, &model.e, &gain, uio, &[], Domain::Continuous, &mut checks)?;
     let dm = model.discretize(dt);
     let mut sampled = Checks::sampled(kind, dt);
-    let d = core(&dm.a, &dm.b, &dm.c, &dm.e, &gain, uio, Domain::Discrete(dt), &mut sampled)?;
+    let d = core(&dm.a, &dm.b, &dm.c, &dm.e, &gain, uio, &ct.fixed, Domain::Discrete(dt), &mut sampled)?;
     let q = &d.cg + &d.l * &d.k;
     let runtime = LinearObserver::new(&d.f, &d.ku, &d.ky, &d.l, &q);
     let mut notes = ct.notes;

@@ -21,9 +21,9 @@ use crate::runtime::LinearObserver;
 
 const KIND: &str = "gi-full-order";
 
-fn core(a: &Mat, c: &Mat, poles: &Poles, method: Method, domain: Domain, checks: &mut Checks) -> Result<(Mat, Mat, Vec<lti::C64>), DesignError> {
+fn core(a: &Mat, c: &Mat, poles: &Poles, carried: &[lti::C64], method: Method, domain: Domain, checks: &mut Checks) -> Result<(Mat, Mat, Vec<lti::C64>), DesignError> {
     let ca = c * a;
-    let (k, fixed) = place_detectable(checks, a, &ca, &domain.poles(poles), method, "(A, CA)", domain)?;
+    let (k, fixed) = place_detectable(checks, a, &ca, poles, carried, method, "(A, CA)", domain)?;
     let f = a - &k * &ca;
     require_stable(checks, "F = A − KCA stable", &eig(&f), domain)?;
     Ok((k, f, fixed))
@@ -33,10 +33,10 @@ pub(super) fn design(model: &Model, poles: &Poles, method: Method, dt: f64) -> R
     let mut checks = Checks::new(KIND);
     let n = model.n();
     let ra = rank(&model.a);
-    let (k, f, fixed) = core(&model.a, &model.c, poles, method, Domain::Continuous, &mut checks)?;
+    let (k, f, fixed) = core(&model.a, &model.c, poles, &[], method, Domain::Continuous, &mut checks)?;
     let dm = model.discretize(dt);
     let mut sampled = Checks::sampled(KIND, dt);
-    let (kd, fd, _) = core(&dm.a, &dm.c, poles, method, Domain::Discrete(dt), &mut sampled)?;
+    let (kd, fd, _) = core(&dm.a, &dm.c, poles, &fixed, method, Domain::Discrete(dt), &mut sampled)?;
     let g = &dm.b - &kd * &dm.c * &dm.b;
     let ky = &fd * &kd;
     let runtime = LinearObserver::new(&fd, &g, &ky, &Mat::identity(n, n), &kd);

@@ -80,6 +80,7 @@ fn core(
     b2: &Mat,
     d: &Mat,
     poles: Option<&Poles>,
+    carried: &[C64],
     method: Method,
     lmi_l: Option<&Mat>,
     domain: Domain,
@@ -98,13 +99,22 @@ fn core(
     checks.require(
         "invariant zeros of (A, B2, C, D) stable",
         unstable.is_empty(),
-        if fixed.is_empty() { "none".into() } else if unstable.is_empty() { format_list(&fixed) } else { format!("unstable zero(s) {}", format_list(&unstable)) },
+        if fixed.is_empty() {
+            "none".into()
+        } else if unstable.is_empty() {
+            format_list(&fixed)
+        } else {
+            format!(
+                "unstable zero(s) {z}: (A1, NC) is not detectable — its unobservable mode(s) s = {z} stay in A1 − LC whatever L is",
+                z = format_list(&unstable)
+            )
+        },
     )?;
     let nc = &dec.n * c;
     let l = match (lmi_l, poles) {
         (Some(l), _) => l.clone(),
         (None, Some(p)) => {
-            let (lt, _) = place_detectable(checks, &dec.a1, &nc, &domain.poles(p), method, "(A1, NC)", domain)?;
+            let (lt, _) = place_detectable(checks, &dec.a1, &nc, p, carried, method, "(A1, NC)", domain)?;
             lt * &dec.n
         }
         (None, None) => return Err(checks.error("poles", "no free poles given (a design bug: the caller supplies the default)")),
@@ -168,7 +178,7 @@ pub(super) fn design(model: &Model, decay: f64, poles: Option<&Poles>, method: M
         }
         None => None,
     };
-    let ct = core(&model.a, &model.c, b2, d, poles, method, lmi_l.as_ref(), Domain::Continuous, &mut checks)?;
+    let ct = core(&model.a, &model.c, b2, d, poles, &[], method, lmi_l.as_ref(), Domain::Continuous, &mut checks)?;
     let poles_c = eig(&ct.acl);
     let slowest = poles_c.iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
     checks.require(
@@ -202,7 +212,7 @@ pub(super) fn design(model: &Model, decay: f64, poles: Option<&Poles>, method: M
         }
         (None, p) => p.cloned(),
     };
-    let d_core = core(&dm.a, &dm.c, &dm.e, d, free_poles.as_ref(), method, None, Domain::Discrete(dt), &mut sampled)?;
+    let d_core = core(&dm.a, &dm.c, &dm.e, d, free_poles.as_ref(), &ct.fixed, method, None, Domain::Discrete(dt), &mut sampled)?;
     let (rho, worst_d) = discrete_certificate(&d_core.acl, decay, dt).map_err(|e| sampled.error("Lyapunov certificate", e))?;
     notes.push(format!("sampled decay certificate: ρ = e^(−α·dt/2) = {}, λmax(AᵀPA − ρ²P) = {}", sig(rho), sig(worst_d)));
     let n = model.n();

@@ -13,20 +13,20 @@ use crate::runtime::LinearObserver;
 
 const KIND: &str = "luenberger";
 
-fn gain(a: &Mat, c: &Mat, poles: &Poles, method: Method, domain: Domain, checks: &mut Checks) -> Result<(Mat, Vec<lti::C64>), DesignError> {
-    place_detectable(checks, a, c, &domain.poles(poles), method, "(A, C)", domain)
+fn gain(a: &Mat, c: &Mat, poles: &Poles, carried: &[lti::C64], method: Method, domain: Domain, checks: &mut Checks) -> Result<(Mat, Vec<lti::C64>), DesignError> {
+    place_detectable(checks, a, c, poles, carried, method, "(A, C)", domain)
 }
 
 pub(super) fn design(model: &Model, poles: &Poles, method: Method, dt: f64) -> Result<Designed, DesignError> {
     let mut checks = Checks::new(KIND);
-    let (l, fixed) = gain(&model.a, &model.c, poles, method, Domain::Continuous, &mut checks)?;
+    let (l, fixed) = gain(&model.a, &model.c, poles, &[], method, Domain::Continuous, &mut checks)?;
     let f = &model.a - &l * &model.c;
     let poles_c = eig(&f);
     require_stable(&mut checks, "A − LC stable", &poles_c, Domain::Continuous)?;
 
     let dm = model.discretize(dt);
     let mut sampled = Checks::sampled(KIND, dt);
-    let (ld, _) = gain(&dm.a, &dm.c, poles, method, Domain::Discrete(dt), &mut sampled)?;
+    let (ld, _) = gain(&dm.a, &dm.c, poles, &fixed, method, Domain::Discrete(dt), &mut sampled)?;
     let fd = &dm.a - &ld * &dm.c;
     let n = model.n();
     let runtime = LinearObserver::new(&fd, &dm.b, &ld, &Mat::identity(n, n), &Mat::zeros(n, model.p()));

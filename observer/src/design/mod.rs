@@ -137,14 +137,6 @@ impl Domain {
             Domain::Discrete(_) => z.norm() < 1.0 - 1e-13,
         }
     }
-
-    /// The requested continuous poles, mapped to this domain.
-    pub fn poles(self, p: &Poles) -> Poles {
-        match self {
-            Domain::Continuous => p.clone(),
-            Domain::Discrete(dt) => p.to_discrete(dt),
-        }
-    }
 }
 
 /// Collects conditions; a failing required one ends the design with a [`DesignError`].
@@ -183,16 +175,26 @@ impl Checks {
     }
 }
 
-/// An observer gain for the pair (A, C) placing `poles` on its observable part; the
-/// unobservable modes stay where they are and are returned as fixed modes.
+/// An observer gain for the pair (A, C) placing the requested spectrum on its observable part;
+/// the unobservable modes stay where they are and are returned as fixed modes.
 ///
 /// With the staircase Qᵀ A Q = [[A_o, 0], [A₂₁, A_u]], C Q = [C_o, 0], the gain L = Q [L_o; 0]
 /// gives Qᵀ(A − LC)Q = [[A_o − L_oC_o, 0], [A₂₁, A_u]]: eig = eig(A_o − L_oC_o) ∪ eig(A_u).
+///
+/// `free` are the user's continuous poles: one per observable mode of the continuous pair.
+/// `carried` are the continuous design's fixed modes (empty for the continuous design itself).
+/// The sampled design aims at the same spectrum mapped by z = e^{s·dt}: every free pole p goes
+/// to e^{p·dt}, and every continuous fixed mode z_f to e^{z_f·dt} — left alone where the
+/// sampled pair keeps a fixed mode of its own there, placed there where sampling made it
+/// observable (an invariant zero of (A, E, C) is often not one of (A_d, E_d, C)). Both designs
+/// then have the same error dynamics, and the user writes one pole list for both.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn place_detectable(
     checks: &mut Checks,
     a: &Mat,
     c: &Mat,
-    poles: &Poles,
+    free: &Poles,
+    carried: &[C64],
     method: Method,
     pair: &str,
     domain: Domain,
@@ -200,37 +202,78 @@ pub(crate) fn place_detectable(
     let n = a.nrows();
     let stairs = observability_staircase(a, c);
     let fixed = stairs.unobservable_modes().map_err(|e| checks.error(pair, e.to_string()))?;
-    if stairs.no == n {
-        let placed = place_observer(a, c, poles, method).map_err(|e| checks.error("pole placement", e.to_string()))?;
-        return Ok((placed.gain, Vec::new()));
+    if stairs.no < n {
+        let what = if domain == Domain::Continuous { "Re < 0" } else { "|z| < 1" };
+        let unstable: Vec<C64> = fixed.iter().copied().filter(|&z| !domain.stable(z)).collect();
+        checks.require(
+            &format!("{pair} detectable"),
+            unstable.is_empty(),
+            if unstable.is_empty() {
+                format!("unobservable modes {} have {what}", format_list(&fixed))
+            } else {
+                format!("{pair} is not detectable: unobservable mode(s) {} not stable (no gain can move them)", format_list(&unstable))
+            },
+        )?;
     }
-    let what = if domain == Domain::Continuous { "Re < 0" } else { "|z| < 1" };
-    let unstable: Vec<C64> = fixed.iter().copied().filter(|&z| !domain.stable(z)).collect();
-    checks.require(
-        &format!("{pair} detectable"),
-        unstable.is_empty(),
-        if unstable.is_empty() {
-            format!("unobservable modes {} have {what}", format_list(&fixed))
-        } else {
-            format!("unobservable mode(s) {} not stable", format_list(&unstable))
-        },
-    )?;
-    if poles.len() != stairs.no {
-        return Err(checks.error(
-            "poles",
-            format!(
-                "{pair} has {} fixed mode(s) {}; give {} pole(s) for the observable part, {} given",
+    let target = match domain {
+        Domain::Continuous => free.clone(),
+        Domain::Discrete(dt) => sampled_target(free, carried, &fixed, dt).map_err(|e| checks.error("poles", e))?,
+    };
+    if target.len() != stairs.no {
+        let detail = match domain {
+            Domain::Continuous if stairs.no == n => {
+                format!("{pair} is observable: give {n} pole(s) (poles = [...]), {} given", free.len())
+            }
+            Domain::Continuous => format!(
+                "{pair} has {} fixed mode(s) {} that no gain moves; give {} pole(s) for the observable part{}, {} given",
                 n - stairs.no,
                 format_list(&fixed),
                 stairs.no,
-                poles.len()
+                if stairs.no == 0 { " (poles = [] or no poles key)" } else { "" },
+                free.len()
             ),
-        ));
+            Domain::Discrete(_) => format!(
+                "{pair} needs {} pole(s) but the continuous design's {} free pole(s) and {} fixed mode(s) {} map to {} \
+                 (the sampled pair has fixed mode(s) {} that sampling did not carry over)",
+                stairs.no,
+                free.len(),
+                carried.len(),
+                format_list(carried),
+                target.len(),
+                format_list(&fixed)
+            ),
+        };
+        return Err(checks.error("poles", detail));
+    }
+    if stairs.no == n {
+        let placed = place_observer(a, c, &target, method).map_err(|e| checks.error("pole placement", e.to_string()))?;
+        return Ok((placed.gain, Vec::new()));
+    }
+    if stairs.no == 0 {
+        return Ok((Mat::zeros(n, c.nrows()), fixed));
     }
     let (ao, co) = stairs.observable_part();
-    let placed = place_observer(&ao, &co, poles, method).map_err(|e| checks.error("pole placement", e.to_string()))?;
+    let placed = place_observer(&ao, &co, &target, method).map_err(|e| checks.error("pole placement", e.to_string()))?;
     let l = stairs.q.columns(0, stairs.no) * placed.gain;
     Ok((l, fixed))
+}
+
+/// The sampled design's poles: e^{p·dt} for the free poles, and e^{z·dt} for each continuous
+/// fixed mode z that the sampled pair does not keep fixed itself. Each sampled fixed mode takes
+/// away the nearest image of a continuous one (it sits there, up to sampling, and stays).
+fn sampled_target(free: &Poles, carried: &[C64], sampled_fixed: &[C64], dt: f64) -> Result<Poles, String> {
+    // Conjugates mapped as conjugates, so the list stays exactly closed under conjugation.
+    let image = |z: C64| if z.im < 0.0 { (z.conj() * dt).exp().conj() } else { (z * dt).exp() };
+    let mut left: Vec<C64> = carried.to_vec();
+    for f in sampled_fixed {
+        let nearest = (0..left.len()).min_by(|&i, &j| (image(left[i]) - f).norm().total_cmp(&(image(left[j]) - f).norm()));
+        if let Some(i) = nearest {
+            left.remove(i);
+        }
+    }
+    let mut values: Vec<C64> = free.to_discrete(dt).values().to_vec();
+    values.extend(left.into_iter().map(image));
+    Poles::from_values(&values).map_err(|e| e.to_string())
 }
 
 /// Sorted eigenvalues (design matrices are small and finite; failure is a bug upstream).

@@ -10,8 +10,8 @@ use lti::eig::sig;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 
-use crate::recording::{Recording, Series};
-use crate::tools::recorded_scenario;
+use recording::{Recording, Series};
+use recording::tools::recorded_scenario;
 
 const FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 const SIZE: (u32, u32) = (1200, 600);
@@ -76,11 +76,11 @@ fn views(r: &Recording) -> Vec<View> {
     let n = r.series.keys().filter(|p| p.starts_with("/plant/x/")).count();
     for i in 0..n {
         let (name, unit) = match &scenario {
-            Some(s) if i < s.state_names.len() => (s.state_names[i].clone(), s.state_units[i].clone()),
+            Some(s) if i < s.names.state.len() => (s.names.state[i].name.clone(), s.names.state[i].unit.clone()),
             _ => (format!("x{}", i + 1), String::new()),
         };
-        let mut series = vec![(legend(&format!("/plant/x/{i}")), format!("/plant/x/{i}"))];
-        series.extend(observers.iter().map(|o| (legend(&format!("/observer/{o}/xhat/{i}")), format!("/observer/{o}/xhat/{i}"))));
+        let mut series = vec![(legend(&format!("/plant/x/{}", i + 1)), format!("/plant/x/{}", i + 1))];
+        series.extend(observers.iter().map(|o| (legend(&format!("/observer/{o}/xhat/{}", i + 1)), format!("/observer/{o}/xhat/{}", i + 1))));
         let y_label = if unit.is_empty() { name.clone() } else { format!("{name} [{unit}]") };
         out.push(View { file: format!("state_{}_{}.png", i + 1, sanitize(&name)), title: format!("state x{}: {name}, true and estimated", i + 1), y_label, series });
     }
@@ -110,7 +110,7 @@ fn sanitize(s: &str) -> String {
 }
 
 /// Draws every view of `r` into `dir`; returns the files written.
-pub fn plot(r: &Recording, dir: &Path) -> Result<Vec<PathBuf>, String> {
+fn plot(r: &Recording, dir: &Path) -> Result<Vec<PathBuf>, String> {
     register_font();
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
     let dt = recorded_scenario(r).map(|s| s.dt);
@@ -178,4 +178,10 @@ fn draw(path: &Path, view: &View, curves: &[(String, Vec<(f64, f64)>)], (x0, x1,
     chart.configure_series_labels().position(SeriesLabelPosition::UpperRight).background_style(WHITE.mix(0.85)).border_style(BLACK).label_font(("sans-serif", 15)).draw()?;
     root.present()?;
     Ok(())
+}
+
+fn main() {
+    let a: Vec<String> = std::env::args().collect();
+    let r = recording::read(Path::new(&a[1])).unwrap();
+    for f in plot(&r, Path::new(&a[2])).unwrap() { println!("{}", f.display()); }
 }

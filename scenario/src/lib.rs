@@ -5,6 +5,7 @@
 
 mod locate;
 mod raw;
+pub mod untrusted;
 mod validate;
 
 use std::fmt;
@@ -16,6 +17,7 @@ use lti::Model;
 use observer::Spec;
 
 pub use raw::RawExpect;
+pub use untrusted::{quoted, MAX_SCENARIO_BYTES};
 
 /// A scenario that passed every check.
 #[derive(Debug, Clone)]
@@ -38,10 +40,8 @@ pub struct Scenario {
     pub x0: Vec<f64>,
     /// |x_i| beyond this stops the run.
     pub state_bound: f64,
-    /// State names for plots.
-    pub state_names: Vec<String>,
-    /// State units for plots ("" when unknown).
-    pub state_units: Vec<String>,
+    /// Names and units of every signal, for labels, titles and CSV headers.
+    pub names: SignalNames,
     /// One per column of E.
     pub disturbances: Vec<Signal>,
     /// One per column of D.
@@ -56,6 +56,37 @@ pub struct Scenario {
     pub expect: RawExpect,
     /// The file's text (to locate fields in later messages).
     pub source: String,
+}
+
+/// A name and a unit ("" when unknown) per component of each signal, in order.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SignalNames {
+    /// States x (default x1, x2, …).
+    pub state: Vec<Named>,
+    /// Outputs y (default y1, …).
+    pub output: Vec<Named>,
+    /// Known inputs r, columns of B (default r1, …).
+    pub input: Vec<Named>,
+    /// Unknown inputs w, columns of E (default w1, …).
+    pub disturbance: Vec<Named>,
+    /// Measurement disturbances v, columns of D (default v1, …).
+    pub measurement_disturbance: Vec<Named>,
+}
+
+/// A signal component's name and unit.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Named {
+    /// E.g. "eta", or the default "x3".
+    pub name: String,
+    /// E.g. "rad"; "" when not given.
+    pub unit: String,
+}
+
+impl Named {
+    /// "eta [rad]", or "eta" without a unit.
+    pub fn with_unit(&self) -> String {
+        if self.unit.is_empty() { self.name.clone() } else { format!("{} [{}]", self.name, self.unit) }
+    }
 }
 
 /// One `[[observer]]`.
@@ -90,15 +121,18 @@ pub struct ScenarioError {
 }
 
 impl fmt::Display for ScenarioError {
+    /// One line: the file name, the field path (which may hold a key from the file) and the
+    /// reason (which may quote the file's text) have their control characters escaped.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}", self.file.display())?;
+        use untrusted::one_line;
+        write!(f, "{}", one_line(&self.file.display().to_string()))?;
         if let Some((l, c)) = self.at {
             write!(f, ":{l}:{c}")?;
         }
         if self.field.is_empty() {
-            write!(f, ": {}", self.reason)
+            write!(f, ": {}", one_line(&self.reason))
         } else {
-            write!(f, ": {}: {}", self.field, self.reason)
+            write!(f, ": {}: {}", one_line(&self.field), one_line(&self.reason))
         }
     }
 }
@@ -112,13 +146,13 @@ pub fn locate_error(s: &Scenario, field: &str, reason: String) -> ScenarioError 
 }
 
 impl Scenario {
-    /// Reads and validates a scenario file.
+    /// Reads and validates a scenario file: a regular file of at most [`MAX_SCENARIO_BYTES`].
     pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError {
+        let text = untrusted::read_bounded(path, MAX_SCENARIO_BYTES).map_err(|reason| ScenarioError {
             file: path.to_path_buf(),
             at: None,
             field: String::new(),
-            reason: format!("cannot read: {e}"),
+            reason,
         })?;
         Self::parse(path, &text)
     }

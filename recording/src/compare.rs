@@ -2,7 +2,7 @@
 //! max(abs_tol, rel_tol·|a|) — the rule of Simulink's Data Inspector — or, with no tolerance
 //! given, bit for bit. Latency series are timing, not signals, and are left out.
 
-use crate::recording::Recording;
+use crate::read::Recording;
 
 /// The first disagreement found.
 #[derive(Debug, Clone, PartialEq)]

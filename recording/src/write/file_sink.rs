@@ -9,7 +9,7 @@
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::Path;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use re_log_encoding::{EncodingOptions, Encoder};
@@ -21,7 +21,8 @@ type FileEncoder = Encoder<BufWriter<File>>;
 /// Uncompressed `.rrd` writer; the footer is written when it is dropped.
 pub struct UncompressedFileSink {
     encoder: Mutex<Option<FileEncoder>>,
-    error: Mutex<Option<String>>,
+    /// The first write error, shared with whoever must stop writing when the disk is full.
+    error: Arc<Mutex<Option<String>>>,
 }
 
 impl UncompressedFileSink {
@@ -30,7 +31,13 @@ impl UncompressedFileSink {
         let file = File::create(path).map_err(|e| format!("{}: cannot create: {e}", path.display()))?;
         let encoder = Encoder::new_eager(re_build_info::CrateVersion::LOCAL, EncodingOptions::PROTOBUF_UNCOMPRESSED, BufWriter::with_capacity(1 << 20, file))
             .map_err(|e| format!("{}: {e}", path.display()))?;
-        Ok(Self { encoder: Mutex::new(Some(encoder)), error: Mutex::new(None) })
+        Ok(Self { encoder: Mutex::new(Some(encoder)), error: Arc::new(Mutex::new(None)) })
+    }
+
+    /// Where the first write error is kept: Rerun calls `send` on its own thread and cannot
+    /// return the error, so the recorder polls this instead.
+    pub fn error_slot(&self) -> Arc<Mutex<Option<String>>> {
+        self.error.clone()
     }
 
     fn fail(&self, e: impl std::fmt::Display) {
@@ -67,8 +74,12 @@ impl Drop for UncompressedFileSink {
         if let Ok(mut guard) = self.encoder.lock()
             && let Some(mut enc) = guard.take()
         {
-            let _ = enc.finish();
-            let _ = enc.flush_blocking();
+            // The footer: a failure here (a full disk) is kept for the recorder to report.
+            if let Err(e) = enc.finish() {
+                self.fail(e);
+            } else if let Err(e) = enc.flush_blocking() {
+                self.fail(e);
+            }
         }
     }
 }

@@ -1,7 +1,7 @@
 //! Small helpers shared by the commands that read recordings.
 
-use crate::recording::Recording;
-use crate::scenario::Scenario;
+use crate::read::Recording;
+use scenario::Scenario;
 
 /// The scenario stored in a recording, parsed, if it is there and still valid.
 pub fn recorded_scenario(r: &Recording) -> Option<Scenario> {

@@ -47,10 +47,26 @@ pub struct RawPlant {
     pub x0: Vec<f64>,
     /// |x_i| beyond this stops the run (default 1e9).
     pub state_bound: Option<f64>,
-    /// Names of the states for plots (default x1, x2, …).
+    /// Names of the states for plots and exports (default x1, x2, …).
     pub state_names: Option<Vec<String>>,
-    /// Units of the states for plots.
+    /// Units of the states.
     pub state_units: Option<Vec<String>>,
+    /// Names of the outputs, rows of C (default y1, y2, …).
+    pub output_names: Option<Vec<String>>,
+    /// Units of the outputs.
+    pub output_units: Option<Vec<String>>,
+    /// Names of the known inputs, columns of B (default r1, r2, …).
+    pub input_names: Option<Vec<String>>,
+    /// Units of the known inputs.
+    pub input_units: Option<Vec<String>>,
+    /// Names of the unknown inputs, columns of E (default w1, w2, …).
+    pub disturbance_names: Option<Vec<String>>,
+    /// Units of the unknown inputs.
+    pub disturbance_units: Option<Vec<String>>,
+    /// Names of the measurement disturbances, columns of D (default v1, v2, …).
+    pub measurement_disturbance_names: Option<Vec<String>>,
+    /// Units of the measurement disturbances.
+    pub measurement_disturbance_units: Option<Vec<String>>,
 }
 
 /// One pole as written: a real number, or [re, im] for a complex pair.

@@ -12,7 +12,8 @@ use observer::Spec;
 
 use super::locate::{line_col, offset, parse_path};
 use super::raw::{RawController, RawExpect, RawObserver, RawPole, RawScenario, Rows};
-use super::{ControllerEntry, ObserverEntry, Scenario, ScenarioError};
+use super::untrusted::quoted;
+use super::{ControllerEntry, Named, ObserverEntry, Scenario, ScenarioError, SignalNames};
 
 /// Observer kinds a scenario may name.
 pub const KINDS: [&str; 7] = ["luenberger", "chen-patton-uio", "das-ghosal", "das-ghosal-uio", "gi-full-order", "cumming", "hui-zak-uio"];
@@ -95,6 +96,28 @@ fn signals(field: &str, list: &[Signal], count: usize, source: &str) -> Result<V
     Ok(list.to_vec())
 }
 
+/// `<prefix>_names` and `<prefix>_units`: one entry per component (`count`, described by `what`
+/// with `{}` for the count and `{s}` for its plural), names non-empty; defaults `<letter>1`, `<letter>2`, … and no unit.
+fn names(prefix: &str, names: Option<&Vec<String>>, units: Option<&Vec<String>>, count: usize, what: &str, letter: &str) -> Result<Vec<Named>, Bad> {
+    for (key, list) in [("names", names), ("units", units)] {
+        if let Some(list) = list
+            && list.len() != count
+        {
+            let what = what.replace("{}", &count.to_string()).replace("{s}", if count == 1 { "" } else { "s" });
+            return Err(bad(format!("{prefix}_{key}"), format!("has {} entr{}, {what}", list.len(), if list.len() == 1 { "y" } else { "ies" })));
+        }
+    }
+    if let Some(i) = names.and_then(|v| v.iter().position(|s| s.trim().is_empty())) {
+        return Err(bad(format!("{prefix}_names[{i}]"), "must not be empty"));
+    }
+    Ok((0..count)
+        .map(|i| Named {
+            name: names.map_or_else(|| format!("{letter}{}", i + 1), |v| v[i].clone()),
+            unit: units.map_or_else(String::new, |v| v[i].clone()),
+        })
+        .collect())
+}
+
 fn poles(field: &str, raw: &[RawPole]) -> Result<Poles, Bad> {
     let mut specs = Vec::new();
     for (i, p) in raw.iter().enumerate() {
@@ -111,9 +134,8 @@ fn poles(field: &str, raw: &[RawPole]) -> Result<Poles, Bad> {
             RawPole::Pair(v) => return Err(bad(f, format!("a complex pair is written [re, im]; this has {} numbers", v.len()))),
         }
     }
-    if specs.is_empty() {
-        return Err(bad(field, "must not be empty"));
-    }
+    // An empty list is valid: a design whose pair has only fixed modes takes no free poles, and
+    // the design itself says how many it needs when the count is wrong.
     Poles::new(specs).map_err(|e| bad(field, e.to_string()))
 }
 
@@ -123,15 +145,30 @@ fn placement(field: &str, p: &Option<String>) -> Result<Method, Bad> {
         Some("knv0") => Ok(Method::Knv0),
         Some("matlab") => Ok(Method::Matlab),
         Some("ackermann") => Ok(Method::Ackermann),
-        Some(other) => Err(bad(field, format!("'{other}' is not a placement (robust, knv0, matlab, ackermann)"))),
+        Some(other) => Err(bad(field, format!("{} is not a placement (robust, knv0, matlab, ackermann)", quoted(other)))),
     }
+}
+
+/// Longest scenario or observer name, in characters. Names become file names (the recording,
+/// the summary, PNGs, CSVs, component configurations) and iceoryx2 service names: this keeps
+/// every one of them far below the file system's 255-byte limit, checked before anything is
+/// created.
+pub const MAX_NAME_CHARS: usize = 64;
+
+/// A name: 1 to [`MAX_NAME_CHARS`] ASCII letters, digits, '-' or '_'.
+fn check_name(field: &str, name: &str, why: &str) -> Result<(), Bad> {
+    if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_') {
+        return Err(bad(field, format!("{} must be non-empty letters, digits, '-' or '_' ({why})", quoted(name))));
+    }
+    if name.len() > MAX_NAME_CHARS {
+        return Err(bad(field, format!("{} is {} characters long, at most {MAX_NAME_CHARS} are allowed ({why})", quoted(name), name.len())));
+    }
+    Ok(())
 }
 
 fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
     let _ = path;
-    if raw.name.is_empty() || !raw.name.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_') {
-        return Err(bad("name", format!("'{}' must be non-empty letters, digits, '-' or '_' (it names the recording)", raw.name)));
-    }
+    check_name("name", &raw.name, "it names the recording's files")?;
     let dt = finite("dt", raw.dt)?;
     let duration = finite("duration", raw.duration)?;
     if dt <= 0.0 {
@@ -184,15 +221,20 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
     if layout.len() > lockstep::MAX_VALUES {
         return Err(bad("plant", format!("n + p + q + r + 2l = {} values exceed the {} a sample holds", layout.len(), lockstep::MAX_VALUES)));
     }
-    let names = |field: &str, v: &Option<Vec<String>>, default: &dyn Fn(usize) -> String| -> Result<Vec<String>, Bad> {
-        match v {
-            Some(v) if v.len() != n => Err(bad(field, format!("has {} entries, the plant has {n} states", v.len()))),
-            Some(v) => Ok(v.clone()),
-            None => Ok((0..n).map(default).collect()),
-        }
+    let layout_names = SignalNames {
+        state: names("plant.state", p.state_names.as_ref(), p.state_units.as_ref(), n, "the plant has {} state{s}", "x")?,
+        output: names("plant.output", p.output_names.as_ref(), p.output_units.as_ref(), pn, "C has {} row{s} (outputs)", "y")?,
+        input: names("plant.input", p.input_names.as_ref(), p.input_units.as_ref(), b.ncols(), "B has {} column{s} (known inputs)", "r")?,
+        disturbance: names("plant.disturbance", p.disturbance_names.as_ref(), p.disturbance_units.as_ref(), e.ncols(), "E has {} column{s} (unknown inputs)", "w")?,
+        measurement_disturbance: names(
+            "plant.measurement_disturbance",
+            p.measurement_disturbance_names.as_ref(),
+            p.measurement_disturbance_units.as_ref(),
+            d.ncols(),
+            "D has {} column{s} (measurement disturbances)",
+            "v",
+        )?,
     };
-    let state_names = names("plant.state_names", &p.state_names, &|i| format!("x{}", i + 1))?;
-    let state_units = names("plant.state_units", &p.state_units, &|_| String::new())?;
 
     let disturbances = signals("disturbance", &raw.disturbance, e.ncols(), "plant.E")?;
     let measurement_disturbances = signals("measurement_disturbance", &raw.measurement_disturbance, d.ncols(), "plant.D")?;
@@ -204,11 +246,9 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
     let mut observers = Vec::new();
     for (i, o) in raw.observer.iter().enumerate() {
         let f = format!("observer[{i}]");
-        if o.name.is_empty() || !o.name.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_') {
-            return Err(bad(format!("{f}.name"), format!("'{}' must be non-empty letters, digits, '-' or '_'", o.name)));
-        }
+        check_name(&format!("{f}.name"), &o.name, "it names signals, files and a process")?;
         if !seen.insert(o.name.clone()) {
-            return Err(bad(format!("{f}.name"), format!("two observers are named '{}'", o.name)));
+            return Err(bad(format!("{f}.name"), format!("two observers are named {}", quoted(&o.name))));
         }
         observers.push(ObserverEntry { name: o.name.clone(), spec: observer_spec(&f, o, &model)? });
     }
@@ -226,8 +266,7 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
         model,
         x0: p.x0.clone(),
         state_bound,
-        state_names,
-        state_units,
+        names: layout_names,
         disturbances,
         measurement_disturbances,
         inputs,
@@ -240,7 +279,7 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
 
 fn observer_spec(f: &str, o: &RawObserver, model: &Model) -> Result<Spec, Bad> {
     if !KINDS.contains(&o.kind.as_str()) {
-        return Err(bad(format!("{f}.kind"), format!("'{}' is not an observer kind ({})", o.kind, KINDS.join(", "))));
+        return Err(bad(format!("{f}.kind"), format!("{} is not an observer kind ({})", quoted(&o.kind), KINDS.join(", "))));
     }
     let method = placement(&format!("{f}.placement"), &o.placement)?;
     let needs_poles = || match &o.poles {
@@ -269,10 +308,9 @@ fn observer_spec(f: &str, o: &RawObserver, model: &Model) -> Result<Spec, Bad> {
             if h.is_some() && o.poles.is_some() {
                 return Err(bad(format!("{f}.poles"), "give H or poles, not both (H fixes the poles)"));
             }
-            if h.is_none() && o.poles.is_none() {
-                return Err(bad(format!("{f}.H"), "a das-ghosal-uio observer needs H = [[…]] or poles = […]"));
-            }
-            Spec::DasGhosalUio { h, poles: opt_poles()?, placement: method }
+            // Neither given: no free poles (poles = []), right when every mode of the pair is fixed.
+            let poles = if h.is_none() { Some(opt_poles()?.unwrap_or_else(|| Poles::new([]).expect("empty"))) } else { None };
+            Spec::DasGhosalUio { h, poles, placement: method }
         }
         "cumming" => {
             let h = o.h.as_ref().map(|h| matrix(&format!("{f}.H"), h, (Some(n - p.min(n)), Some(n)), "(n − p)×n, completing C to an invertible [C; H]")).transpose()?;
@@ -286,7 +324,7 @@ fn observer_spec(f: &str, o: &RawObserver, model: &Model) -> Result<Spec, Bad> {
             let path = match o.path.as_deref() {
                 None | Some("placement") => HuiZakPath::Placement,
                 Some("lmi") => HuiZakPath::Lmi,
-                Some(other) => return Err(bad(format!("{f}.path"), format!("'{other}' is not a design path (placement, lmi)"))),
+                Some(other) => return Err(bad(format!("{f}.path"), format!("{} is not a design path (placement, lmi)", quoted(other)))),
             };
             Spec::HuiZak { decay, poles: opt_poles()?, placement: method, path }
         }
@@ -296,11 +334,11 @@ fn observer_spec(f: &str, o: &RawObserver, model: &Model) -> Result<Spec, Bad> {
 
 fn controller_entry(c: &RawController, model: &Model, observers: &BTreeSet<String>) -> Result<ControllerEntry, Bad> {
     if c.kind != "state-feedback" {
-        return Err(bad("controller.kind", format!("'{}' is not a controller kind (state-feedback)", c.kind)));
+        return Err(bad("controller.kind", format!("{} is not a controller kind (state-feedback)", quoted(&c.kind))));
     }
     if !observers.contains(&c.observer) {
         let known: Vec<&str> = observers.iter().map(String::as_str).collect();
-        return Err(bad("controller.observer", format!("no observer named '{}' (observers: {})", c.observer, known.join(", "))));
+        return Err(bad("controller.observer", format!("no observer named {} (observers: {})", quoted(&c.observer), known.join(", "))));
     }
     let method = placement("controller.placement", &c.placement)?;
     let spec = match (&c.poles, &c.gain) {
@@ -314,7 +352,7 @@ fn controller_entry(c: &RawController, model: &Model, observers: &BTreeSet<Strin
 
 fn check_expect(e: &RawExpect, observers: &BTreeSet<String>) -> Result<(), Bad> {
     let known = |field: &str, name: &str| {
-        if observers.contains(name) { Ok(()) } else { Err(bad(field, format!("no observer named '{name}'"))) }
+        if observers.contains(name) { Ok(()) } else { Err(bad(field, format!("no observer named {}", quoted(name)))) }
     };
     let positive = |field: &str, v: f64| {
         if v.is_finite() && v > 0.0 { Ok(()) } else { Err(bad(field, format!("{v} must be a finite number > 0"))) }
@@ -330,7 +368,7 @@ fn check_expect(e: &RawExpect, observers: &BTreeSet<String>) -> Result<(), Bad> 
         for (pair, &v) in map {
             let f = format!("expect.{table}");
             let Some((a, b)) = pair.split_once('/') else {
-                return Err(bad(f, format!("'{pair}' must name two observers as \"a/b\"")));
+                return Err(bad(f, format!("{} must name two observers as \"a/b\"", quoted(pair))));
             };
             known(&f, a)?;
             known(&f, b)?;

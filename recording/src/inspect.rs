@@ -6,8 +6,8 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use crate::record::{histogram, nan_max, Latency, Percentiles};
-use crate::recording::Recording;
+use crate::write::{histogram, nan_max, Latency, Percentiles};
+use crate::read::Recording;
 use crate::tools::recorded_scenario;
 
 /// One entity.
@@ -28,10 +28,11 @@ pub struct EntityInfo {
 pub struct ObserverFigures {
     /// Name.
     pub name: String,
-    /// max |x − x̂| over the last quarter of the run.
-    pub tail_max_abs_error: f64,
-    /// max |y − Cx̂| over the last quarter of the run.
-    pub tail_max_abs_residual: f64,
+    /// max |x − x̂| over the last quarter of the steps recorded (as the run's summary defines
+    /// it, [`crate::write::tail`]); `None` with fewer than 4 steps.
+    pub tail_max_abs_error: Option<f64>,
+    /// max |y − Cx̂| over the same tail.
+    pub tail_max_abs_residual: Option<f64>,
 }
 
 /// Latency percentiles recomputed from the recording, ns.
@@ -70,7 +71,7 @@ pub struct Inspection {
 pub fn inspect(file: &str, r: &Recording) -> Inspection {
     let scenario = recorded_scenario(r);
     let dt = scenario.as_ref().map(|s| s.dt);
-    let steps_recorded = r.series.get("/plant/x/0").map_or(0, |s| s.values.len() as u64);
+    let steps_recorded = r.series.get(&crate::signals::state(0)).map_or(0, |s| s.values.len() as u64);
     let steps_planned = scenario.as_ref().map(|s| s.steps);
     let mut warnings = Vec::new();
     if !r.complete {
@@ -92,15 +93,17 @@ pub fn inspect(file: &str, r: &Recording) -> Inspection {
             EntityInfo { path: path.clone(), rows: s.values.len(), steps, sim_time: dt.map(|dt| [steps[0] as f64 * dt, steps[1] as f64 * dt]) }
         })
         .collect();
-    // The tail as the run defined it: the last quarter of the planned steps.
-    let total = steps_planned.unwrap_or(steps_recorded) as i64;
-    let tail_start = total - total / 4;
-    let tail_max = |prefix: &str| -> f64 {
-        r.series
-            .iter()
-            .filter(|(p, _)| p.starts_with(prefix))
-            .flat_map(|(_, s)| s.steps.iter().zip(&s.values).filter(|(k, _)| **k >= tail_start).map(|(_, v)| v.abs()))
-            .fold(0.0, nan_max)
+    // The tail as the run defined it: the last quarter of the steps it completed.
+    let tail_start = crate::write::tail::tail_start(steps_recorded, steps_planned.unwrap_or(steps_recorded)).map(|s| s as i64);
+    let tail_max = |prefix: &str| -> Option<f64> {
+        let start = tail_start?;
+        Some(
+            r.series
+                .iter()
+                .filter(|(p, _)| p.starts_with(prefix))
+                .flat_map(|(_, s)| s.steps.iter().zip(&s.values).filter(|(k, _)| **k >= start).map(|(_, v)| v.abs()))
+                .fold(0.0, nan_max),
+        )
     };
     let mut names: Vec<String> = r
         .series
@@ -167,7 +170,8 @@ impl Inspection {
         }
         t += &format!("  {:<14} {:>14} {:>14}\n", "observer", "tail max|e|", "tail max|r|");
         for o in &self.observers {
-            t += &format!("  {:<14} {:>14.3e} {:>14.3e}\n", o.name, o.tail_max_abs_error, o.tail_max_abs_residual);
+            let figure = |v: Option<f64>| v.map_or_else(|| "—".to_string(), |v| format!("{v:.3e}"));
+            t += &format!("  {:<14} {:>14} {:>14}\n", o.name, figure(o.tail_max_abs_error), figure(o.tail_max_abs_residual));
         }
         let p = &self.latency_ns.step;
         if p.max > 0 {

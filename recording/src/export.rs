@@ -1,14 +1,19 @@
 //! `launcher export --csv DIR`: one CSV per entity group (e.g. `/observer/uio/error` →
-//! `observer_uio_error.csv`) with columns `step,sim_time,<member>…`. Floats are written in
-//! Rust's shortest round-trip form, so they parse back to the same bits.
+//! `observer_uio_error.csv`) with columns `step,sim_time,<member>…`, each member headed by its
+//! name and unit from the recorded scenario (`eta [rad]`, `e3 [rad]`, `plant->observer/uio [ns]`).
+//! Floats are written in Rust's shortest round-trip form, so they parse back to the same bits.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use crate::recording::{Recording, Series};
+use scenario::Scenario;
 
-/// Groups series by their parent path: "/plant/x/0" → ("/plant/x", "0").
+use crate::read::{Recording, Series};
+use crate::signals;
+use crate::tools::recorded_scenario;
+
+/// Groups series by their parent path: "/plant/x/1" → ("/plant/x", "1").
 pub fn groups(r: &Recording) -> BTreeMap<String, Vec<(String, &Series)>> {
     let mut out: BTreeMap<String, Vec<(String, &Series)>> = BTreeMap::new();
     for (path, s) in &r.series {
@@ -29,9 +34,30 @@ pub fn file_name(group: &str) -> String {
     format!("{}.csv", group.trim_start_matches('/').replace('/', "_"))
 }
 
+/// The column header of `member` of `group`: the signal's name and unit where the scenario is
+/// known (`eta [rad]`), a latency's hop name in ns (the `step` member becomes `step_latency`,
+/// not a second `step` column), else the member itself.
+pub fn header(s: Option<&Scenario>, r: &Recording, group: &str, member: &str) -> String {
+    let path = format!("{group}/{member}");
+    if group == "/latency" {
+        let name = if member == "step" { "step_latency".to_string() } else { r.names.get(&path).cloned().unwrap_or_else(|| member.to_string()) };
+        return csv_field(&format!("{name} [ns]"));
+    }
+    match signals::named(s, &path) {
+        Some(n) => csv_field(&n.with_unit()),
+        None => csv_field(member),
+    }
+}
+
+/// Quotes a field holding a comma or a quote (RFC 4180).
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n']) { format!("\"{}\"", s.replace('"', "\"\"")) } else { s.to_string() }
+}
+
 /// Writes the CSV files; returns them. `dt` converts steps to sim_time.
 pub fn export(r: &Recording, dir: &Path, dt: Option<f64>) -> Result<Vec<PathBuf>, String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
+    let scenario = recorded_scenario(r);
     let mut written = Vec::new();
     for (group, members) in groups(r) {
         // Union of steps (series of one group share them; latency may lag by one).
@@ -40,7 +66,7 @@ pub fn export(r: &Recording, dir: &Path, dt: Option<f64>) -> Result<Vec<PathBuf>
         steps.dedup();
         let mut text = String::from("step,sim_time");
         for (m, _) in &members {
-            text += &format!(",{m}");
+            text += &format!(",{}", header(scenario.as_ref(), r, &group, m));
         }
         text.push('\n');
         let mut cursors = vec![0usize; members.len()];

@@ -7,12 +7,15 @@ mod file_sink;
 mod latency;
 mod metrics;
 mod rrd;
+mod select;
+pub mod tail;
 
 pub use blueprint::blueprint;
 pub use file_sink::UncompressedFileSink;
 pub use latency::{histogram, Latency, Percentiles};
 pub use metrics::{nan_max, Metrics, ObserverFigures};
 pub use rrd::{RrdSink, SeriesId};
+pub use select::Selection;
 
 use lockstep::{Header, PlantLayout};
 

@@ -1,20 +1,21 @@
 //! Figures of merit, accumulated step by step: per observer the largest |x − x̂| and |y − Cx̂|
-//! over the last quarter of the run (the "tail", after transients), and between observers the
-//! largest difference of their estimates at any step.
+//! over the last quarter of the steps completed (the "tail", after transients; see [`super::tail`]),
+//! and between observers the largest difference of their estimates at any step.
 
 use lockstep::PlantLayout;
 use lti::kernel::mul_into;
 use lti::Mat;
 
+use super::tail::{tail_start, BlockMax};
 use super::StepRow;
 
 /// The figures of one observer.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ObserverFigures {
-    /// max_k≥tail max_i |x_i − x̂_i|.
-    pub tail_max_abs_error: f64,
+    /// max_k≥tail max_i |x_i − x̂_i|; `None` when the run has no tail (fewer than 4 steps).
+    pub tail_max_abs_error: Option<f64>,
     /// max_k≥tail max_j |y_j − (Cx̂)_j|.
-    pub tail_max_abs_residual: f64,
+    pub tail_max_abs_residual: Option<f64>,
     /// max over the whole run of max_i |x_i − x̂_i|.
     pub max_abs_error: f64,
     /// max_i |x_i − x̂_i| at the last step.
@@ -33,7 +34,9 @@ pub fn nan_max(a: f64, b: f64) -> f64 {
 pub struct Metrics {
     layout: PlantLayout,
     c: Mat,
-    tail_start: u64,
+    planned: u64,
+    /// Per observer, block maxima of max_i |e_i| and max_j |r_j| (the tail of an early stop).
+    blocks: Vec<[BlockMax; 2]>,
     /// Per observer.
     pub observers: Vec<ObserverFigures>,
     /// max_k max_i |x̂_a − x̂_b| for each pair (a, b), a < b.
@@ -58,7 +61,8 @@ impl Metrics {
         Metrics {
             layout,
             c,
-            tail_start: steps - steps / 4,
+            planned: steps,
+            blocks: (0..observers).map(|_| [BlockMax::new(steps), BlockMax::new(steps)]).collect(),
             observers: vec![ObserverFigures::default(); observers],
             differences,
             steps: 0,
@@ -67,16 +71,24 @@ impl Metrics {
         }
     }
 
-    /// The first step of the tail.
-    pub fn tail_start(&self) -> u64 {
-        self.tail_start
+    /// The first step of the tail of the steps completed so far.
+    pub fn tail_start(&self) -> Option<u64> {
+        tail_start(self.steps, self.planned)
+    }
+
+    /// Sets each observer's tail figures from the steps completed; call once the run has ended.
+    pub fn finish(&mut self) {
+        let start = self.tail_start();
+        for (f, [e, r]) in self.observers.iter_mut().zip(&self.blocks) {
+            f.tail_max_abs_error = start.map(|s| e.max_from(s));
+            f.tail_max_abs_residual = start.map(|s| r.max_from(s));
+        }
     }
 
     /// Adds one step.
     pub fn push(&mut self, row: &StepRow) {
         let x = &row.plant[self.layout.x()];
         let y = &row.plant[self.layout.y()];
-        let tail = row.k >= self.tail_start;
         for (o, xhat) in row.xhat.iter().enumerate() {
             let mut emax: f64 = 0.0;
             for i in 0..self.layout.n {
@@ -94,10 +106,9 @@ impl Metrics {
             let f = &mut self.observers[o];
             f.max_abs_error = nan_max(f.max_abs_error, emax);
             f.final_abs_error = emax;
-            if tail {
-                f.tail_max_abs_error = nan_max(f.tail_max_abs_error, emax);
-                f.tail_max_abs_residual = nan_max(f.tail_max_abs_residual, rmax);
-            }
+            let [be, br] = &mut self.blocks[o];
+            be.push(row.k, emax);
+            br.push(row.k, rmax);
         }
         for ((a, b), d) in self.differences.iter_mut() {
             for i in 0..self.layout.n {

@@ -1,0 +1,433 @@
+//! The matrix exponential e^{Mh}, correctly rounded in practice.
+//!
+//! Method: the scaling and squaring algorithm of Al-Mohy & Higham, "A new scaling and squaring
+//! algorithm for the matrix exponential", SIAM J. Matrix Anal. Appl. 31(3), 2009 (Algorithm 5.1),
+//! with its evaluation carried out in double-double arithmetic (Dekker, "A floating-point
+//! technique for extending the available precision", Numer. Math. 18, 1971).
+//!
+//! With X = Mh, the [m/m] Padé approximant of e^x is r_m = q_m(x)⁻¹ p_m(x),
+//!
+//! ```text
+//! p_m(x) = Σ_{j=0}^{m} b_j x^j,   b_j = (2m − j)! / (j! (m − j)!),   q_m(x) = p_m(−x),
+//! p_m(X) = V + U,  q_m(X) = V − U,   U = X Σ_j b_{2j+1} X^{2j},  V = Σ_j b_{2j} X^{2j}
+//! ```
+//!
+//! (for m = 13, U = X[X⁶(b₁₃X⁶ + b₁₁X⁴ + b₉X²) + b₇X⁶ + b₅X⁴ + b₃X² + b₁I] and V likewise, the
+//! paper's scheme), and e^X ≈ r_m(2^{−s}X)^{2^s}. In exact arithmetic that is e^{X + ΔX} with
+//! ΔX = 2^s h_{2m+1}(2^{−s}X), h_{2m+1}(Y) = log(e^{−Y} r_m(Y)) a power series in Y from Y^{2m+1} on
+//! (Higham 2005, SIAM J. Matrix Anal. Appl. 26(4)), bounded by
+//!
+//! ```text
+//! ‖ΔX‖/‖X‖ ≤ h̃_{2m+1}(α_p)/α_p,  α_p = max(d_p, d_{p+1}),  d_k = ‖(2^{−s}X)^k‖₁^{1/k},  2m + 1 ≥ p(p − 1)
+//! ```
+//!
+//! with h̃ the series of |coefficients|. θ_m is the largest α for which that bound is ≤ u = 2⁻⁵³
+//! (Higham 2005's values, which the 2009 paper keeps). Algorithm 5.1 picks the cheapest
+//! m ∈ {3, 5, 7, 9} with α ≤ θ_m, else m = 13 with the smallest such s, each time with
+//! ℓ(A, m) = max(⌈log₂(α/u)/(2m)⌉, 0), α = |c_{2m+1}|·‖|A|^{2m+1}‖₁/‖A‖₁, |c_{2m+1}| =
+//! (m!)²/((2m)!(2m+1)!), the squarings that keep the rounding errors of evaluating r_m in check.
+//! The norms here are exact (the matrices are small), not the paper's estimates.
+//!
+//! Why not plain double precision (nalgebra's `exp()`, a port of the same algorithm): the bound is
+//! normwise. For the stiff missile autopilot (entries 10⁻³ … 3·10⁴, dt = 10⁻⁴: m = 13, s = 0,
+//! ‖X‖₁ ≈ 3.3) the small entries of Φ = e^{Ah} carry errors of ~u·‖Φ‖, i.e. thousands of ulps of
+//! themselves. So here, after choosing (m, s) as above,
+//!
+//! 1. X = M·h is formed exactly (hi + lo, by a fused multiply-add);
+//! 2. s is raised by j = ⌈53/(2m)⌉: since h̃_{2m+1} has non-negative coefficients from x^{2m+1} on,
+//!    h̃(α/2^j)/(α/2^j) ≤ 2^{−2mj} h̃(α)/α, so the truncation bound drops from u to ≤ u²;
+//! 3. the powers, the solve of q_m·R = p_m (Gaussian elimination, partial pivoting) and the
+//!    squaring phase all run in double-double (unit roundoff ≈ 2⁻¹⁰⁴), so the squarings — the
+//!    step the paper's Code Fragment 2.1 makes exact for triangular matrices only — add no
+//!    double-precision rounding either;
+//! 4. each entry is rounded to double once, at the end.
+//!
+//! Every entry, however small beside the norm, then sits within its own final rounding of the
+//! exact value (≤ 0.5 ulp on every seed model; lti/tests/expm_reference.rs checks against 40-digit
+//! values). Balancing (D⁻¹XD with D a diagonal of powers of two) was tried and left out: with
+//! steps 1–4 it changes nothing on the seed models, and in plain double precision it helps a full
+//! step of the missile but costs ~300 ulps on part of a step (it lowers m while Γ's entries stay
+//! graded). Block-triangular structure survives exactly: the zero blocks of [[A, G], [0, W]] stay
+//! 0 through every product, and the solve never pivots into them. Set-up code only: it allocates.
+
+use nalgebra::DMatrix;
+
+/// Unit roundoff of IEEE double precision, the u of the paper's θ_m.
+const U: f64 = 1.1102230246251565e-16;
+
+/// θ_m for m = 3, 5, 7, 9, 13 at u = 2⁻⁵³ (Higham 2005; Al-Mohy & Higham 2009).
+const THETA: [(usize, f64); 5] = [
+    (3, 1.495585217958292e-2),
+    (5, 2.539398330063230e-1),
+    (7, 9.504178996162932e-1),
+    (9, 2.097847961257068e0),
+    (13, 5.371920351148152e0),
+];
+
+/// e^{Mh} for a square M, with the product M·h formed exactly.
+pub fn expm(m: &DMatrix<f64>, h: f64) -> DMatrix<f64> {
+    let n = m.nrows();
+    assert_eq!(n, m.ncols(), "expm of a non-square matrix");
+    if n == 0 {
+        return DMatrix::zeros(0, 0);
+    }
+    if !h.is_finite() || m.iter().any(|x| !x.is_finite()) {
+        return DMatrix::from_element(n, n, f64::NAN);
+    }
+    // X = M h exactly, row-major.
+    let x = DdMat { n, v: (0..n * n).map(|k| two_prod(m[(k / n, k % n)], h)).collect() };
+    let xf = DMatrix::from_fn(n, n, |i, j| x.v[i * n + j].hi);
+    let (deg, s) = degree_and_scaling(&xf);
+    // Step 2: truncation bound from u to u².
+    let s = s + 53usize.div_ceil(2 * deg);
+    let y = x.scaled(2f64.powi(-(s as i32)));
+    let mut r = pade(&y, deg);
+    for _ in 0..s {
+        r = r.mul(&r);
+    }
+    DMatrix::from_fn(n, n, |i, j| r.v[i * n + j].to_f64())
+}
+
+/// (m, s) of Al-Mohy & Higham (2009), Algorithm 5.1, steps 1–16, with exact norms.
+fn degree_and_scaling(a: &DMatrix<f64>) -> (usize, usize) {
+    let norm = |p: &DMatrix<f64>| one_norm(p);
+    let a2 = a * a;
+    let a4 = &a2 * &a2;
+    let a6 = &a4 * &a2;
+    let a8 = &a4 * &a4;
+    let a10 = &a8 * &a2;
+    let d = |p: &DMatrix<f64>, k: i32| norm(p).powf(1.0 / k as f64);
+    let (d4, d6, d8, d10) = (d(&a4, 4), d(&a6, 6), d(&a8, 8), d(&a10, 10));
+    let eta1 = d4.max(d6);
+    let eta3 = d6.max(d8);
+    for &(m, theta) in &THETA[..4] {
+        let eta = if m <= 5 { eta1 } else { eta3 };
+        if eta <= theta && ell(a, m) == 0 {
+            return (m, 0);
+        }
+    }
+    let eta5 = eta3.min(d8.max(d10));
+    let theta13 = THETA[4].1;
+    let mut s = if eta5 > 0.0 { (eta5 / theta13).log2().ceil().max(0.0) as usize } else { 0 };
+    // A norm so large that e^X overflows anyway: no point squaring more than that.
+    s = s.min(1100);
+    s += ell(&(a * 2f64.powi(-(s as i32))), 13);
+    (13, s.min(1100))
+}
+
+/// ℓ(A, m) of Al-Mohy & Higham (2009), Algorithm 5.1: the squarings that keep the rounding errors
+/// of evaluating r_m below the truncation error u when |A| has much larger powers than A.
+fn ell(a: &DMatrix<f64>, m: usize) -> usize {
+    let n1 = one_norm(a);
+    if n1 == 0.0 {
+        return 0;
+    }
+    // ‖|A|^{2m+1}‖₁ = max of (|A|ᵀ)^{2m+1}·1 (non-negative matrix: no cancellation).
+    let abs_t = a.map(f64::abs).transpose();
+    let mut v = nalgebra::DVector::from_element(a.nrows(), 1.0);
+    for _ in 0..2 * m + 1 {
+        v = &abs_t * v;
+    }
+    let power = v.max();
+    // |c_{2m+1}| = (m!)² / ((2m)! (2m+1)!), as a running product to stay in range.
+    let mut c = 1.0f64;
+    for k in 1..=m {
+        c *= k as f64 / (m + k) as f64; // m!·m!/(2m)! = Π m!/((m+1)…(2m)) step by step
+    }
+    for k in 1..=2 * m + 1 {
+        c /= k as f64;
+    }
+    let alpha = c * power / n1;
+    if alpha <= 0.0 {
+        return 0;
+    }
+    ((alpha / U).log2() / (2 * m) as f64).ceil().max(0.0) as usize
+}
+
+fn one_norm(a: &DMatrix<f64>) -> f64 {
+    a.column_iter().map(|c| c.iter().map(|x| x.abs()).sum::<f64>()).fold(0.0, f64::max)
+}
+
+/// b_j = (2m − j)! / (j! (m − j)!), j = 0 … m: integers (exact in u128 and in double-double).
+fn pade_coefficients(m: usize) -> Vec<Dd> {
+    let fact = |k: usize| (1..=k as u128).product::<u128>();
+    (0..=m).map(|j| Dd::from_u128(fact(2 * m - j) / (fact(j) * fact(m - j)))).collect()
+}
+
+/// r_m(Y) = q_m(Y)⁻¹ p_m(Y) in double-double.
+fn pade(y: &DdMat, m: usize) -> DdMat {
+    let n = y.n;
+    let b = pade_coefficients(m);
+    let id = DdMat::identity(n);
+    let y2 = y.mul(y);
+    let (u, v) = if m == 13 {
+        let y4 = y2.mul(&y2);
+        let y6 = y4.mul(&y2);
+        let lin = |c: [(usize, &DdMat); 3]| {
+            let mut acc = DdMat::zeros(n);
+            for (k, p) in c {
+                acc.add_scaled(p, b[k]);
+            }
+            acc
+        };
+        let mut inner_u = y6.mul(&lin([(13, &y6), (11, &y4), (9, &y2)]));
+        inner_u.add_scaled(&y6, b[7]);
+        inner_u.add_scaled(&y4, b[5]);
+        inner_u.add_scaled(&y2, b[3]);
+        inner_u.add_scaled(&id, b[1]);
+        let mut v = y6.mul(&lin([(12, &y6), (10, &y4), (8, &y2)]));
+        v.add_scaled(&y6, b[6]);
+        v.add_scaled(&y4, b[4]);
+        v.add_scaled(&y2, b[2]);
+        v.add_scaled(&id, b[0]);
+        (y.mul(&inner_u), v)
+    } else {
+        let mut odd = DdMat::zeros(n);
+        let mut v = DdMat::zeros(n);
+        let mut p = id;
+        for j in 0..=m / 2 {
+            odd.add_scaled(&p, b[2 * j + 1]);
+            v.add_scaled(&p, b[2 * j]);
+            if j < m / 2 {
+                p = p.mul(&y2);
+            }
+        }
+        (y.mul(&odd), v)
+    };
+    let mut q = v.clone();
+    q.add_scaled(&u, Dd::from(-1.0));
+    let mut p = v;
+    p.add_scaled(&u, Dd::from(1.0));
+    q.solve(p)
+}
+
+/// A double-double number hi + lo with |lo| ≤ ulp(hi)/2.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Dd {
+    hi: f64,
+    lo: f64,
+}
+
+impl From<f64> for Dd {
+    fn from(hi: f64) -> Self {
+        Dd { hi, lo: 0.0 }
+    }
+}
+
+/// a + b exactly (Knuth).
+fn two_sum(a: f64, b: f64) -> Dd {
+    let s = a + b;
+    let bb = s - a;
+    Dd { hi: s, lo: (a - (s - bb)) + (b - bb) }
+}
+
+/// a + b exactly, for |a| ≥ |b| (Dekker).
+fn quick_two_sum(a: f64, b: f64) -> Dd {
+    let s = a + b;
+    Dd { hi: s, lo: b - (s - a) }
+}
+
+/// a·b exactly: the fused multiply-add returns the rounding error of the product.
+fn two_prod(a: f64, b: f64) -> Dd {
+    let p = a * b;
+    Dd { hi: p, lo: a.mul_add(b, -p) }
+}
+
+impl Dd {
+    const ZERO: Dd = Dd { hi: 0.0, lo: 0.0 };
+
+    fn from_u128(x: u128) -> Dd {
+        let hi = x as f64;
+        // x − hi is exact in i128 and below 2⁵³ for the coefficients used here.
+        let lo = (x as i128 - hi as i128) as f64;
+        quick_two_sum(hi, lo)
+    }
+
+    fn add(self, o: Dd) -> Dd {
+        let s = two_sum(self.hi, o.hi);
+        let t = two_sum(self.lo, o.lo);
+        let u = quick_two_sum(s.hi, s.lo + t.hi);
+        quick_two_sum(u.hi, u.lo + t.lo)
+    }
+
+    fn neg(self) -> Dd {
+        Dd { hi: -self.hi, lo: -self.lo }
+    }
+
+    fn sub(self, o: Dd) -> Dd {
+        self.add(o.neg())
+    }
+
+    fn mul(self, o: Dd) -> Dd {
+        let p = two_prod(self.hi, o.hi);
+        quick_two_sum(p.hi, p.lo + (self.hi * o.lo + self.lo * o.hi))
+    }
+
+    fn div(self, o: Dd) -> Dd {
+        let q1 = self.hi / o.hi;
+        let r = self.sub(o.mul(Dd::from(q1)));
+        let q2 = r.hi / o.hi;
+        let r = r.sub(o.mul(Dd::from(q2)));
+        let q3 = r.hi / o.hi;
+        quick_two_sum(q1, q2).add(Dd::from(q3))
+    }
+
+    /// Rounded to the nearest double.
+    fn to_f64(self) -> f64 {
+        self.hi + self.lo
+    }
+}
+
+/// A square double-double matrix, row-major.
+#[derive(Debug, Clone)]
+struct DdMat {
+    n: usize,
+    v: Vec<Dd>,
+}
+
+impl DdMat {
+    fn zeros(n: usize) -> Self {
+        DdMat { n, v: vec![Dd::ZERO; n * n] }
+    }
+
+    fn identity(n: usize) -> Self {
+        let mut m = Self::zeros(n);
+        for i in 0..n {
+            m.v[i * n + i] = Dd::from(1.0);
+        }
+        m
+    }
+
+    /// Every entry times a power of two (exact).
+    fn scaled(&self, pow2: f64) -> Self {
+        DdMat { n: self.n, v: self.v.iter().map(|x| Dd { hi: x.hi * pow2, lo: x.lo * pow2 }).collect() }
+    }
+
+    fn mul(&self, o: &DdMat) -> DdMat {
+        let n = self.n;
+        let mut out = Self::zeros(n);
+        for i in 0..n {
+            for k in 0..n {
+                let a = self.v[i * n + k];
+                if a.hi == 0.0 {
+                    continue; // keeps structural zeros exact and skips work
+                }
+                for j in 0..n {
+                    let b = o.v[k * n + j];
+                    if b.hi != 0.0 {
+                        out.v[i * n + j] = out.v[i * n + j].add(a.mul(b));
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// self += c·o.
+    fn add_scaled(&mut self, o: &DdMat, c: Dd) {
+        for (x, y) in self.v.iter_mut().zip(&o.v) {
+            if y.hi != 0.0 {
+                *x = x.add(c.mul(*y));
+            }
+        }
+    }
+
+    /// self⁻¹·rhs by Gaussian elimination with partial pivoting.
+    fn solve(mut self, mut rhs: DdMat) -> DdMat {
+        let n = self.n;
+        for c in 0..n {
+            let p = (c..n).max_by(|&i, &j| self.v[i * n + c].hi.abs().total_cmp(&self.v[j * n + c].hi.abs())).unwrap_or(c);
+            if p != c {
+                for j in 0..n {
+                    self.v.swap(c * n + j, p * n + j);
+                    rhs.v.swap(c * n + j, p * n + j);
+                }
+            }
+            let piv = self.v[c * n + c];
+            for i in c + 1..n {
+                if self.v[i * n + c].hi == 0.0 {
+                    continue;
+                }
+                let f = self.v[i * n + c].div(piv);
+                for j in c..n {
+                    self.v[i * n + j] = self.v[i * n + j].sub(f.mul(self.v[c * n + j]));
+                }
+                for j in 0..n {
+                    rhs.v[i * n + j] = rhs.v[i * n + j].sub(f.mul(rhs.v[c * n + j]));
+                }
+            }
+        }
+        for i in (0..n).rev() {
+            for j in 0..n {
+                let mut acc = rhs.v[i * n + j];
+                for k in i + 1..n {
+                    acc = acc.sub(self.v[i * n + k].mul(rhs.v[k * n + j]));
+                }
+                rhs.v[i * n + j] = acc.div(self.v[i * n + i]);
+            }
+        }
+        rhs
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pade_coefficients_are_the_papers() {
+        // b_j for m = 3 and two of m = 13 (the textbook [m/m] coefficients, scaled so b_m = 1).
+        let b3: Vec<f64> = pade_coefficients(3).iter().map(|x| x.to_f64()).collect();
+        assert_eq!(b3, [120.0, 60.0, 12.0, 1.0]);
+        let b13 = pade_coefficients(13);
+        assert_eq!(b13[0].to_f64(), 64_764_752_532_480_000.0);
+        assert_eq!(b13[12].to_f64(), 182.0);
+        // e^x − r_3(x) = ±(3!)²/(6!·7!)·x⁷·(1 + O(x)): a wrong b_j would leave
+        // an error of order x^j, j ≤ 6, hundreds of times larger at x = 0.1.
+        let x = 0.1f64;
+        let p: f64 = b3.iter().enumerate().map(|(j, b)| b * x.powi(j as i32)).sum();
+        let q: f64 = b3.iter().enumerate().map(|(j, b)| b * (-x).powi(j as i32)).sum();
+        let lead = 36.0 / (720.0 * 5040.0) * x.powi(7);
+        assert!(((p / q - x.exp()) / lead - 1.0).abs() < 0.2, "{}", (p / q - x.exp()) / lead);
+    }
+
+    #[test]
+    fn double_double_products_are_exact() {
+        let (a, b) = (0.1f64, 3.0f64);
+        let p = two_prod(a, b);
+        // 0.1·3 = 0.30000000000000001665…: hi is the rounded product, lo what rounding dropped.
+        assert_eq!(p.hi, 0.30000000000000004);
+        assert_eq!(p.lo, -2.7755575615628914e-17);
+        let q = Dd::from(1.0).div(Dd::from(3.0));
+        let back = q.mul(Dd::from(3.0)).sub(Dd::from(1.0));
+        assert!(back.hi.abs() < 1e-31);
+    }
+
+    #[test]
+    fn scalar_and_rotation_against_closed_forms() {
+        // e^{−2·0.1} and the rotation exp([[0, ω], [−ω, 0]]h) = [[cos, sin], [−sin, cos]](ωh).
+        let e = expm(&DMatrix::from_element(1, 1, -2.0), 0.1)[(0, 0)];
+        assert!((e - (-0.2f64).exp()).abs() <= f64::EPSILON * e);
+        let w = 7.0;
+        let r = expm(&DMatrix::from_row_slice(2, 2, &[0.0, w, -w, 0.0]), 0.25);
+        let (s, c) = (1.75f64).sin_cos();
+        for (got, want) in r.iter().zip([c, -s, s, c]) {
+            assert!((got - want).abs() <= f64::EPSILON * want.abs(), "{got} vs {want}");
+        }
+    }
+
+    #[test]
+    fn nilpotent_and_large_norms() {
+        // e^{N} = I + N + N²/2 exactly for a nilpotent Jordan block.
+        let nil = DMatrix::from_row_slice(3, 3, &[0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]);
+        let e = expm(&nil, 3.0);
+        assert_eq!(e, DMatrix::from_row_slice(3, 3, &[1.0, 3.0, 4.5, 0.0, 1.0, 3.0, 0.0, 0.0, 1.0]));
+        // Many squarings: diag(−50, −60)·1: e^{−50}, e^{−60} to the last bit.
+        let e = expm(&DMatrix::from_row_slice(2, 2, &[-50.0, 0.0, 0.0, -60.0]), 1.0);
+        assert_eq!(e[(0, 1)], 0.0);
+        assert!((e[(0, 0)] / (-50.0f64).exp() - 1.0).abs() <= f64::EPSILON);
+        assert!((e[(1, 1)] / (-60.0f64).exp() - 1.0).abs() <= f64::EPSILON);
+        assert!(expm(&DMatrix::from_element(2, 2, f64::NAN), 1.0)[(0, 0)].is_nan());
+        assert_eq!(expm(&DMatrix::zeros(0, 0), 1.0).nrows(), 0);
+    }
+}

@@ -1,0 +1,135 @@
+//! The colours of every picture of a run, shared by the Rerun blueprint and the PNG plots so an
+//! observer has one colour everywhere: the true state is grey (visible on white paper and on
+//! Rerun's dark background), each observer takes the next colour of a palette of saturated,
+//! dark-enough hues (Okabe–Ito and Tableau, without their pale yellows).
+
+/// An sRGB colour.
+pub type Rgb = [u8; 3];
+
+/// The true state (and any reference signal an estimate is drawn over).
+pub const TRUE_STATE: Rgb = [140, 140, 140];
+
+/// Observers in scenario order; other signal groups (inputs, outputs, latency hops) take the
+/// same sequence by component.
+const PALETTE: [Rgb; 8] = [
+    [0, 114, 178],   // blue
+    [213, 94, 0],    // vermilion
+    [0, 158, 115],   // bluish green
+    [148, 103, 189], // purple
+    [204, 51, 119],  // crimson
+    [140, 86, 75],   // brown
+    [23, 160, 190],  // cyan, darkened
+    [120, 120, 20],  // olive
+];
+
+/// The colour of the `i`-th observer of a scenario (or the `i`-th series of a signal group).
+pub fn color(i: usize) -> Rgb {
+    PALETTE[i % PALETTE.len()]
+}
+
+/// Component `i` of one observer's vector signal (its errors, its residuals): shades of the
+/// observer's colour, darker and lighter in turn, so the view still reads as that observer.
+pub fn shade(base: Rgb, i: usize) -> Rgb {
+    // Negative mixes toward black, positive toward white.
+    const T: [f64; 6] = [0.0, -0.5, 0.45, -0.25, 0.25, 0.55];
+    let t = T[i % T.len()];
+    base.map(|c| {
+        let c = c as f64;
+        (if t < 0.0 { c * (1.0 + t) } else { c + (255.0 - c) * t }).round() as u8
+    })
+}
+
+/// How one series is drawn.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Line {
+    /// Its colour.
+    pub color: Rgb,
+    /// Width in points (Rerun) or pixels (PNG).
+    pub width: f32,
+}
+
+/// Wide, for the true state in a PNG, drawn under the estimates.
+pub const WIDE: f32 = 3.0;
+/// Everything else.
+pub const THIN: f32 = 1.5;
+
+/// The width of the entity at `path` in the Rerun viewer. The viewer draws a view's series in
+/// entity-path order, so `/plant/x/…` lands on top of `/observer/…` whatever the blueprint
+/// says; there the estimates are the wide lines and the true state the thin one over them,
+/// which keeps both visible where they coincide (a PNG draws the other way round).
+pub fn viewer_width(path: &str) -> f32 {
+    let parts: Vec<&str> = path.trim_start_matches('/').split('/').collect();
+    match parts.as_slice() {
+        ["observer", _, "xhat", _] => WIDE,
+        _ => THIN,
+    }
+}
+
+/// The line of the entity at `path` (see [`crate::signals`]) in a run whose observers are
+/// `observers`, in scenario order: the rule both the recording and the PNG plots follow.
+pub fn line(path: &str, observers: &[String]) -> Line {
+    let thin = |color| Line { color, width: THIN };
+    let parts: Vec<&str> = path.trim_start_matches('/').split('/').collect();
+    let k = parts.last().and_then(|s| s.parse::<usize>().ok()).map_or(0, |k| k.saturating_sub(1));
+    let observer = |name: &str| color(observers.iter().position(|o| o == name).unwrap_or(observers.len()));
+    match parts.as_slice() {
+        ["plant", "x", _] => Line { color: TRUE_STATE, width: WIDE },
+        ["plant", "y", _] | ["disturbance", _] | ["input", _] => thin(color(k)),
+        // Beside w and r in their views, from the other end of the palette.
+        ["measurement_disturbance", _] | ["controller", "u", _] => thin(color(PALETTE.len() - 1 - k)),
+        ["observer", o, "error" | "residual", _] => thin(shade(observer(o), k)),
+        ["observer", o, ..] => thin(observer(o)),
+        ["latency", "step"] => thin(TRUE_STATE),
+        ["latency", hop] => {
+            // plant_to_observer_<o>, observer_<o>_to_controller, controller_to_plant.
+            let to_observer = hop.strip_prefix("plant_to_observer_");
+            let from_observer = hop.strip_prefix("observer_").and_then(|h| h.strip_suffix("_to_controller"));
+            match (to_observer, from_observer) {
+                (Some(o), _) => thin(observer(o)),
+                (_, Some(o)) => thin(shade(observer(o), 1)),
+                _ => thin(color(PALETTE.len() - 1)),
+            }
+        }
+        _ => thin(color(k)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Readable on white: no colour is pale (WCAG relative luminance well below white's).
+    #[test]
+    fn every_colour_contrasts_with_white() {
+        let lin = |c: u8| {
+            let c = c as f64 / 255.0;
+            if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+        };
+        let lum = |c: Rgb| 0.2126 * lin(c[0]) + 0.7152 * lin(c[1]) + 0.0722 * lin(c[2]);
+        for c in PALETTE.iter().copied().chain([TRUE_STATE]) {
+            let contrast = 1.05 / (lum(c) + 0.05);
+            assert!(contrast >= 2.5, "{c:?}: contrast {contrast:.2} with white");
+        }
+        // The lightest shade.
+        for i in 0..PALETTE.len() {
+            let c = shade(color(i), 5);
+            assert!(1.05 / (lum(c) + 0.05) >= 1.5, "{c:?}");
+        }
+    }
+
+    #[test]
+    fn an_observer_keeps_its_colour_in_every_signal() {
+        let obs = ["uio".to_string(), "luenberger".to_string()];
+        let c = line("/observer/luenberger/xhat/2", &obs).color;
+        assert_eq!(c, color(1));
+        assert_eq!(line("/observer/luenberger/log10_max_abs_error", &obs).color, c);
+        assert_eq!(line("/observer/luenberger/error/1", &obs).color, c);
+        assert_ne!(line("/observer/luenberger/error/2", &obs).color, line("/observer/luenberger/error/3", &obs).color);
+        assert_eq!(line("/latency/plant_to_observer_luenberger", &obs).color, c);
+        assert_eq!(line("/plant/x/1", &obs), Line { color: TRUE_STATE, width: WIDE });
+        assert_ne!(line("/input/1", &obs).color, line("/controller/u/1", &obs).color);
+        // Wide under thin: in a PNG the truth is drawn first, in the viewer last.
+        assert!(line("/plant/x/1", &obs).width > line("/observer/uio/xhat/1", &obs).width);
+        assert!(viewer_width("/plant/x/1") < viewer_width("/observer/uio/xhat/1"));
+    }
+}

@@ -1,0 +1,230 @@
+//! `launcher plot`: one PNG per view of the recording's blueprint — each state with every
+//! observer's estimate, every observer's max |e| on a log axis, each observer's errors and
+//! residuals, the unknown inputs, the inputs, the outputs, and the latency (log axis) — with
+//! the names, units and colours of the Rerun views, drawn with plotters' pure-Rust bitmap
+//! backend and an embedded font (DejaVu Sans), so nothing but this binary is needed.
+
+mod figure;
+mod raster;
+mod select;
+
+use std::path::{Path, PathBuf};
+use std::sync::Once;
+
+use plotters::style::FontStyle;
+use scenario::{Named, Scenario};
+
+pub use figure::{linear_label, log_label, Curve, Figure, Scale, SIZE};
+pub use select::{glob, Selection};
+
+use crate::palette;
+use crate::read::{Recording, Series};
+use crate::signals;
+use crate::tools::recorded_scenario;
+
+const FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+
+/// Latencies below this (a hop measured as 0 ns) are drawn at it on the log axis, µs.
+const LATENCY_FLOOR_US: f64 = 1e-3;
+
+fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        // The font is valid TrueType; a failure would only leave plots without text.
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
+    });
+}
+
+/// A view before its data is read: file, texts, scale, and (legend, entity path) per curve.
+struct View {
+    file: String,
+    title: String,
+    y_label: String,
+    scale: Scale,
+    series: Vec<(String, String)>,
+}
+
+/// Min and max per pixel column: the shape of a long series survives, at a few thousand points.
+fn decimate(points: &[(f64, f64)], width: usize) -> Vec<(f64, f64)> {
+    if points.len() <= 2 * width {
+        return points.to_vec();
+    }
+    let per = points.len().div_ceil(width);
+    let mut out = Vec::with_capacity(2 * width + 2);
+    for chunk in points.chunks(per) {
+        let (mut lo, mut hi) = (0, 0);
+        for (i, p) in chunk.iter().enumerate() {
+            if p.1 < chunk[lo].1 {
+                lo = i;
+            }
+            if p.1 > chunk[hi].1 {
+                hi = i;
+            }
+        }
+        out.push(chunk[lo.min(hi)]);
+        if lo != hi {
+            out.push(chunk[lo.max(hi)]);
+        }
+    }
+    out
+}
+
+/// Numbered members of a group, ascending: "/plant/x" → [(1, "/plant/x/1"), …].
+fn members(r: &Recording, group: &str) -> Vec<(usize, String)> {
+    let prefix = format!("{group}/");
+    let mut v: Vec<(usize, String)> = r.series.keys().filter_map(|p| p.strip_prefix(&prefix).and_then(|m| m.parse().ok()).map(|k| (k, p.clone()))).collect();
+    v.sort();
+    v
+}
+
+/// "y [m]" when every member shares the unit, else "y".
+fn common_unit(what: &str, units: &[String]) -> String {
+    match units.first() {
+        Some(u) if !u.is_empty() && units.iter().all(|x| x == u) => format!("{what} [{u}]"),
+        _ => what.to_string(),
+    }
+}
+
+fn sanitize(s: &str) -> String {
+    s.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect()
+}
+
+fn views(r: &Recording, s: Option<&Scenario>, observers: &[String]) -> Vec<View> {
+    let named = |path: &str| signals::named(s, path).unwrap_or_else(|| Named { name: r.names.get(path).cloned().unwrap_or_else(|| path.to_string()), unit: String::new() });
+    let legend = |path: &str| named(path).with_unit();
+    // "e3: eta [rad]" for a named state, "e3 [rad]" for one with the default name.
+    let tagged = |tag: String, of: Named, default: String| match (of.name == default, of.unit.is_empty()) {
+        (true, true) => tag,
+        (true, false) => format!("{tag} [{}]", of.unit),
+        (false, _) => format!("{tag}: {}", of.with_unit()),
+    };
+    let mut out = Vec::new();
+    for (k, path) in members(r, "/plant/x") {
+        let x = named(&path);
+        let mut series = vec![(format!("{} (true)", x.name), path.clone())];
+        series.extend(observers.iter().map(|o| (format!("{} ({o})", x.name), signals::estimate(o, k - 1))));
+        let title = if x.name == format!("x{k}") { format!("x{k} — true and estimated") } else { format!("x{k}: {} — true and estimated", x.name) };
+        out.push(View { file: format!("state_{k}_{}.png", sanitize(&x.name)), title, y_label: x.with_unit(), scale: Scale::Linear, series });
+    }
+    let state_units: Vec<String> = members(r, "/plant/x").iter().map(|(_, p)| named(p).unit).collect();
+    if !observers.is_empty() {
+        let series = observers.iter().map(|o| (format!("max |e| ({o})"), signals::log_error(o))).collect();
+        let title = format!("max_i |e_i| of every observer, log scale (0 drawn at {:e})", signals::LOG_FLOOR);
+        out.push(View { file: "errors_log.png".into(), title, y_label: common_unit("max |e|", &state_units), scale: Scale::Log, series });
+    }
+    for o in observers {
+        let errors = members(r, &format!("/observer/{o}/error"));
+        let units: Vec<String> = errors.iter().map(|(_, p)| named(p).unit).collect();
+        let series = errors.iter().map(|(k, p)| (tagged(format!("e{k}"), named(&signals::state(k - 1)), format!("x{k}")), p.clone())).collect();
+        out.push(View { file: format!("error_{}.png", sanitize(o)), title: format!("estimation error e = x − xhat ({o})"), y_label: common_unit("e", &units), scale: Scale::Linear, series });
+        let residuals = members(r, &format!("/observer/{o}/residual"));
+        let units: Vec<String> = residuals.iter().map(|(_, p)| named(p).unit).collect();
+        let series = residuals.iter().map(|(k, p)| (tagged(format!("r{k}"), named(&signals::output(k - 1)), format!("y{k}")), p.clone())).collect();
+        out.push(View { file: format!("residual_{}.png", sanitize(o)), title: format!("residual r = y − C·xhat ({o})"), y_label: common_unit("r", &units), scale: Scale::Linear, series });
+    }
+    let group = |groups: &[&str]| -> (Vec<(String, String)>, Vec<String>) {
+        let paths: Vec<String> = groups.iter().flat_map(|g| members(r, g)).map(|(_, p)| p).collect();
+        (paths.iter().map(|p| (legend(p), p.clone())).collect(), paths.iter().map(|p| named(p).unit).collect())
+    };
+    let (series, units) = group(&["/disturbance", "/measurement_disturbance"]);
+    out.push(View { file: "unknown_inputs.png".into(), title: "unknown inputs w (state) and v (measurement)".into(), y_label: common_unit("w, v", &units), scale: Scale::Linear, series });
+    let (series, units) = group(&["/input", "/controller/u"]);
+    out.push(View { file: "inputs.png".into(), title: "known inputs r and controller output u".into(), y_label: common_unit("r, u", &units), scale: Scale::Linear, series });
+    let (series, units) = group(&["/plant/y"]);
+    out.push(View { file: "outputs.png".into(), title: "measured outputs y".into(), y_label: common_unit("y", &units), scale: Scale::Linear, series });
+    let latency = r.series.keys().filter(|p| p.starts_with("/latency/")).map(|p| (r.names.get(p).cloned().unwrap_or_else(|| p.trim_start_matches("/latency/").to_string()), p.clone())).collect();
+    out.push(View { file: "latency.png".into(), title: "lockstep latency, log scale".into(), y_label: "latency [µs]".into(), scale: Scale::Log, series: latency });
+    out
+}
+
+/// max_i |e_i| of `o` per step, as log10 (zeros at the floor); from the recorded errors, so
+/// it works for any recording.
+fn log_max_error(r: &Recording, o: &str) -> Option<Series> {
+    let errors: Vec<&Series> = members(r, &format!("/observer/{o}/error")).iter().filter_map(|(_, p)| r.series.get(p)).collect();
+    let first = errors.first()?;
+    let mut out = Series { steps: first.steps.clone(), values: vec![0.0; first.steps.len()] };
+    for e in &errors {
+        // Series of one group share their steps; a shorter one (a killed writer) cuts the rest.
+        let n = out.values.len().min(e.values.len());
+        out.values.truncate(n);
+        out.steps.truncate(n);
+        for (m, v) in out.values.iter_mut().zip(&e.values) {
+            *m = crate::write::nan_max(*m, v.abs());
+        }
+    }
+    out.values.iter_mut().for_each(|v| *v = signals::log10_floored(*v));
+    Some(out)
+}
+
+/// The figures of every selected view of `r`, with their file names; an error names what is
+/// wrong (a bad selection, nothing selected).
+pub fn figures(r: &Recording, sel: &Selection) -> Result<Vec<(String, Figure)>, String> {
+    sel.validate()?;
+    let scenario = recorded_scenario(r);
+    let s = scenario.as_ref();
+    let dt = s.map(|s| s.dt);
+    let x_of = |k: i64| dt.map_or(k as f64, |dt| k as f64 * dt);
+    let x_label = if dt.is_some() { "t [s]" } else { "step" };
+    let mut observers: Vec<String> = r.series.keys().filter_map(|p| p.strip_prefix("/observer/").and_then(|x| x.split_once('/')).map(|(n, _)| n.to_string())).collect();
+    observers.dedup();
+    // In the scenario's order where it is known: that order gives each observer its colour.
+    let order: Vec<String> = s.map(|s| s.observers.iter().map(|o| o.name.clone()).collect()).unwrap_or_default();
+    observers.sort_by_key(|n| order.iter().position(|o| o == n).unwrap_or(usize::MAX));
+    let colours: Vec<String> = if order.is_empty() { observers.clone() } else { order };
+    let width = (SIZE.0 as usize).saturating_sub(400);
+    let mut out = Vec::new();
+    for view in views(r, s, &observers) {
+        let mut curves = Vec::new();
+        for (label, path) in &view.series {
+            let derived = path.ends_with("/log10_max_abs_error");
+            let observer = path.strip_prefix("/observer/").and_then(|p| p.split_once('/')).map(|(o, _)| o);
+            let chosen = sel.entity(path) || (derived && observer.is_some_and(|o| members(r, &format!("/observer/{o}/error")).iter().any(|(_, p)| sel.entity(p))));
+            if !chosen {
+                continue;
+            }
+            let owned;
+            let series = match (derived, observer) {
+                (true, Some(o)) => match log_max_error(r, o) {
+                    Some(s) => {
+                        owned = s;
+                        &owned
+                    }
+                    None => continue,
+                },
+                _ => match r.series.get(path) {
+                    Some(s) => s,
+                    None => continue,
+                },
+            };
+            let latency = path.starts_with("/latency/");
+            let y = |v: f64| if latency { (v * 1e-3).max(LATENCY_FLOOR_US).log10() } else { v };
+            let points: Vec<(f64, f64)> = series.steps.iter().zip(&series.values).map(|(&k, &v)| (x_of(k), y(v))).filter(|p| sel.time(p.0) && p.1.is_finite()).collect();
+            if points.is_empty() {
+                continue;
+            }
+            curves.push(Curve { label: label.clone(), line: palette::line(path, &colours), points: decimate(&points, width) });
+        }
+        if !curves.is_empty() {
+            out.push((view.file, Figure { title: view.title, y_label: view.y_label, x_label: x_label.into(), scale: view.scale, curves }));
+        }
+    }
+    if out.is_empty() {
+        return Err(format!("nothing to plot: no selected signal has data{}", if sel.from.is_some() || sel.to.is_some() { " in the time window" } else { "" }));
+    }
+    Ok(out)
+}
+
+/// Draws every selected view of `r` into `dir`; returns the files written.
+pub fn plot(r: &Recording, dir: &Path, sel: &Selection) -> Result<Vec<PathBuf>, String> {
+    let figures = figures(r, sel)?;
+    register_font();
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
+    let mut written = Vec::new();
+    for (file, fig) in figures {
+        let path = dir.join(file);
+        if figure::draw(&path, &fig).map_err(|e| format!("{}: {e}", path.display()))? {
+            written.push(path);
+        }
+    }
+    Ok(written)
+}

@@ -1,0 +1,180 @@
+//! One PNG: plotters draws the frame, grid, ticks, title and legend text into a buffer; the
+//! curves are drawn by [`super::raster`] (anti-aliased, clipped to the plot area); the legend
+//! sits in its own column right of the plot so it never covers data.
+
+use std::path::Path;
+
+use plotters::backend::DrawingBackend;
+use plotters::coord::types::RangedCoordf64;
+use plotters::prelude::*;
+
+use super::raster::{polyline, Canvas, Rect};
+use crate::palette::Line;
+
+/// Image size, pixels.
+pub const SIZE: (u32, u32) = (1400, 700);
+/// Width of the legend column.
+const LEGEND_W: u32 = 290;
+/// At most this many tick labels per axis.
+const X_LABELS: usize = 10;
+const Y_LABELS: usize = 8;
+
+/// How the y values are read.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Scale {
+    /// As they are.
+    Linear,
+    /// The points hold log10 of the value; ticks are labelled with the value.
+    Log,
+}
+
+/// One series, in plot coordinates (y already log10 for [`Scale::Log`]).
+pub struct Curve {
+    /// Legend text.
+    pub label: String,
+    /// Colour and width.
+    pub line: Line,
+    /// (x, y) points.
+    pub points: Vec<(f64, f64)>,
+}
+
+/// What one PNG shows.
+pub struct Figure {
+    /// Caption.
+    pub title: String,
+    /// y axis description.
+    pub y_label: String,
+    /// x axis description.
+    pub x_label: String,
+    /// y scale.
+    pub scale: Scale,
+    /// Curves, drawn in order (the first underneath).
+    pub curves: Vec<Curve>,
+}
+
+/// The step between the ticks plotters puts on `lo..hi` when asked for at most `n` labels.
+fn tick_step(lo: f64, hi: f64, n: usize) -> f64 {
+    let points = RangedCoordf64::from(lo..hi).key_points(n);
+    match points.as_slice() {
+        [a, b, ..] => b - a,
+        _ => (hi - lo).abs().max(f64::MIN_POSITIVE),
+    }
+}
+
+/// A linear tick label with the digits its step needs: "0.25", "-3", "2.5e-15".
+pub fn linear_label(v: f64, step: f64, max_abs: f64) -> String {
+    if v.abs() < step * 1e-6 {
+        return "0".into();
+    }
+    let step_exp = step.log10().floor() as i32;
+    let exp = max_abs.log10().floor() as i32;
+    if !(-3..6).contains(&exp) {
+        // Scientific with the mantissa digits the step resolves.
+        format!("{:.*e}", (exp - step_exp).clamp(0, 6) as usize, v)
+    } else {
+        format!("{:.*}", (-step_exp).max(0) as usize, v)
+    }
+}
+
+/// A log-axis tick label: the value 10^v, plain near 1, else as a power of ten.
+pub fn log_label(v: f64, step: f64) -> String {
+    let value = 10f64.powf(v);
+    if step >= 1.0 && (v - v.round()).abs() < 1e-9 {
+        let e = v.round() as i32;
+        if (-3..=4).contains(&e) { format!("{}", 10f64.powi(e)) } else { format!("1e{e}") }
+    } else {
+        format!("{value:.2e}").replace("e0", "")
+    }
+}
+
+fn range(curves: &[Curve], axis: impl Fn(&(f64, f64)) -> f64) -> Option<(f64, f64)> {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in curves.iter().flat_map(|c| c.points.iter().map(&axis)).filter(|v| v.is_finite()) {
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    lo.is_finite().then_some((lo, hi))
+}
+
+/// Draws `fig` into the PNG `path`; false when it has no finite point (nothing written).
+pub fn draw(path: &Path, fig: &Figure) -> Result<bool, String> {
+    let Some((x0, mut x1)) = range(&fig.curves, |p| p.0) else { return Ok(false) };
+    let Some((lo, hi)) = range(&fig.curves, |p| p.1) else { return Ok(false) };
+    if x1 <= x0 {
+        x1 = x0 + 1.0;
+    }
+    // The y range holds every point with a 5 % margin; a flat series gets a band around it.
+    let pad = if hi > lo { 0.05 * (hi - lo) } else if fig.scale == Scale::Log { 0.5 } else { lo.abs().max(f64::MIN_POSITIVE) * 0.5 };
+    let (y0, y1) = if hi > lo || lo != 0.0 || fig.scale == Scale::Log { (lo - pad, hi + pad) } else { (-1.0, 1.0) };
+    let (w, h) = (SIZE.0 as usize, SIZE.1 as usize);
+    let mut buf = vec![255u8; 3 * w * h];
+    let (plot, legend) = frame(&mut buf, fig, (x0, x1, y0, y1))?;
+    let mut canvas = Canvas { buf: &mut buf, width: w };
+    let map = |(x, y): (f64, f64)| {
+        let px = plot.x0 as f64 + (x - x0) / (x1 - x0) * (plot.x1 - plot.x0) as f64;
+        let py = plot.y1 as f64 - (y - y0) / (y1 - y0) * (plot.y1 - plot.y0) as f64;
+        (px, py)
+    };
+    // Inside the frame line, so a curve at the edge does not paint over it.
+    let inner = Rect { x0: plot.x0 + 1, y0: plot.y0 + 1, x1: plot.x1 - 1, y1: plot.y1 - 1 };
+    for c in &fig.curves {
+        let pts: Vec<(f64, f64)> = c.points.iter().map(|&p| map(p)).collect();
+        polyline(&mut canvas, inner, &pts, c.line.color, c.line.width as f64);
+    }
+    let legend_clip = Rect { x0: SIZE.0 as i32 - LEGEND_W as i32, y0: 0, x1: SIZE.0 as i32 - 1, y1: SIZE.1 as i32 - 1 };
+    for (c, (x, y)) in fig.curves.iter().zip(legend) {
+        polyline(&mut canvas, legend_clip, &[(x as f64, y as f64), (x as f64 + 30.0, y as f64)], c.line.color, c.line.width as f64 + 0.5);
+    }
+    let mut out = BitMapBackend::new(path, SIZE);
+    out.blit_bitmap((0, 0), SIZE, &buf).map_err(|e| e.to_string())?;
+    out.present().map_err(|e| e.to_string())?;
+    Ok(true)
+}
+
+/// Title, grid, ticks, frame and legend text; returns the plot rectangle and where each
+/// legend sample line starts.
+fn frame(buf: &mut [u8], fig: &Figure, (x0, x1, y0, y1): (f64, f64, f64, f64)) -> Result<(Rect, Vec<(i32, i32)>), String> {
+    let root = BitMapBackend::with_buffer(buf, SIZE).into_drawing_area();
+    let (left, right) = root.split_horizontally(SIZE.0 - LEGEND_W);
+    let (xstep, ystep) = (tick_step(x0, x1, X_LABELS), tick_step(y0, y1, Y_LABELS));
+    let max_abs = y0.abs().max(y1.abs());
+    let x_max = x0.abs().max(x1.abs());
+    let mut chart = ChartBuilder::on(&left)
+        .caption(&fig.title, ("sans-serif", 22))
+        .margin(14)
+        .x_label_area_size(52)
+        .y_label_area_size(96)
+        .build_cartesian_2d(x0..x1, y0..y1).map_err(|e| e.to_string())?;
+    let ylab = |v: &f64| match fig.scale {
+        Scale::Linear => linear_label(*v, ystep, max_abs),
+        Scale::Log => log_label(*v, ystep),
+    };
+    chart
+        .configure_mesh()
+        .x_desc(&fig.x_label)
+        .y_desc(&fig.y_label)
+        .x_labels(X_LABELS)
+        .y_labels(Y_LABELS)
+        .label_style(("sans-serif", 15))
+        .axis_desc_style(("sans-serif", 16))
+        .bold_line_style(RGBColor(222, 222, 222))
+        .light_line_style(RGBColor(245, 245, 245))
+        .axis_style(BLACK)
+        .x_label_formatter(&|v| linear_label(*v, xstep, x_max))
+        .y_label_formatter(&ylab)
+        .draw().map_err(|e| e.to_string())?;
+    let (xr, yr) = chart.plotting_area().get_pixel_range();
+    let plot = Rect { x0: xr.start, y0: yr.start, x1: xr.end - 1, y1: yr.end - 1 };
+    root.draw(&Rectangle::new([(plot.x0, plot.y0), (plot.x1, plot.y1)], BLACK.stroke_width(1))).map_err(|e| e.to_string())?;
+    let mut samples = Vec::new();
+    let (lx, _) = right.get_pixel_range();
+    let mut y = plot.y0 + 12;
+    for c in &fig.curves {
+        // `right` has its own origin at its top-left corner; the samples are in image pixels.
+        right.draw(&Text::new(c.label.clone(), (46, y - 9), ("sans-serif", 15).into_font().color(&BLACK))).map_err(|e| e.to_string())?;
+        samples.push((lx.start + 8, y));
+        y += 24;
+    }
+    root.present().map_err(|e| e.to_string())?;
+    Ok((plot, samples))
+}

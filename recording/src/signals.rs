@@ -1,0 +1,110 @@
+//! Every recorded signal's entity path and label, in one place: the writer, the blueprint and
+//! every tool that reads a recording agree on them. Paths number components from 1, the way the
+//! labels (x1, y1, w1) and the papers do: `/plant/x/1` is x1.
+
+use scenario::{Named, Scenario};
+
+/// `/plant/x/<i+1>`: the true state x_i (0-based `i`).
+pub fn state(i: usize) -> String {
+    format!("/plant/x/{}", i + 1)
+}
+
+/// `/plant/y/<j+1>`: the measured output.
+pub fn output(j: usize) -> String {
+    format!("/plant/y/{}", j + 1)
+}
+
+/// `/disturbance/<k+1>`: the unknown input w (column of E).
+pub fn disturbance(k: usize) -> String {
+    format!("/disturbance/{}", k + 1)
+}
+
+/// `/measurement_disturbance/<k+1>`: v (column of D).
+pub fn measurement_disturbance(k: usize) -> String {
+    format!("/measurement_disturbance/{}", k + 1)
+}
+
+/// `/input/<k+1>`: the known input / reference r (column of B).
+pub fn input(k: usize) -> String {
+    format!("/input/{}", k + 1)
+}
+
+/// `/controller/u/<k+1>`: the controller's u.
+pub fn control(k: usize) -> String {
+    format!("/controller/u/{}", k + 1)
+}
+
+/// `/observer/<name>/xhat/<i+1>`.
+pub fn estimate(observer: &str, i: usize) -> String {
+    format!("/observer/{observer}/xhat/{}", i + 1)
+}
+
+/// `/observer/<name>/error/<i+1>`: x_i − x̂_i.
+pub fn error(observer: &str, i: usize) -> String {
+    format!("/observer/{observer}/error/{}", i + 1)
+}
+
+/// `/observer/<name>/residual/<j+1>`: y_j − (Cx̂)_j.
+pub fn residual(observer: &str, j: usize) -> String {
+    format!("/observer/{observer}/residual/{}", j + 1)
+}
+
+/// `/observer/<name>/log10_max_abs_error`: log10 of max_i |e_i|, a zero error recorded as
+/// log10 of [`LOG_FLOOR`]. Derived from the errors, so that a viewer without log axes still
+/// shows rounding-level and large errors with readable numbers on one axis.
+pub fn log_error(observer: &str) -> String {
+    format!("/observer/{observer}/log10_max_abs_error")
+}
+
+/// Where an error of exactly zero is drawn on a log axis (log10 of 0 has no value).
+pub const LOG_FLOOR: f64 = 1e-18;
+
+/// log10 of a max |e|, zeros at the floor (NaN stays NaN: a diverged run shows as a gap).
+pub fn log10_floored(v: f64) -> f64 {
+    if v.is_nan() { v } else { v.max(LOG_FLOOR).log10() }
+}
+
+/// The name and unit of the signal at `path` in a run of `s`, for CSV headers and axis labels:
+/// a state estimate is named after its state, an error `e<i>` and a residual `r<j>` carry the
+/// unit of their state or output (as in the README: e = x − x̂, r = y − Cx̂). Without the
+/// scenario, the default names (x1, y1, w1, …) and no unit. `None` for paths that are not a
+/// numbered signal (latency).
+pub fn named(s: Option<&Scenario>, path: &str) -> Option<Named> {
+    let (group, index) = path.rsplit_once('/')?;
+    let i = index.parse::<usize>().ok()?.checked_sub(1)?;
+    let kind = group.strip_prefix("/observer/").and_then(|g| g.split_once('/')).map_or(group, |(_, kind)| kind);
+    let Some(s) = s else {
+        let letter = match kind {
+            "/plant/x" | "xhat" => "x",
+            "/plant/y" => "y",
+            "/disturbance" => "w",
+            "/measurement_disturbance" => "v",
+            "/input" | "residual" => "r",
+            "/controller/u" => "u",
+            "error" => "e",
+            _ => return None,
+        };
+        return Some(Named { name: format!("{letter}{}", i + 1), unit: String::new() });
+    };
+    let n = &s.names;
+    let get = |v: &[Named]| v.get(i).cloned();
+    match kind {
+        "/plant/x" | "xhat" => get(&n.state),
+        "/plant/y" => get(&n.output),
+        "/disturbance" => get(&n.disturbance),
+        "/measurement_disturbance" => get(&n.measurement_disturbance),
+        "/input" => get(&n.input),
+        "/controller/u" => n.input.get(i).map(|r| Named { name: control_name(s, i), unit: r.unit.clone() }),
+        "error" => n.state.get(i).map(|x| Named { name: format!("e{}", i + 1), unit: x.unit.clone() }),
+        "residual" => n.output.get(i).map(|y| Named { name: format!("r{}", i + 1), unit: y.unit.clone() }),
+        _ => None,
+    }
+}
+
+/// u's name: `u<k>`, or "<input name> (u)" when the inputs are named.
+pub fn control_name(s: &Scenario, k: usize) -> String {
+    match s.names.input.get(k) {
+        Some(r) if r.name != format!("r{}", k + 1) => format!("{} (u)", r.name),
+        _ => format!("u{}", k + 1),
+    }
+}

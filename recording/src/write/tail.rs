@@ -1,0 +1,92 @@
+//! The tail of a run: its last quarter of steps, where transients have died out and the figures
+//! of merit (tail max|e|, tail max|r|) are taken.
+//!
+//! A run that completed all its K planned steps has the tail [K − ⌊K/4⌋, K), exactly. A run that
+//! stopped early after K' steps has the tail of the steps it completed: [K' − ⌊K'/4⌋, K'), with
+//! its start rounded down to a block of [`block_len`] steps — the figures are kept as block
+//! maxima so that memory stays bounded; for runs of up to [`MAX_BLOCKS`] planned steps a block is
+//! one step and the tail is exact. With ⌊K'/4⌋ = 0 (fewer than 4 steps) there is no tail.
+
+use super::nan_max;
+
+/// Most blocks kept per figure (512 KiB each).
+pub const MAX_BLOCKS: u64 = 1 << 16;
+
+/// Steps per block for a run of `planned` steps: 1 up to [`MAX_BLOCKS`] steps, then the power
+/// of two that keeps at most [`MAX_BLOCKS`] blocks.
+pub fn block_len(planned: u64) -> u64 {
+    planned.div_ceil(MAX_BLOCKS).next_power_of_two().max(1)
+}
+
+/// The first step of the tail of a run that completed `completed` of `planned` steps, or `None`
+/// when it completed fewer than 4.
+pub fn tail_start(completed: u64, planned: u64) -> Option<u64> {
+    let quarter = completed / 4;
+    if quarter == 0 {
+        return None;
+    }
+    let start = completed - quarter;
+    if completed >= planned { Some(start) } else { Some(start - start % block_len(planned)) }
+}
+
+/// Maxima of one figure per block of steps, allocated once for the whole run.
+#[derive(Debug, Clone)]
+pub struct BlockMax {
+    len: u64,
+    blocks: Vec<f64>,
+}
+
+impl BlockMax {
+    /// For a run of `planned` steps.
+    pub fn new(planned: u64) -> Self {
+        let len = block_len(planned);
+        BlockMax { len, blocks: vec![0.0; planned.div_ceil(len).max(1) as usize] }
+    }
+
+    /// Takes the value of step `k` into its block (steps beyond the plan are ignored).
+    #[inline]
+    pub fn push(&mut self, k: u64, v: f64) {
+        if let Some(b) = self.blocks.get_mut((k / self.len) as usize) {
+            *b = nan_max(*b, v);
+        }
+    }
+
+    /// The largest value from step `start` (a block boundary) on.
+    pub fn max_from(&self, start: u64) -> f64 {
+        self.blocks.iter().skip((start / self.len) as usize).fold(0.0, |m, &v| nan_max(m, v))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn completed_run_has_exact_last_quarter() {
+        assert_eq!(tail_start(20_000, 20_000), Some(15_000));
+        assert_eq!(tail_start(7, 7), Some(6));
+        assert_eq!(tail_start(3, 10), None);
+    }
+
+    #[test]
+    fn early_stop_takes_last_quarter_of_completed_steps() {
+        assert_eq!(tail_start(1_000, 20_000), Some(750));
+        // Beyond MAX_BLOCKS planned steps the start is rounded down to a block.
+        let planned = 10 * MAX_BLOCKS;
+        let b = block_len(planned);
+        assert_eq!(b, 16);
+        assert_eq!(tail_start(1_003, planned), Some(752 - 752 % 16));
+    }
+
+    #[test]
+    fn block_maxima_cover_from_start() {
+        let mut m = BlockMax::new(100);
+        for k in 0..100 {
+            m.push(k, if k == 10 { 5.0 } else { 1.0 / (k + 1) as f64 });
+        }
+        assert_eq!(m.max_from(11), 1.0 / 12.0);
+        assert_eq!(m.max_from(10), 5.0);
+        m.push(50, f64::NAN);
+        assert!(m.max_from(20).is_nan());
+    }
+}

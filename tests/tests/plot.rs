@@ -1,0 +1,198 @@
+//! Issue 10, items 4–7: `launcher plot` stays inside its axes, draws one colour per observer,
+//! an |e| view on a log axis, and what `--signals`, `--from` and `--to` select; every signal is
+//! numbered from 1 and named with its unit in plots and CSV headers.
+
+use std::path::Path;
+
+use recording::plot::{figures, Scale, Selection};
+use tests::*;
+
+/// The plot rectangle of a PNG (left, top, right, bottom): the y axis is the longest vertical
+/// run of dark pixels, the x axis the longest horizontal one.
+fn plot_rect(img: &image::RgbImage) -> (u32, u32, u32, u32) {
+    let dark = |x: u32, y: u32| {
+        let p = img.get_pixel(x, y).0;
+        p.iter().all(|&c| c < 80) && p.iter().max().unwrap() - p.iter().min().unwrap() < 20
+    };
+    let (w, h) = img.dimensions();
+    let longest = |n: u32, at: &dyn Fn(u32) -> bool| {
+        let (mut best, mut run, mut end) = (0, 0, 0);
+        for i in 0..n {
+            run = if at(i) { run + 1 } else { 0 };
+            if run > best {
+                (best, end) = (run, i);
+            }
+        }
+        (best, end + 1 - best, end)
+    };
+    let (mut v, mut left) = ((0, 0, 0), 0);
+    for x in 0..w {
+        let r = longest(h, &|y| dark(x, y));
+        if r.0 > v.0 {
+            (v, left) = (r, x);
+        }
+    }
+    let (mut hz, mut bottom) = ((0, 0, 0), 0);
+    for y in 0..h {
+        let r = longest(w, &|x| dark(x, y));
+        // The lowest of equally long lines: a frame's top edge is as long as its bottom.
+        if r.0 >= hz.0 {
+            (hz, bottom) = (r, y);
+        }
+    }
+    (left, v.1, hz.2, bottom)
+}
+
+/// Pixels of a series colour (saturated, unlike text, grid and frame) left of, above or below
+/// the plot rectangle. (Right of it is the legend column, whose samples carry the colours.)
+fn coloured_outside(png: &Path) -> Vec<(u32, u32)> {
+    let img = image::open(png).unwrap().to_rgb8();
+    let (left, top, _, bottom) = plot_rect(&img);
+    let mut out = Vec::new();
+    for (x, y, p) in img.enumerate_pixels() {
+        let p = p.0;
+        let saturated = p.iter().max().unwrap() - p.iter().min().unwrap() > 60;
+        if saturated && (x < left || y < top || y > bottom) {
+            out.push((x, y));
+        }
+    }
+    out
+}
+
+/// A 300 s run at 1 ms with a long quiet stretch, noise, and one spike a million times larger.
+fn spiky_recording(path: &Path) {
+    let n = 300_000;
+    let steps: Vec<i64> = (0..n).collect();
+    let noise = |k: i64| ((k * 7919) % 101) as f64 / 101.0;
+    let latency: Vec<f64> = steps.iter().map(|&k| if k == 150_000 { 4e9 } else { 15_000.0 + 20_000.0 * noise(k) }).collect();
+    let estimate: Vec<f64> = steps.iter().map(|&k| if k == 200_000 { 1e6 } else { (k as f64 * 1e-3).sin() + 0.01 * noise(k) }).collect();
+    let mut r = Recording::default();
+    r.series.insert("/latency/step".into(), Series { steps: steps.clone(), values: latency });
+    r.series.insert("/observer/a/xhat/1".into(), Series { steps: steps.clone(), values: estimate.clone() });
+    r.series.insert("/plant/x/1".into(), Series { steps, values: estimate });
+    recording::read::write(path, &r).unwrap();
+}
+
+#[test]
+fn plots_stay_inside_their_axes() {
+    let s = Scratch::new("plot-spike");
+    let rrd = s.join("spike.rrd");
+    spiky_recording(&rrd);
+    let out = launcher(&s).arg("plot").arg(&rrd).arg("--out").arg(s.join("png")).output().unwrap();
+    assert!(out.status.success(), "{:?}", text(&out));
+    let mut checked = 0;
+    for f in std::fs::read_dir(s.join("png")).unwrap().flatten() {
+        let outside = coloured_outside(&f.path());
+        assert!(outside.is_empty(), "{}: {} pixels of a series colour outside the axes, e.g. {:?}", f.path().display(), outside.len(), &outside[..outside.len().min(5)]);
+        checked += 1;
+    }
+    assert!(checked >= 2, "{checked} files");
+}
+
+#[test]
+fn one_colour_per_observer_a_log_error_view_and_one_based_names() {
+    let s = Scratch::new("plot-views");
+    assert!(run(&s, &scenario("seed002-sine"), &["--mode", "in-process"]).status.success());
+    let r = read(&s.join("out/seed002-sine.rrd")).unwrap();
+    assert!(r.series.contains_key("/plant/x/1") && r.series.contains_key("/plant/x/3") && !r.series.contains_key("/plant/x/0"));
+    assert!(r.series.contains_key("/observer/uio/error/3") && r.series.contains_key("/input/2") && r.series.contains_key("/disturbance/1"));
+    let figs = figures(&r, &Selection::default()).unwrap();
+    let fig = |file: &str| &figs.iter().find(|(f, _)| f == file).unwrap_or_else(|| panic!("no {file}")).1;
+    let colour_of = |file: &str, label_part: &str| fig(file).curves.iter().find(|c| c.label.contains(label_part)).unwrap_or_else(|| panic!("{file}: {label_part}")).line.color;
+    // The same colour for an observer in every view; the true state apart and wider.
+    let uio = colour_of("state_1_x1.png", "(uio)");
+    let luenberger = colour_of("state_1_x1.png", "(luenberger)");
+    assert_ne!(uio, luenberger);
+    assert_eq!(colour_of("state_3_x3.png", "(uio)"), uio);
+    assert_eq!(colour_of("errors_log.png", "uio"), uio);
+    assert_eq!(colour_of("error_uio.png", "e1"), uio);
+    let truth = &fig("state_2_x2.png").curves[0];
+    assert!(truth.label.contains("true") && truth.line.width > fig("state_2_x2.png").curves[1].line.width);
+    assert!(![uio, luenberger].contains(&truth.line.color));
+    // The log view separates the UIO (converging like e^{−t}) from the Luenberger observer
+    // (driven by the disturbance) by orders of magnitude at the end of the run.
+    let log = fig("errors_log.png");
+    assert_eq!(log.scale, Scale::Log);
+    let last = |part: &str| log.curves.iter().find(|c| c.label.contains(part)).unwrap().points.iter().filter(|p| p.0 > 15.0).map(|p| p.1).fold(f64::MIN, f64::max);
+    assert!(last("luenberger") - last("uio") > 4.0, "log10 gap {}", last("luenberger") - last("uio"));
+}
+
+#[test]
+fn signals_and_a_time_window_choose_what_is_drawn() {
+    let s = Scratch::new("plot-select");
+    assert!(run(&s, &scenario("seed002-sine"), &["--mode", "in-process"]).status.success());
+    let rrd = s.join("out/seed002-sine.rrd");
+    let out = launcher(&s).arg("plot").arg(&rrd).args(["--out", "png", "--signals", "/observer/uio/**", "--from", "5", "--to", "7.5"]).output().unwrap();
+    assert!(out.status.success(), "{:?}", text(&out));
+    let mut files: Vec<String> = std::fs::read_dir(s.join("png")).unwrap().flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect();
+    files.sort();
+    assert_eq!(files, ["error_uio.png", "errors_log.png", "residual_uio.png", "state_1_x1.png", "state_2_x2.png", "state_3_x3.png"]);
+    let r = read(&rrd).unwrap();
+    let sel = Selection { signals: vec!["/observer/uio/**".into()], from: Some(5.0), to: Some(7.5) };
+    for (file, fig) in figures(&r, &sel).unwrap() {
+        for c in &fig.curves {
+            assert!(c.label.contains("uio") || file.contains("uio"), "{file}: {}", c.label);
+            let (lo, hi) = c.points.iter().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
+            assert!(lo >= 5.0 && hi <= 7.5 && hi - lo > 2.4, "{file}: {lo}..{hi}");
+        }
+    }
+    // A bad window or glob: exit 2, one line naming the option, nothing drawn.
+    for (args, what) in [(vec!["--from", "3", "--to", "1"], "--from"), (vec!["--to", "nan"], "--to"), (vec!["--signals", "observer"], "--signals")] {
+        let out = launcher(&s).arg("plot").arg(&rrd).args(["--out", "bad"]).args(&args).output().unwrap();
+        let (_, err) = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(err.contains(what), "{err}");
+        assert!(!s.join("bad").exists());
+    }
+    // A window with no data.
+    let out = launcher(&s).arg("plot").arg(&rrd).args(["--out", "late", "--from", "100", "--to", "200"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2), "{:?}", text(&out));
+}
+
+#[test]
+fn names_and_units_label_plots_and_csv_headers() {
+    let s = Scratch::new("plot-names");
+    let text_ = std::fs::read_to_string(scenario("seed002-sine")).unwrap();
+    let named = text_.replacen(
+        "[plant]",
+        "[plant]\nstate_names = [\"pos\", \"vel\", \"volt\"]\nstate_units = [\"m\", \"m/s\", \"V\"]\noutput_names = [\"pos_meas\", \"volt_meas\"]\noutput_units = [\"m\", \"V\"]\ninput_names = [\"force\", \"supply\"]\ninput_units = [\"N\", \"V\"]\ndisturbance_names = [\"gust\"]\ndisturbance_units = [\"N\"]",
+        1,
+    );
+    let path = s.join("named.toml");
+    std::fs::write(&path, named).unwrap();
+    assert!(run(&s, &path, &["--mode", "in-process"]).status.success());
+    let rrd = s.join("out/seed002-sine.rrd");
+    let out = launcher(&s).arg("export").arg(&rrd).arg("--csv").arg(s.join("csv")).output().unwrap();
+    assert!(out.status.success(), "{:?}", text(&out));
+    let header = |file: &str| std::fs::read_to_string(s.join("csv").join(file)).unwrap().lines().next().unwrap().to_string();
+    assert_eq!(header("plant_x.csv"), "step,sim_time,pos [m],vel [m/s],volt [V]");
+    assert_eq!(header("plant_y.csv"), "step,sim_time,pos_meas [m],volt_meas [V]");
+    assert_eq!(header("observer_uio_xhat.csv"), "step,sim_time,pos [m],vel [m/s],volt [V]");
+    assert_eq!(header("observer_uio_error.csv"), "step,sim_time,e1 [m],e2 [m/s],e3 [V]");
+    assert_eq!(header("observer_luenberger_residual.csv"), "step,sim_time,r1 [m],r2 [V]");
+    assert_eq!(header("input.csv"), "step,sim_time,force [N],supply [V]");
+    assert_eq!(header("controller_u.csv"), "step,sim_time,force (u) [N],supply (u) [V]");
+    assert_eq!(header("disturbance.csv"), "step,sim_time,gust [N]");
+    let latency = header("latency.csv");
+    let cols: Vec<&str> = latency.split(',').collect();
+    assert_eq!(cols.iter().filter(|c| **c == "step").count(), 1, "{latency}");
+    assert!(cols.contains(&"step_latency [ns]"), "{latency}");
+    // Plots: titles, axis labels and legends carry the names and units.
+    let r = read(&rrd).unwrap();
+    let figs = figures(&r, &Selection::default()).unwrap();
+    let (file, fig) = figs.iter().find(|(f, _)| f.starts_with("state_2")).unwrap();
+    assert_eq!(file, "state_2_vel.png");
+    assert_eq!(fig.y_label, "vel [m/s]");
+    assert!(fig.title.contains("vel") && fig.curves.iter().any(|c| c.label == "vel (uio)"));
+    let outputs = &figs.iter().find(|(f, _)| f == "outputs.png").unwrap().1;
+    let labels: Vec<&str> = outputs.curves.iter().map(|c| c.label.as_str()).collect();
+    assert_eq!(labels, ["pos_meas [m]", "volt_meas [V]"]);
+    // A names list of the wrong length is bad input, named by file and field.
+    let bad = std::fs::read_to_string(&path).unwrap().replace("output_names = [\"pos_meas\", \"volt_meas\"]", "output_names = [\"pos_meas\"]");
+    std::fs::write(&path, bad).unwrap();
+    let out = run(&s, &path, &["--mode", "in-process", "--force"]);
+    let (_, err) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("named.toml") && err.contains("plant.output_names") && err.contains("has 1 entry, C has 2 rows"), "{err}");
+}
