@@ -2,6 +2,17 @@
 //! loop it makes, continuous eig(A − BG) and sampled eig(A_d − B_dG) (G is applied to samples
 //! held over each step). By the separation principle the loop with an observer has these
 //! eigenvalues plus the observer's.
+//!
+//! With u = N r − G x̂ and tracked outputs z = C_t x (one per input), the reference prefilter
+//!
+//! ```text
+//! N = −(C_t (A − BG)⁻¹ B)⁻¹
+//! ```
+//!
+//! gives the closed loop unit DC gain from r to z, so z settles on a constant r (Franklin,
+//! Powell & Emami-Naeini, *Feedback Control of Dynamic Systems*, §7.9). The exact sampling has
+//! the same DC gain, (I − A_d + B_dG)⁻¹B_d = −(A − BG)⁻¹B, so N holds for the sampled loop too.
+//! Without tracked outputs N = I: u = r − G x̂.
 
 use lti::eig::{eigenvalues, format_list};
 use lti::place::{place, Method};
@@ -26,6 +37,8 @@ pub enum FeedbackSpec {
 pub struct FeedbackDesign {
     /// G, l×n.
     pub g: Mat,
+    /// The reference prefilter N, l×l (I without tracked outputs).
+    pub n: Mat,
     /// eig(A − BG), sorted.
     pub closed_loop: Vec<C64>,
     /// eig(A_d − B_dG), sorted.
@@ -53,8 +66,9 @@ impl FeedbackDesign {
     }
 }
 
-/// Designs (or checks) G for `model` sampled with period dt.
-pub fn design(model: &Model, spec: &FeedbackSpec, dt: f64) -> Result<FeedbackDesign, String> {
+/// Designs (or checks) G for `model` sampled with period dt, and the prefilter N for the tracked
+/// outputs z = C_t x (`track`, l×n), if any.
+pub fn design(model: &Model, spec: &FeedbackSpec, track: Option<&Mat>, dt: f64) -> Result<FeedbackDesign, String> {
     let g = match spec {
         FeedbackSpec::Poles { poles, placement } => place(&model.a, &model.b, poles, *placement).map_err(|e| e.to_string())?.gain,
         FeedbackSpec::Gain(g) => {
@@ -67,6 +81,22 @@ pub fn design(model: &Model, spec: &FeedbackSpec, dt: f64) -> Result<FeedbackDes
     let closed_loop = eigenvalues(&(&model.a - &model.b * &g)).map_err(|e| e.to_string())?;
     let dm = model.discretize(dt);
     let discrete_closed_loop = eigenvalues(&(&dm.a - &dm.b * &g)).map_err(|e| e.to_string())?;
-    let unstable = closed_loop.iter().copied().filter(|z| z.re >= 0.0).collect();
-    Ok(FeedbackDesign { g, closed_loop, discrete_closed_loop, unstable })
+    let unstable: Vec<C64> = closed_loop.iter().copied().filter(|z| z.re >= 0.0).collect();
+    let n = match track {
+        None => Mat::identity(model.l(), model.l()),
+        Some(ct) => prefilter(model, &g, ct)?,
+    };
+    Ok(FeedbackDesign { g, n, closed_loop, discrete_closed_loop, unstable })
+}
+
+/// N = −(C_t (A − BG)⁻¹ B)⁻¹ (see the module documentation).
+fn prefilter(model: &Model, g: &Mat, ct: &Mat) -> Result<Mat, String> {
+    if ct.shape() != (model.l(), model.n()) {
+        return Err(format!("track is {}×{}, must be {}×{} (one tracked output per input)", ct.nrows(), ct.ncols(), model.l(), model.n()));
+    }
+    let acl = &model.a - &model.b * g;
+    let x = acl.lu().solve(&model.b).ok_or("A − BG is singular: the loop has an integrator, so no prefilter is needed or possible")?;
+    let dc = ct * x;
+    let inv = dc.clone().try_inverse().filter(|i| i.iter().all(|v| v.is_finite()));
+    inv.map(|i| -i).ok_or_else(|| format!("the closed loop's DC gain to the tracked outputs, C_t(A − BG)⁻¹B = {dc:.4}, is singular: those outputs cannot follow r"))
 }

@@ -1,5 +1,6 @@
-//! The controller component: state feedback on an observer's estimate, u_k = r_k − G x̂_k
-//! (seed 000 eq. 24), its design, and the process shell that runs it in lockstep.
+//! The controller component: state feedback on an observer's estimate, u_k = N r_k − G x̂_k
+//! (seed 000 eq. 24, with the reference prefilter N of [`design`]), its design, and the process
+//! shell that runs it in lockstep.
 
 pub mod design;
 pub mod shell;
@@ -15,6 +16,8 @@ use serde::{Deserialize, Serialize};
 pub struct ControllerConfig {
     /// Feedback gain G (l×n).
     pub g: MatData,
+    /// Reference prefilter N (l×l).
+    pub n: MatData,
     /// Reference signals r, one per input.
     pub references: Vec<Signal>,
     /// Sample period, s.
@@ -29,6 +32,8 @@ pub struct ControllerConfig {
 #[derive(Debug, Clone)]
 pub struct Controller {
     g: DMatrix<f64>,
+    n: DMatrix<f64>,
+    r: DVector<f64>,
     references: Vec<Signal>,
     dt: f64,
     gx: DVector<f64>,
@@ -42,15 +47,21 @@ impl Controller {
         if g.nrows() != cfg.references.len() {
             return Err(format!("G has {} rows but there are {} references", g.nrows(), cfg.references.len()));
         }
-        Ok(Self { gx: DVector::zeros(g.nrows()), u: DVector::zeros(g.nrows()), g, references: cfg.references.clone(), dt: cfg.dt })
+        let n: DMatrix<f64> = (&cfg.n).into();
+        if n.shape() != (g.nrows(), g.nrows()) {
+            return Err(format!("N is {}×{}, must be {}×{}", n.nrows(), n.ncols(), g.nrows(), g.nrows()));
+        }
+        let l = g.nrows();
+        Ok(Self { gx: DVector::zeros(l), u: DVector::zeros(l), r: DVector::zeros(l), g, n, references: cfg.references.clone(), dt: cfg.dt })
     }
 
-    /// u_k = r(t_k) − G x̂_k.
+    /// u_k = N r(t_k) − G x̂_k.
     pub fn step(&mut self, k: u64, xhat: &[f64]) -> &[f64] {
         let t = k as f64 * self.dt;
-        for (u, r) in self.u.iter_mut().zip(&self.references) {
-            *u = r.sample(t, self.dt);
+        for (r, s) in self.r.iter_mut().zip(&self.references) {
+            *r = s.sample(t, self.dt);
         }
+        mul_into(self.u.as_mut_slice(), &self.n, self.r.as_slice());
         mul_into(self.gx.as_mut_slice(), &self.g, xhat);
         for (u, gx) in self.u.iter_mut().zip(self.gx.iter()) {
             *u -= gx;

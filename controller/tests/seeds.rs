@@ -13,7 +13,7 @@ fn seed003_ackermann_gain() {
     let m = &seeds()["seed_003"]["model"];
     let model = Model { a: mat(&m["A"]), b: mat(&m["B"]), c: mat(&m["C"]), e: Mat::zeros(4, 0), d: Mat::zeros(2, 0) };
     let poles = Poles::new([-4.0, -5.0, -6.0, -7.0].map(PoleSpec::Real)).unwrap();
-    let fb = design(&model, &FeedbackSpec::Poles { poles, placement: Method::Ackermann }, 1e-3).unwrap();
+    let fb = design(&model, &FeedbackSpec::Poles { poles, placement: Method::Ackermann }, None, 1e-3).unwrap();
     let want = [6.00762691997, -28.0996201851, 14.6870142616, -1.54712121541];
     for (i, w) in want.iter().enumerate() {
         assert!((fb.g[(0, i)] - w).abs() < 1e-9, "G[{i}] = {}", fb.g[(0, i)]);
@@ -26,10 +26,40 @@ fn seed000_printed_gain_is_reported_unstable() {
     let m = &seeds()["seed_000"]["model_primary_open_loop"];
     let model = Model { a: mat(&m["A"]), b: mat(&m["B"]), c: mat(&m["C"]), e: mat(&m["Ed"]), d: Mat::zeros(2, 0) };
     let g = Mat::from_row_slice(1, 4, &[5.86, 0.99, 0.0, 0.0]);
-    let fb = design(&model, &FeedbackSpec::Gain(g), 1e-4).unwrap();
+    let fb = design(&model, &FeedbackSpec::Gain(g), None, 1e-4).unwrap();
     assert!(!fb.stable());
     assert_eq!(fb.unstable.len(), 1);
     assert!((fb.unstable[0] - C64::new(122.2708754065, 0.0)).norm() < 1e-6, "{:?}", fb.unstable);
     let why = fb.instability().unwrap();
     assert!(why.contains("122.271"), "{why}");
+}
+
+/// The prefilter N makes the tracked output settle on a constant reference: iterate the sampled
+/// closed loop x_{k+1} = (A_d − B_dG)x_k + B_dN r until it settles, and read θ (the simulation
+/// is the independent check of N's formula), in a loop with the unit DC gain the formula claims.
+#[test]
+fn seed003_prefilter_makes_the_pitch_angle_follow_the_reference() {
+    let m = &seeds()["seed_003"]["model"];
+    let model = Model { a: mat(&m["A"]), b: mat(&m["B"]), c: mat(&m["C"]), e: Mat::zeros(4, 0), d: Mat::zeros(2, 0) };
+    let poles = Poles::new([-4.0, -5.0, -6.0, -7.0].map(PoleSpec::Real)).unwrap();
+    let track = Mat::from_row_slice(1, 4, &[0.0, 0.0, 1.0, 0.0]);
+    let dt = 1e-3;
+    let fb = design(&model, &FeedbackSpec::Poles { poles, placement: Method::Ackermann }, Some(&track), dt).unwrap();
+    let dm = model.discretize(dt);
+    let (acl, bn) = (&dm.a - &dm.b * &fb.g, &dm.b * &fb.n);
+    let r = Mat::from_element(1, 1, 0.1);
+    let mut x = Mat::zeros(4, 1);
+    for _ in 0..20_000 {
+        x = &acl * &x + &bn * &r;
+    }
+    assert!((x[(2, 0)] - 0.1).abs() < 1e-12, "θ settles at {}", x[(2, 0)]);
+    // Without N (u = r − Gx) it settles elsewhere: the prefilter is what makes it track.
+    let mut x = Mat::zeros(4, 1);
+    for _ in 0..20_000 {
+        x = &acl * &x + &dm.b * &r;
+    }
+    assert!((x[(2, 0)] - 0.1).abs() > 1e-2, "θ without N: {}", x[(2, 0)]);
+    // A tracked output the input cannot move in steady state is refused, with the reason.
+    let e = design(&model, &FeedbackSpec::Poles { poles: Poles::new([-4.0, -5.0, -6.0, -7.0].map(PoleSpec::Real)).unwrap(), placement: Method::Ackermann }, Some(&Mat::zeros(1, 4)), dt).unwrap_err();
+    assert!(e.contains("singular"), "{e}");
 }

@@ -53,7 +53,7 @@ fn conditions_text(c: &[Condition]) -> String {
 /// Designs everything in the scenario and reports it.
 pub fn report(s: &Scenario) -> DesignReport {
     let mut ok = true;
-    let mut text = format!("{}: {}\n", s.name, s.description);
+    let mut text = format!("{}: {}\n", s.name, scenario::untrusted::one_line(&s.description));
     let mut observers = Vec::new();
     for o in &s.observers {
         text += &format!("\nobserver '{}' ({})\n", o.name, o.spec.kind());
@@ -108,15 +108,19 @@ pub fn report(s: &Scenario) -> DesignReport {
             Ok(p) => {
                 warnings = p.warnings.clone();
                 if let (Some(c), Some(fb)) = (&s.controller, &p.feedback) {
-                    text += &format!("\ncontroller: state feedback u = r − G x̂ on '{}'\n", c.observer);
+                    text += &format!("\ncontroller: state feedback u = {}r − G x̂ on '{}'\n", if c.track.is_some() { "N " } else { "" }, c.observer);
                     text += &matrix_text("G", &fb.g);
+                    if c.track.is_some() {
+                        text += "  prefilter N = −(C_t(A − BG)⁻¹B)⁻¹ (u = N r − G x̂):\n";
+                        text += &matrix_text("N", &fb.n);
+                    }
                     text += &format!("  closed loop eig(A − BG):       {}\n", format_list(&fb.closed_loop));
                     text += &format!("  sampled eig(A_d − B_dG):       {}\n", format_list(&fb.discrete_closed_loop));
                     text += &format!("  stable: {}\n", fb.stable());
                     controller = json!({
                         "kind": "state-feedback",
                         "observer": c.observer,
-                        "matrices": {"G": rows(&fb.g)},
+                        "matrices": {"G": rows(&fb.g), "N": rows(&fb.n)},
                         "closed_loop_poles": lti::re_im(&fb.closed_loop),
                         "discrete_closed_loop_poles": lti::re_im(&fb.discrete_closed_loop),
                         "stable": fb.stable(),

@@ -296,22 +296,21 @@ fn main() -> ExitCode {
             if let Err(e) = selection.validate() {
                 return fail(&LaunchError::BadInput(e));
             }
-            match read_recording(&recording) {
-            Ok(r) => {
-                if !r.complete {
-                    eprintln!("warning: {}: incomplete recording (its writer did not finish); plotting what it holds", recording.display());
-                }
-                match recording::plot::plot(&r, &out, &selection) {
-                    Ok(files) => {
-                        for f in &files {
-                            println!("{}", f.display());
-                        }
-                        ExitCode::SUCCESS
-                    }
-                    Err(e) => fail(&LaunchError::BadInput(format!("{}: {e}", recording.display()))),
-                }
+            let r = match read_recording(&recording) {
+                Ok(r) => r,
+                Err(code) => return code,
+            };
+            if !r.complete {
+                eprintln!("warning: {}: incomplete recording (its writer did not finish); plotting what it holds", recording.display());
             }
-            Err(code) => code,
+            match recording::plot::plot(&r, &out, &selection) {
+                Ok(files) => {
+                    for f in &files {
+                        println!("{}", f.display());
+                    }
+                    ExitCode::SUCCESS
+                }
+                Err(e) => fail(&LaunchError::BadInput(format!("{}: {e}", recording.display()))),
             }
         }
         Command::Export { recording, csv } => {

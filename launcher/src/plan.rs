@@ -50,7 +50,7 @@ pub fn plan(s: &Scenario) -> Result<Plan, PlanError> {
         observers.push((o.name.clone(), d));
     }
     let feedback = match &s.controller {
-        Some(c) => Some(design_feedback(&s.model, &c.spec, s.dt).map_err(|reason| {
+        Some(c) => Some(design_feedback(&s.model, &c.spec, c.track.as_ref(), s.dt).map_err(|reason| {
             let field = if matches!(c.spec, FeedbackSpec::Gain(_)) { "controller.gain" } else { "controller.poles" };
             PlanError { error: locate(field.into(), reason), conditions: vec![], observer: None }
         })?),

@@ -55,7 +55,7 @@ impl Entry {
     /// One line of `launcher list`.
     pub fn line(&self) -> String {
         let Some(name) = &self.name else {
-            return format!("{:<34} (invalid: {})", self.file.display(), self.text);
+            return scenario::untrusted::one_line(&format!("{:<34} (invalid: {})", self.file.display(), self.text));
         };
         let mut line = format!("{name:<34} {}", self.text);
         if !self.same_name.is_empty() {

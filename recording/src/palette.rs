@@ -48,32 +48,50 @@ pub struct Line {
     pub width: f32,
 }
 
-/// Wide, for the true state in a PNG, drawn under the estimates.
-pub const WIDE: f32 = 3.0;
-/// Everything else.
+/// Estimates and every other signal.
 pub const THIN: f32 = 1.5;
+/// How much wider each estimate is than the one drawn over it, so estimates that coincide
+/// still all show (as nested bands).
+const NEST: f32 = 0.8;
+/// How much wider the true state is than the widest estimate over it in a PNG.
+const TRUE_MARGIN: f32 = 1.5;
 
-/// The width of the entity at `path` in the Rerun viewer. The viewer draws a view's series in
-/// entity-path order, so `/plant/x/…` lands on top of `/observer/…` whatever the blueprint
-/// says; there the estimates are the wide lines and the true state the thin one over them,
-/// which keeps both visible where they coincide (a PNG draws the other way round).
-pub fn viewer_width(path: &str) -> f32 {
+/// Width of an estimate drawn `over` other estimates, which lie on top of it.
+fn nested(over: usize) -> f32 {
+    THIN + NEST * over as f32
+}
+
+/// The width of the entity at `path` in the Rerun viewer of a run with `observers`. The viewer
+/// draws a view's series in entity-path order, so `/plant/x/…` lands on top of `/observer/…`
+/// whatever the blueprint says, and observers in name order: there the true state is the
+/// thin line over the estimates, and the estimate drawn first the widest, which keeps every
+/// line visible where they coincide (a PNG draws the other way round, see [`line`]).
+pub fn viewer_width(path: &str, observers: &[String]) -> f32 {
     let parts: Vec<&str> = path.trim_start_matches('/').split('/').collect();
     match parts.as_slice() {
-        ["observer", _, "xhat", _] => WIDE,
+        ["observer", o, "xhat", _] => {
+            let later = observers.iter().filter(|x| x.as_str() > *o).count();
+            nested(later + 1)
+        }
         _ => THIN,
     }
 }
 
 /// The line of the entity at `path` (see [`crate::signals`]) in a run whose observers are
-/// `observers`, in scenario order: the rule both the recording and the PNG plots follow.
+/// `observers`, in scenario order: the colours both the recording and the PNG plots use, and
+/// the PNG widths (a PNG draws the true state first, widest, then the estimates in scenario
+/// order, each thinner than the one before).
 pub fn line(path: &str, observers: &[String]) -> Line {
     let thin = |color| Line { color, width: THIN };
     let parts: Vec<&str> = path.trim_start_matches('/').split('/').collect();
     let k = parts.last().and_then(|s| s.parse::<usize>().ok()).map_or(0, |k| k.saturating_sub(1));
     let observer = |name: &str| color(observers.iter().position(|o| o == name).unwrap_or(observers.len()));
     match parts.as_slice() {
-        ["plant", "x", _] => Line { color: TRUE_STATE, width: WIDE },
+        ["plant", "x", _] => Line { color: TRUE_STATE, width: nested(observers.len().saturating_sub(1)) + TRUE_MARGIN },
+        ["observer", o, "xhat", _] => {
+            let later = observers.iter().position(|x| x == o).map_or(0, |i| observers.len() - 1 - i);
+            Line { color: observer(o), width: nested(later) }
+        }
         ["plant", "y", _] | ["disturbance", _] | ["input", _] => thin(color(k)),
         // Beside w and r in their views, from the other end of the palette.
         ["measurement_disturbance", _] | ["controller", "u", _] => thin(color(PALETTE.len() - 1 - k)),
@@ -126,10 +144,22 @@ mod tests {
         assert_eq!(line("/observer/luenberger/error/1", &obs).color, c);
         assert_ne!(line("/observer/luenberger/error/2", &obs).color, line("/observer/luenberger/error/3", &obs).color);
         assert_eq!(line("/latency/plant_to_observer_luenberger", &obs).color, c);
-        assert_eq!(line("/plant/x/1", &obs), Line { color: TRUE_STATE, width: WIDE });
+        assert_eq!(line("/plant/x/1", &obs).color, TRUE_STATE);
         assert_ne!(line("/input/1", &obs).color, line("/controller/u/1", &obs).color);
-        // Wide under thin: in a PNG the truth is drawn first, in the viewer last.
-        assert!(line("/plant/x/1", &obs).width > line("/observer/uio/xhat/1", &obs).width);
-        assert!(viewer_width("/plant/x/1") < viewer_width("/observer/uio/xhat/1"));
+    }
+
+    /// What is drawn first is wider than what is drawn over it: in a PNG the truth, then the
+    /// observers in scenario order; in the viewer the observers in name order, then the truth.
+    #[test]
+    fn lines_drawn_first_are_wider() {
+        let obs = ["uio".to_string(), "luenberger".to_string(), "dgo".to_string()];
+        let png = |p: &str| line(p, &obs).width;
+        assert!(png("/plant/x/1") > png("/observer/uio/xhat/1"));
+        assert!(png("/observer/uio/xhat/1") > png("/observer/luenberger/xhat/1"));
+        assert!(png("/observer/luenberger/xhat/1") > png("/observer/dgo/xhat/1"));
+        let viewer = |p: &str| viewer_width(p, &obs);
+        assert!(viewer("/observer/dgo/xhat/1") > viewer("/observer/luenberger/xhat/1"));
+        assert!(viewer("/observer/luenberger/xhat/1") > viewer("/observer/uio/xhat/1"));
+        assert!(viewer("/observer/uio/xhat/1") > viewer("/plant/x/1"));
     }
 }

@@ -14,8 +14,8 @@ use std::sync::Once;
 use plotters::style::FontStyle;
 use scenario::{Named, Scenario};
 
-pub use figure::{linear_label, log_label, Curve, Figure, Scale, SIZE};
-pub use select::{glob, Selection};
+pub use figure::{Curve, Figure, Scale, SIZE};
+pub use select::{Matcher, Selection};
 
 use crate::palette;
 use crate::read::{Recording, Series};
@@ -158,8 +158,8 @@ fn log_max_error(r: &Recording, o: &str) -> Option<Series> {
 
 /// The figures of every selected view of `r`, with their file names; an error names what is
 /// wrong (a bad selection, nothing selected).
-pub fn figures(r: &Recording, sel: &Selection) -> Result<Vec<(String, Figure)>, String> {
-    sel.validate()?;
+pub fn figures(r: &Recording, selection: &Selection) -> Result<Vec<(String, Figure)>, String> {
+    let sel = selection.matcher()?;
     let scenario = recorded_scenario(r);
     let s = scenario.as_ref();
     let dt = s.map(|s| s.dt);
@@ -209,7 +209,7 @@ pub fn figures(r: &Recording, sel: &Selection) -> Result<Vec<(String, Figure)>, 
         }
     }
     if out.is_empty() {
-        return Err(format!("nothing to plot: no selected signal has data{}", if sel.from.is_some() || sel.to.is_some() { " in the time window" } else { "" }));
+        return Err(format!("nothing to plot: no selected signal has data{}", if selection.from.is_some() || selection.to.is_some() { " in the time window" } else { "" }));
     }
     Ok(out)
 }

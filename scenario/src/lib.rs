@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 use controller::design::FeedbackSpec;
 use lti::signal::Signal;
-use lti::Model;
+use lti::{Mat, Model};
 use observer::Spec;
 
 pub use raw::RawExpect;
@@ -105,6 +105,8 @@ pub struct ControllerEntry {
     pub observer: String,
     /// How G is obtained.
     pub spec: FeedbackSpec,
+    /// Tracked outputs z = C_t x (l×n): the prefilter makes them follow r.
+    pub track: Option<Mat>,
 }
 
 /// A problem with a scenario file.

@@ -100,6 +100,8 @@ pub struct RawController {
     pub poles: Option<Vec<RawPole>>,
     pub gain: Option<Rows>,
     pub placement: Option<String>,
+    /// Rows of C_t: the state combinations that follow the reference.
+    pub track: Option<Rows>,
 }
 
 /// `[expect]`: per-observer upper bounds on the run's figures.

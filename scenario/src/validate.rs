@@ -347,7 +347,8 @@ fn controller_entry(c: &RawController, model: &Model, observers: &BTreeSet<Strin
         (Some(_), Some(_)) => return Err(bad("controller.gain", "give poles or gain, not both")),
         (None, None) => return Err(bad("controller.poles", "a state-feedback controller needs poles = […] or gain = [[…]]")),
     };
-    Ok(ControllerEntry { observer: c.observer.clone(), spec })
+    let track = c.track.as_ref().map(|t| matrix("controller.track", t, (Some(model.l()), Some(model.n())), "one row per input: the state combination that follows it")).transpose()?;
+    Ok(ControllerEntry { observer: c.observer.clone(), spec, track })
 }
 
 fn check_expect(e: &RawExpect, observers: &BTreeSet<String>) -> Result<(), Bad> {

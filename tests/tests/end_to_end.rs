@@ -47,8 +47,13 @@ fn check_scenario(name: &str) {
         let same = sp.values.iter().zip(&si.values).all(|(a, b)| a.to_bits() == b.to_bits());
         assert!(same && sp.values.len() == si.values.len(), "{kp} differs between modes");
     }
-    // The latency series are there too, one per completed step.
-    assert_eq!(rp.series["/latency/step"].values.len(), steps as usize - 1);
+    // The latency series are there too, one per step: the last step's too, closed by the
+    // plant's end sample (issue 10, item 15).
+    for hop in ["/latency/step", "/latency/controller_to_plant"] {
+        let l = &rp.series[hop];
+        assert_eq!(l.steps, (0..steps as i64).collect::<Vec<_>>(), "{hop}");
+        assert!(l.values.iter().all(|&v| v > 0.0 && v < 1e9), "{hop}");
+    }
 }
 
 #[test]

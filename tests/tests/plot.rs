@@ -137,7 +137,7 @@ fn signals_and_a_time_window_choose_what_is_drawn() {
         }
     }
     // A bad window or glob: exit 2, one line naming the option, nothing drawn.
-    for (args, what) in [(vec!["--from", "3", "--to", "1"], "--from"), (vec!["--to", "nan"], "--to"), (vec!["--signals", "observer"], "--signals")] {
+    for (args, what) in [(vec!["--from", "3", "--to", "1"], "--from"), (vec!["--to", "nan"], "--to"), (vec!["--signals", "/plant/[x"], "--signals")] {
         let out = launcher(&s).arg("plot").arg(&rrd).args(["--out", "bad"]).args(&args).output().unwrap();
         let (_, err) = text(&out);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");

@@ -65,7 +65,7 @@ pub fn configs(s: &Scenario, plan: &Plan) -> Configs {
         })
         .collect();
     let controller = match (&s.controller, &plan.feedback) {
-        (Some(c), Some(fb)) => Some(ControllerConfig { g: (&fb.g).into(), references: s.inputs.clone(), dt: s.dt, steps: s.steps, observer: c.observer.clone() }),
+        (Some(c), Some(fb)) => Some(ControllerConfig { g: (&fb.g).into(), n: (&fb.n).into(), references: s.inputs.clone(), dt: s.dt, steps: s.steps, observer: c.observer.clone() }),
         _ => None,
     };
     Configs { plant, observers, controller, layout }

@@ -35,7 +35,7 @@ impl Progress {
             Some(bar) => bar.set_position(done),
             None if self.start.elapsed() >= SHOW_AFTER => {
                 let bar = ProgressBar::with_draw_target(Some(self.total), ProgressDrawTarget::stderr());
-                let style = ProgressStyle::with_template("{bar:40} {pos}/{len} steps  {per_sec}  eta {eta}").unwrap_or_else(|_| ProgressStyle::default_bar());
+                let style = ProgressStyle::with_template("{bar:40} {pos}/{len} steps  {elapsed} elapsed, eta {eta}").unwrap_or_else(|_| ProgressStyle::default_bar());
                 bar.set_style(style);
                 bar.set_position(done);
                 self.bar = Some(bar);

@@ -92,7 +92,7 @@ impl Session {
                 // Colours and widths by the palette's rule, which the PNG plots follow too.
                 let mut series = |g: usize, path: String, legend: String| {
                     let line = palette::line(&path, &observer_names);
-                    sink.series(g, &path, &legend, line.color, palette::viewer_width(&path))
+                    sink.series(g, &path, &legend, line.color, palette::viewer_width(&path, &observer_names))
                 };
                 let x = (0..layout.n).map(|i| series(signals, sig::state(i), format!("{} (true)", names.state[i].name))).collect();
                 let y = (0..layout.p).map(|j| series(signals, sig::output(j), names.output[j].name.clone())).collect();

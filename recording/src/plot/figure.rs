@@ -62,7 +62,7 @@ fn tick_step(lo: f64, hi: f64, n: usize) -> f64 {
 }
 
 /// A linear tick label with the digits its step needs: "0.25", "-3", "2.5e-15".
-pub fn linear_label(v: f64, step: f64, max_abs: f64) -> String {
+fn linear_label(v: f64, step: f64, max_abs: f64) -> String {
     if v.abs() < step * 1e-6 {
         return "0".into();
     }
@@ -77,7 +77,7 @@ pub fn linear_label(v: f64, step: f64, max_abs: f64) -> String {
 }
 
 /// A log-axis tick label: the value 10^v, plain near 1, else as a power of ten.
-pub fn log_label(v: f64, step: f64) -> String {
+fn log_label(v: f64, step: f64) -> String {
     let value = 10f64.powf(v);
     if step >= 1.0 && (v - v.round()).abs() < 1e-9 {
         let e = v.round() as i32;
@@ -177,4 +177,22 @@ fn frame(buf: &mut [u8], fig: &Figure, (x0, x1, y0, y1): (f64, f64, f64, f64)) -
     }
     root.present().map_err(|e| e.to_string())?;
     Ok((plot, samples))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Rounding-level errors get readable ticks, not 0.000000000000002 or a row of zeros.
+    #[test]
+    fn tick_labels_carry_the_digits_their_step_needs() {
+        assert_eq!(linear_label(2.5e-15, 5e-16, 1.2e-14), "2.5e-15");
+        assert_eq!(linear_label(-1e-11, 5e-12, 1.2e-11), "-1.0e-11");
+        assert_eq!(linear_label(1e-22, 5e-16, 1.2e-14), "0");
+        assert_eq!(linear_label(0.25, 0.05, 2.0), "0.25");
+        assert_eq!(linear_label(150000.0, 50000.0, 3e5), "150000");
+        assert_eq!(log_label(-15.0, 5.0), "1e-15");
+        assert_eq!(log_label(2.0, 1.0), "100");
+        assert_eq!(log_label(0.5, 0.1), "3.16");
+    }
 }

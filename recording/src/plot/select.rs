@@ -1,11 +1,14 @@
 //! What `launcher plot` draws: entities chosen by glob (`--signals '/observer/uio/**'`) and a
 //! time window (`--from`, `--to`).
 
+use globset::{GlobBuilder, GlobSet, GlobSetBuilder};
+use scenario::quoted;
+
 /// The choice of signals and time.
 #[derive(Debug, Clone, Default)]
 pub struct Selection {
     /// Entity globs; empty means every entity. `*` matches within one path segment, `**` any
-    /// number of segments, `?` one character.
+    /// number of segments (as `launcher run --record`).
     pub signals: Vec<String>,
     /// First time drawn, s (steps for a recording without its scenario).
     pub from: Option<f64>,
@@ -14,8 +17,14 @@ pub struct Selection {
 }
 
 impl Selection {
-    /// Checks the window: finite bounds, `from` before `to`. The message names the option.
+    /// Checks the window (finite bounds, `from` before `to`) and the globs; the message names
+    /// the option.
     pub fn validate(&self) -> Result<(), String> {
+        self.matcher().map(|_| ())
+    }
+
+    /// The compiled selection.
+    pub fn matcher(&self) -> Result<Matcher, String> {
         for (name, v) in [("--from", self.from), ("--to", self.to)] {
             if let Some(v) = v
                 && !v.is_finite()
@@ -28,46 +37,37 @@ impl Selection {
         {
             return Err(format!("--from {a} must be before --to {b}"));
         }
-        for g in &self.signals {
-            if !g.starts_with('/') {
-                return Err(format!("--signals: '{g}' must be an entity path glob starting with '/', e.g. '/observer/uio/**'"));
+        let globs = if self.signals.is_empty() {
+            None
+        } else {
+            // The rules of `launcher run --record`: `*` stops at '/', a leading '/' is implied.
+            let mut set = GlobSetBuilder::new();
+            for g in &self.signals {
+                let rooted = if g.starts_with('/') { g.clone() } else { format!("/{g}") };
+                set.add(GlobBuilder::new(&rooted).literal_separator(true).build().map_err(|e| format!("--signals {}: {}", quoted(g), e.kind()))?);
             }
-        }
-        Ok(())
+            Some(set.build().map_err(|e| format!("--signals: {e}"))?)
+        };
+        Ok(Matcher { globs, from: self.from, to: self.to })
     }
+}
 
+/// A checked [`Selection`].
+pub struct Matcher {
+    globs: Option<GlobSet>,
+    from: Option<f64>,
+    to: Option<f64>,
+}
+
+impl Matcher {
     /// Whether the entity at `path` is selected.
     pub fn entity(&self, path: &str) -> bool {
-        self.signals.is_empty() || self.signals.iter().any(|g| glob(g, path))
+        self.globs.as_ref().is_none_or(|g| g.is_match(path))
     }
 
     /// Whether time `x` is in the window.
     pub fn time(&self, x: f64) -> bool {
         self.from.is_none_or(|a| x >= a) && self.to.is_none_or(|b| x <= b)
-    }
-}
-
-/// Matches an entity path against a glob of path segments.
-pub fn glob(pattern: &str, path: &str) -> bool {
-    let p: Vec<&str> = pattern.trim_matches('/').split('/').filter(|s| !s.is_empty()).collect();
-    let s: Vec<&str> = path.trim_matches('/').split('/').filter(|s| !s.is_empty()).collect();
-    segments(&p, &s)
-}
-
-fn segments(p: &[&str], s: &[&str]) -> bool {
-    match p.split_first() {
-        None => s.is_empty(),
-        Some((&"**", rest)) => (0..=s.len()).any(|k| segments(rest, &s[k..])),
-        Some((first, rest)) => !s.is_empty() && segment(first.as_bytes(), s[0].as_bytes()) && segments(rest, &s[1..]),
-    }
-}
-
-fn segment(p: &[u8], s: &[u8]) -> bool {
-    match p.split_first() {
-        None => s.is_empty(),
-        Some((b'*', rest)) => (0..=s.len()).any(|k| segment(rest, &s[k..])),
-        Some((b'?', rest)) => !s.is_empty() && segment(rest, &s[1..]),
-        Some((c, rest)) => s.first() == Some(c) && segment(rest, &s[1..]),
     }
 }
 
@@ -77,15 +77,16 @@ mod tests {
 
     #[test]
     fn globs_match_by_segment() {
-        assert!(glob("/observer/uio/**", "/observer/uio/xhat/1"));
-        assert!(glob("/observer/uio/**", "/observer/uio/log10_max_abs_error"));
-        assert!(!glob("/observer/uio/**", "/observer/luenberger/xhat/1"));
-        assert!(glob("/observer/*/error/*", "/observer/luenberger/error/3"));
-        assert!(!glob("/observer/*/error/*", "/observer/luenberger/xhat/3"));
-        assert!(!glob("/plant/*", "/plant/x/1"));
-        assert!(glob("/plant/x/?", "/plant/x/1"));
-        assert!(glob("/**/residual/*", "/observer/uio/residual/2"));
-        assert!(glob("/plant/x/1", "/plant/x/1") && !glob("/plant/x/1", "/plant/x/10"));
+        let m = |g: &str| Selection { signals: vec![g.to_string()], from: None, to: None }.matcher().unwrap();
+        assert!(m("/observer/uio/**").entity("/observer/uio/xhat/1"));
+        assert!(m("/observer/uio/**").entity("/observer/uio/log10_max_abs_error"));
+        assert!(!m("/observer/uio/**").entity("/observer/luenberger/xhat/1"));
+        assert!(m("/observer/*/error/*").entity("/observer/luenberger/error/3"));
+        assert!(!m("/observer/*/error/*").entity("/observer/luenberger/xhat/3"));
+        assert!(!m("/plant/*").entity("/plant/x/1"));
+        assert!(m("plant/x/?").entity("/plant/x/1"));
+        assert!(m("/plant/x/1").entity("/plant/x/1") && !m("/plant/x/1").entity("/plant/x/10"));
+        assert!(Selection { signals: vec!["/plant/[x".into()], from: None, to: None }.validate().unwrap_err().contains("--signals"));
     }
 
     #[test]

@@ -12,7 +12,7 @@ use scenario::{Named, Scenario};
 use crate::signals;
 
 /// "what: a [m], b [V]" for a handful of components, "what" alone for more.
-pub fn titled(what: &str, parts: &[String]) -> String {
+fn titled(what: &str, parts: &[String]) -> String {
     if parts.is_empty() || parts.len() > 4 { what.to_string() } else { format!("{what}: {}", parts.join(", ")) }
 }
 
