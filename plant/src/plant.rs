@@ -44,7 +44,8 @@ struct Piece {
 pub struct Divergence {
     /// The step whose result diverged (x_{step+1}).
     pub step: u64,
-    /// The state that diverged: x[state].
+    /// The index of the state that diverged (from 0; messages name it x{state + 1}, the
+    /// project's 1-based numbering of signals).
     pub state: usize,
     /// Its value.
     pub value: f64,
@@ -55,9 +56,9 @@ pub struct Divergence {
 impl std::fmt::Display for Divergence {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         if self.value.is_finite() {
-            write!(f, "x[{}] = {:.6e} left the bound ±{:.3e} at step {}", self.state, self.value, self.bound, self.step + 1)
+            write!(f, "x{} = {:.6e} left the bound ±{:.3e} at step {}", self.state + 1, self.value, self.bound, self.step + 1)
         } else {
-            write!(f, "x[{}] = {} at step {}", self.state, self.value, self.step + 1)
+            write!(f, "x{} = {} at step {}", self.state + 1, self.value, self.step + 1)
         }
     }
 }

@@ -107,7 +107,7 @@ fn divergence_names_the_state_and_step() {
         k += 1;
     };
     assert_eq!(err.state, 0);
-    assert!(err.to_string().starts_with("x[0] = "), "{err}");
+    assert!(err.to_string().starts_with("x1 = "), "{err}");
     assert_eq!(err.step, 1); // e^{10} ≈ 2.2e4, e^{20} ≈ 4.9e8 > 1e6
     assert!(err.to_string().contains("step 2"), "{err}");
 }

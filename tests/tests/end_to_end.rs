@@ -38,8 +38,8 @@ fn check_scenario(name: &str) {
     assert!(rp.complete && ri.complete);
     let (tp, ti) = (trajectories(&rp), trajectories(&ri));
     assert_eq!(tp.len(), ti.len());
-    // x (3) y (2) w (1) r (2) u (2) + 2 observers × (x̂ 3 + e 3 + r 2)
-    assert_eq!(tp.len(), 3 + 2 + 1 + 2 + 2 + 2 * 8, "{:?}", tp.iter().map(|(k, _)| k).collect::<Vec<_>>());
+    // x (3) y (2) w (1) r (2) u (2) + 2 observers × (x̂ 3 + e 3 + r 2 + log10 max|e| 1)
+    assert_eq!(tp.len(), 3 + 2 + 1 + 2 + 2 + 2 * 9, "{:?}", tp.iter().map(|(k, _)| k).collect::<Vec<_>>());
     for ((kp, sp), (ki, si)) in tp.iter().zip(&ti) {
         assert_eq!(kp, ki);
         // Exactly one value per step.

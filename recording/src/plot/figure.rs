@@ -69,8 +69,9 @@ fn linear_label(v: f64, step: f64, max_abs: f64) -> String {
     let step_exp = step.log10().floor() as i32;
     let exp = max_abs.log10().floor() as i32;
     if !(-3..6).contains(&exp) {
-        // Scientific with the mantissa digits the step resolves.
-        format!("{:.*e}", (exp - step_exp).clamp(0, 6) as usize, v)
+        // Scientific with the mantissa digits the step resolves at this value's magnitude.
+        let own = v.abs().log10().floor() as i32;
+        format!("{:.*e}", (own - step_exp).clamp(0, 6) as usize, v)
     } else {
         format!("{:.*}", (-step_exp).max(0) as usize, v)
     }
