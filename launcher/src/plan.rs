@@ -30,6 +30,7 @@ pub struct PlanError {
 }
 
 /// Designs every observer and the controller.
+#[allow(clippy::result_large_err)] // made once per command, never on a hot path
 pub fn plan(s: &Scenario) -> Result<Plan, PlanError> {
     let locate = |field: String, reason: String| scenario::locate_error(s, &field, reason);
     let mut observers = Vec::new();

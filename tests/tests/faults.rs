@@ -20,41 +20,10 @@ fn start(s: &Scratch, scenario: &PathBuf, extra: &[&str]) -> Child {
     launcher(s).arg("run").arg(scenario).arg("--out").arg(s.join("out")).args(extra).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap()
 }
 
-/// The pid of a component of launcher `pid` whose `--name` is `name`.
-fn component_pid(launcher_pid: u32, name: &str) -> Option<i32> {
-    let run = format!("--run\0{launcher_pid}x");
-    let named = format!("--name\0{name}\0");
-    for e in std::fs::read_dir("/proc").ok()?.flatten() {
-        let Ok(pid) = e.file_name().to_string_lossy().parse::<i32>() else { continue };
-        if let Ok(cmd) = std::fs::read(e.path().join("cmdline")) {
-            let cmd = String::from_utf8_lossy(&cmd);
-            if cmd.contains(&run) && cmd.contains(&named) {
-                return Some(pid);
-            }
-        }
-    }
-    None
-}
-
-/// Waits until every component of the run is up and stepping.
-fn wait_running(launcher_pid: u32, names: &[&str]) {
-    let deadline = Instant::now() + Duration::from_secs(20);
-    while names.iter().any(|n| component_pid(launcher_pid, n).is_none()) {
-        assert!(Instant::now() < deadline, "components did not start");
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    std::thread::sleep(Duration::from_millis(100));
-}
-
 /// A reproducible pseudo-random delay (ms) in [lo, hi).
 fn delay(seed: u64, lo: u64, hi: u64) -> Duration {
     let x = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407) >> 33;
     Duration::from_millis(lo + x % (hi - lo))
-}
-
-fn signal(pid: i32, sig: i32) {
-    // SAFETY: sending a signal to a process this test started.
-    unsafe { libc::kill(pid, sig) };
 }
 
 /// Waits for the launcher, returning its output and how long it took after `since`.
@@ -93,33 +62,6 @@ fn a_killed_component_stops_the_run_cleanly() {
             assert!(steps > 0 && steps < 600_000, "{victim}: {steps} steps recorded");
             let sum = summary(&s, "seed002-sine");
             assert!(sum["stopped"].as_str().unwrap().contains("SIGKILL"), "{sum}");
-        }
-    }
-}
-
-#[test]
-fn sigint_and_sigterm_stop_the_run_cleanly() {
-    for (sig, name) in [(libc::SIGINT, "SIGINT"), (libc::SIGTERM, "SIGTERM")] {
-        for mode in ["processes", "in-process"] {
-            let s = Scratch::new(&format!("{name}-{mode}"));
-            let path = long_scenario(&s, if mode == "in-process" { 20_000 } else { 600 });
-            let child = start(&s, &path, &["--mode", mode]);
-            let lpid = child.id();
-            if mode == "processes" {
-                wait_running(lpid, &["plant", "uio", "luenberger", "controller"]);
-            } else {
-                std::thread::sleep(Duration::from_millis(500));
-            }
-            signal(lpid as i32, sig);
-            let sent = Instant::now();
-            let (out, took) = finish(child, sent);
-            let (_, err) = text(&out);
-            assert!(took < Duration::from_secs(2), "{name} {mode}: took {took:?}");
-            assert_eq!(out.status.code(), Some(130), "{name} {mode}: {err}");
-            assert!(err.contains(name), "{name} {mode}: {err}");
-            assert_clean(&s, lpid);
-            let r = read(&s.join("out/seed002-sine.rrd")).unwrap();
-            assert!(r.complete && !r.series["/plant/x/1"].values.is_empty(), "{name} {mode}");
         }
     }
 }
@@ -201,37 +143,46 @@ fn components_started_by_hand_say_how_to_start_them() {
     }
 }
 
+/// A signal to the launcher stops the run like a failed component — components stopped,
+/// recording closed, nothing left behind — with exit code `code`, in both modes.
+fn a_signal_stops_the_run_cleanly(sig: i32, name: &str, code: i32) {
+    for mode in ["processes", "in-process"] {
+        let s = Scratch::new(&format!("{name}-{mode}"));
+        let path = long_scenario(&s, if mode == "in-process" { 20_000 } else { 600 });
+        let child = start(&s, &path, &["--mode", mode]);
+        let lpid = child.id();
+        if mode == "processes" {
+            wait_running(lpid, &["plant", "uio", "luenberger", "controller"]);
+        } else {
+            std::thread::sleep(Duration::from_millis(500));
+        }
+        signal(lpid as i32, sig);
+        let sent = Instant::now();
+        let (out, took) = finish(child, sent);
+        let (_, err) = text(&out);
+        assert!(took < Duration::from_secs(2), "{name} {mode}: took {took:?}");
+        assert_eq!(out.status.code(), Some(code), "{name} {mode}: {err}");
+        assert!(err.contains(name), "{name} {mode}: {err}");
+        assert_clean(&s, lpid);
+        let r = read(&s.join("out/seed002-sine.rrd")).unwrap();
+        assert!(r.complete && !r.series["/plant/x/1"].values.is_empty(), "{name} {mode}");
+        let sum = summary(&s, "seed002-sine");
+        assert!(sum["stopped"].as_str().unwrap().contains(name), "{sum}");
+    }
+}
+
+#[test]
+fn sigint_and_sigterm_stop_the_run_cleanly() {
+    a_signal_stops_the_run_cleanly(libc::SIGINT, "SIGINT", 130);
+    a_signal_stops_the_run_cleanly(libc::SIGTERM, "SIGTERM", 130);
+}
+
 /// Issue 10, item 16: a closed terminal (SIGHUP) or Ctrl-\ (SIGQUIT) stops the run like
-/// SIGTERM — components stopped, recording closed, nothing left behind — with exit code 128 +
-/// the signal's number.
+/// SIGTERM, with exit code 128 + the signal's number.
 #[test]
 fn sighup_and_sigquit_stop_the_run_cleanly() {
-    for (sig, name, code) in [(libc::SIGHUP, "SIGHUP", 129), (libc::SIGQUIT, "SIGQUIT", 131)] {
-        for mode in ["processes", "in-process"] {
-            let s = Scratch::new(&format!("{name}-{mode}"));
-            let path = long_scenario(&s, if mode == "in-process" { 20_000 } else { 600 });
-            let child = start(&s, &path, &["--mode", mode]);
-            let lpid = child.id();
-            if mode == "processes" {
-                wait_running(lpid, &["plant", "uio", "luenberger", "controller"]);
-            } else {
-                std::thread::sleep(Duration::from_millis(500));
-            }
-            signal(lpid as i32, sig);
-            let sent = Instant::now();
-            let (out, took) = finish(child, sent);
-            let (_, err) = text(&out);
-            assert!(took < Duration::from_secs(2), "{name} {mode}: took {took:?}");
-            assert_eq!(out.status.code(), Some(code), "{name} {mode}: {err}");
-            assert!(err.contains(name), "{name} {mode}: {err}");
-            assert_clean(&s, lpid);
-            let r = read(&s.join("out/seed002-sine.rrd")).unwrap();
-            let x = r.series.keys().find(|k| k.starts_with("/plant/x/")).unwrap();
-            assert!(r.complete && !r.series[x].values.is_empty(), "{name} {mode}");
-            let sum = summary(&s, "seed002-sine");
-            assert!(sum["stopped"].as_str().unwrap().contains(name), "{sum}");
-        }
-    }
+    a_signal_stops_the_run_cleanly(libc::SIGHUP, "SIGHUP", 129);
+    a_signal_stops_the_run_cleanly(libc::SIGQUIT, "SIGQUIT", 131);
 }
 
 /// Mounts a tmpfs of `size` at `dir`; false when mounting is not permitted here.

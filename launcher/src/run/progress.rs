@@ -28,7 +28,7 @@ impl Progress {
     /// Notes that `done` steps are complete.
     #[inline]
     pub fn tick(&mut self, done: u64) {
-        if done % EVERY != 0 {
+        if !done.is_multiple_of(EVERY) {
             return;
         }
         match &self.bar {

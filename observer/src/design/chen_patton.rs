@@ -33,6 +33,7 @@ pub(super) struct Core {
     pub fixed: Vec<C64>,
 }
 
+#[allow(clippy::too_many_arguments)]
 pub(super) fn core(
     a: &Mat,
     c: &Mat,

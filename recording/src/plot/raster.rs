@@ -74,9 +74,9 @@ pub fn polyline(canvas: &mut Canvas, clip: Rect, points: &[(f64, f64)], color: R
             if o + 3 > canvas.buf.len() {
                 continue;
             }
-            for k in 0..3 {
-                let under = canvas.buf[o + k] as f32;
-                canvas.buf[o + k] = (under + (color[k] as f32 - under) * c).round() as u8;
+            for (px, &want) in canvas.buf[o..o + 3].iter_mut().zip(&color[..3]) {
+                let under = *px as f32;
+                *px = (under + (want as f32 - under) * c).round() as u8;
             }
         }
     }
@@ -100,7 +100,7 @@ fn cut(a: (f64, f64), b: (f64, f64), (x0, y0, x1, y1): (f64, f64, f64, f64)) -> 
             }
         }
     }
-    (t0 <= t1).then(|| ((a.0 + t0 * dx, a.1 + t0 * dy), (a.0 + t1 * dx, a.1 + t1 * dy)))
+    (t0 <= t1).then_some(((a.0 + t0 * dx, a.1 + t0 * dy), (a.0 + t1 * dx, a.1 + t1 * dy)))
 }
 
 #[cfg(test)]

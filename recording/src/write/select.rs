@@ -44,7 +44,7 @@ impl Selection {
     /// Whether step `k` is recorded.
     #[inline]
     pub fn step(&self, k: u64) -> bool {
-        self.every == 1 || k % self.every == 0
+        self.every == 1 || k.is_multiple_of(self.every)
     }
 
     /// Whether entity `path` is recorded.

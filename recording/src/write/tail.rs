@@ -75,7 +75,7 @@ mod tests {
         let planned = 10 * MAX_BLOCKS;
         let b = block_len(planned);
         assert_eq!(b, 16);
-        assert_eq!(tail_start(1_003, planned), Some(752 - 752 % 16));
+        assert_eq!(tail_start(1_003, planned), Some(753 - 753 % 16));
     }
 
     #[test]
