@@ -56,8 +56,14 @@ pub fn report(s: &Scenario) -> DesignReport {
     let mut text = format!("{}: {}\n", s.name, scenario::untrusted::one_line(&s.description));
     let mut observers = Vec::new();
     for o in &s.observers {
-        text += &format!("\nobserver '{}' ({})\n", o.name, o.spec.kind());
-        match design(&s.model, &o.spec, s.dt) {
+        text += &format!("\nobserver '{}' ({})\n", o.name, o.kind());
+        let Some(spec) = &o.spec else {
+            let p = o.process.as_ref().expect("an observer without a design is a process");
+            text += &format!("  external process: {}\n", scenario::untrusted::one_line(&p.command.join(" ")));
+            observers.push(json!({ "name": o.name, "kind": "process", "command": p.command, "params": p.params }));
+            continue;
+        };
+        match design(&s.model, spec, s.dt) {
             Ok(d) => {
                 let r = &d.report;
                 text += "  conditions:\n";
@@ -76,7 +82,7 @@ pub fn report(s: &Scenario) -> DesignReport {
                 }
                 let matrices: BTreeMap<&str, Vec<Vec<f64>>> = r.matrices.iter().map(|(n, m)| (n.as_str(), rows(m))).collect();
                 observers.push(json!({
-                    "name": o.name, "kind": o.spec.kind(),
+                    "name": o.name, "kind": o.kind(),
                     "conditions": conditions_json(&r.conditions),
                     "matrices": matrices,
                     "poles": lti::re_im(&r.poles),
@@ -94,7 +100,7 @@ pub fn report(s: &Scenario) -> DesignReport {
                 }
                 text += &format!("  no observer: {} does not hold: {}\n", e.condition, e.detail);
                 observers.push(json!({
-                    "name": o.name, "kind": o.spec.kind(),
+                    "name": o.name, "kind": o.kind(),
                     "conditions": conditions_json(&e.conditions),
                     "error": format!("{} does not hold: {}", e.condition, e.detail),
                 }));
@@ -125,6 +131,10 @@ pub fn report(s: &Scenario) -> DesignReport {
                         "discrete_closed_loop_poles": lti::re_im(&fb.discrete_closed_loop),
                         "stable": fb.stable(),
                     });
+                }
+                if let Some((c, p)) = s.controller.as_ref().and_then(|c| c.process.as_ref().map(|p| (c, p))) {
+                    text += &format!("\ncontroller: external process on '{}': {}\n", c.observer, scenario::untrusted::one_line(&p.command.join(" ")));
+                    controller = json!({ "kind": "process", "observer": c.observer, "command": p.command, "params": p.params });
                 }
             }
             Err(e) => {

@@ -355,10 +355,14 @@ fn component(kind: &str, args: Vec<String>) -> ExitCode {
         // SAFETY: PR_SET_NAME copies at most 16 bytes from a valid C string.
         unsafe { libc::prctl(libc::PR_SET_NAME, name.as_ptr()) };
     }
-    lockstep::component_main(kind, args, |l| match kind {
-        "plant" => plant::shell::run(l).map_err(|e| (e.exit_code(), e.to_string())),
-        "observer" => observer::shell::run(l).map_err(|e| (observer::shell::EXIT_FAILED, e.to_string())),
-        "controller" => controller::shell::run(l).map_err(|e| (controller::shell::EXIT_FAILED, e.to_string())),
-        other => Err((lockstep::EXIT_USAGE, format!("unknown component '{other}'"))),
-    })
+    use lockstep::component::main_with_args;
+    match kind {
+        "plant" => main_with_args::<plant::shell::PlantComponent>(kind, args),
+        "observer" => main_with_args::<observer::shell::ObserverComponent>(kind, args),
+        "controller" => main_with_args::<controller::shell::ControllerComponent>(kind, args),
+        other => {
+            eprintln!("unknown component {}", scenario::untrusted::quoted(other));
+            ExitCode::from(lockstep::EXIT_USAGE as u8)
+        }
+    }
 }

@@ -10,9 +10,9 @@ use scenario::{Scenario, ScenarioError};
 /// The designs of a scenario.
 #[derive(Debug, Clone)]
 pub struct Plan {
-    /// (name, design) per observer, in scenario order.
-    pub observers: Vec<(String, Designed)>,
-    /// The state feedback, if any.
+    /// (name, design) per observer, in scenario order; no design for an external observer.
+    pub observers: Vec<(String, Option<Designed>)>,
+    /// The state feedback, if any (not for an external controller).
     pub feedback: Option<FeedbackDesign>,
     /// Things worth knowing that do not stop a run.
     pub warnings: Vec<String>,
@@ -35,7 +35,11 @@ pub fn plan(s: &Scenario) -> Result<Plan, PlanError> {
     let locate = |field: String, reason: String| scenario::locate_error(s, &field, reason);
     let mut observers = Vec::new();
     for (i, o) in s.observers.iter().enumerate() {
-        let d = design(&s.model, &o.spec, s.dt).map_err(|e| {
+        let Some(spec) = &o.spec else {
+            observers.push((o.name.clone(), None));
+            continue;
+        };
+        let d = design(&s.model, spec, s.dt).map_err(|e| {
             let placement = e.condition.ends_with("poles") || e.condition.ends_with("pole placement");
             let (sub, reason) = if placement {
                 (".poles", format!("{} observer '{}': {}", e.kind, o.name, e.detail))
@@ -48,11 +52,11 @@ pub fn plan(s: &Scenario) -> Result<Plan, PlanError> {
                 observer: Some(i),
             }
         })?;
-        observers.push((o.name.clone(), d));
+        observers.push((o.name.clone(), Some(d)));
     }
-    let feedback = match &s.controller {
-        Some(c) => Some(design_feedback(&s.model, &c.spec, c.track.as_ref(), s.dt).map_err(|reason| {
-            let field = if matches!(c.spec, FeedbackSpec::Gain(_)) { "controller.gain" } else { "controller.poles" };
+    let feedback = match s.controller.as_ref().and_then(|c| c.spec.as_ref().map(|spec| (c, spec))) {
+        Some((c, spec)) => Some(design_feedback(&s.model, spec, c.track.as_ref(), s.dt).map_err(|reason| {
+            let field = if matches!(spec, FeedbackSpec::Gain(_)) { "controller.gain" } else { "controller.poles" };
             PlanError { error: locate(field.into(), reason), conditions: vec![], observer: None }
         })?),
         None => None,
@@ -62,7 +66,8 @@ pub fn plan(s: &Scenario) -> Result<Plan, PlanError> {
 }
 
 /// dt too coarse for the fastest pole, an unstable loop, and the like.
-fn warnings(s: &Scenario, observers: &[(String, Designed)], feedback: Option<&FeedbackDesign>) -> Vec<String> {
+fn warnings(s: &Scenario, observers: &[(String, Option<Designed>)], feedback: Option<&FeedbackDesign>) -> Vec<String> {
+    let observers: Vec<(&String, &Designed)> = observers.iter().filter_map(|(n, d)| d.as_ref().map(|d| (n, d))).collect();
     let mut out = Vec::new();
     let fastest = |ev: &[C64]| ev.iter().map(|z| z.norm()).fold(0.0, f64::max);
     let mut check = |what: String, ev: &[C64]| {
@@ -74,7 +79,7 @@ fn warnings(s: &Scenario, observers: &[(String, Designed)], feedback: Option<&Fe
     if let Ok(ev) = eigenvalues(&s.model.a) {
         check("the plant".into(), &ev);
     }
-    for (name, d) in observers {
+    for (name, d) in &observers {
         check(format!("observer '{name}'"), &d.report.poles);
     }
     if let Some(fb) = feedback {
@@ -83,7 +88,7 @@ fn warnings(s: &Scenario, observers: &[(String, Designed)], feedback: Option<&Fe
             out.push(why);
         }
     }
-    for (name, d) in observers {
+    for (name, d) in &observers {
         if !d.report.fixed_modes.is_empty() {
             out.push(format!("observer '{name}': fixed modes {} cannot be moved by any admissible gain", format_list(&d.report.fixed_modes)));
         }

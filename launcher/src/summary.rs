@@ -107,13 +107,13 @@ impl Summary {
             .zip(&plan.observers)
             .map(|((o, f), (_, d))| ObserverSummary {
                 name: o.name.clone(),
-                kind: o.spec.kind().into(),
+                kind: o.kind().into(),
                 tail_max_abs_error: f.tail_max_abs_error,
                 tail_max_abs_residual: f.tail_max_abs_residual,
                 max_abs_error: f.max_abs_error,
                 final_abs_error: f.final_abs_error,
-                poles: lti::re_im(&d.report.poles),
-                discrete_poles: lti::re_im(&d.report.discrete_poles),
+                poles: d.as_ref().map_or_else(Vec::new, |d| lti::re_im(&d.report.poles)),
+                discrete_poles: d.as_ref().map_or_else(Vec::new, |d| lti::re_im(&d.report.discrete_poles)),
             })
             .collect();
         let names = s.observer_names();

@@ -28,6 +28,14 @@ pub enum LockstepError {
         /// Received count.
         got: usize,
     },
+    /// A sample of another protocol version arrived.
+    #[error("{topic}: sample of protocol version {got}, this component speaks {}", crate::PROTOCOL_VERSION)]
+    Protocol {
+        /// The service.
+        topic: String,
+        /// The version the sample carries.
+        got: u32,
+    },
     /// Nothing arrived within the timeout.
     #[error("no sample on {topic} for {secs} s (step {step}): is the peer still running?")]
     Timeout {

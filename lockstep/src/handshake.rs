@@ -1,7 +1,7 @@
 //! How a component process is started and synchronised by the launcher.
 //!
-//! The launcher starts each component with `--run <id> --name <name> --wait <strategy>`, its
-//! stdin and stdout piped. The component reads its configuration from the run directory, creates
+//! The launcher starts each component with `--run <id> --name <name> --wait <strategy>` (or the
+//! same in `UIO_RUN`, `UIO_NAME` and the configuration, PROTOCOL.md §1), its stdin and stdout piped. The component reads its configuration from the run directory, creates
 //! all its ports, writes `ready` on stdout, and starts stepping only when it reads `go` on stdin:
 //! by then every subscriber of the run exists, so no first sample is lost. If the launcher dies,
 //! the kernel kills the component (PR_SET_PDEATHSIG).
@@ -46,7 +46,9 @@ pub fn parse_launch(component: &str, args: impl IntoIterator<Item = String>) -> 
             other => return Err(format!("{how} (unknown argument '{other}')")),
         }
     }
-    let run = run.ok_or_else(|| how.clone())?;
+    // A component started by a launcher of PROTOCOL.md gets the same in its environment.
+    let run = run.or_else(|| std::env::var("UIO_RUN").ok()).ok_or_else(|| how.clone())?;
+    let name = name.or_else(|| std::env::var("UIO_NAME").ok());
     let run = RunSpace::open(&run).map_err(|e| format!("{how} ({e})"))?;
     // SAFETY: getppid has no preconditions.
     let parent = unsafe { libc::getppid() };
@@ -57,34 +59,6 @@ pub fn parse_launch(component: &str, args: impl IntoIterator<Item = String>) -> 
         return Err(format!("{how} (stdin is a terminal, not the launcher's pipe)"));
     }
     Ok(Launch { run, name: name.unwrap_or_else(|| component.to_string()), wait })
-}
-
-/// The `main` of a component: dies with its parent, parses its command line, runs `body`,
-/// and turns a failure `(exit code, message)` into a message on stderr and that exit code.
-pub fn component_main(
-    kind: &str,
-    args: impl IntoIterator<Item = String>,
-    body: impl FnOnce(&Launch) -> Result<(), (i32, String)>,
-) -> std::process::ExitCode {
-    die_with_parent();
-    let launch = match parse_launch(kind, args) {
-        Ok(l) => l,
-        Err(msg) => {
-            eprintln!("{msg}");
-            return std::process::ExitCode::from(EXIT_USAGE as u8);
-        }
-    };
-    match body(&launch) {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err((code, msg)) => {
-            if launch.name == kind {
-                eprintln!("{kind}: {msg}");
-            } else {
-                eprintln!("{kind} {}: {msg}", launch.name);
-            }
-            std::process::ExitCode::from(code as u8)
-        }
-    }
 }
 
 /// Asks the kernel to kill this process when its parent (the launcher) dies.

@@ -4,7 +4,7 @@
 //! ## Protocol
 //!
 //! Every run has its own iceoryx2 prefix and root directory ([`RunSpace`]), so runs never meet.
-//! Each component publishes one [`Sample`] per step on its own service and waits for exactly the
+//! Each component publishes one sample ([`WireHeader`] and its values) per step on its own service and waits for exactly the
 //! samples of the same step from the services it reads:
 //!
 //! ```text
@@ -24,6 +24,7 @@
 //! publishers' retry-until-delivered back-pressure mean no sample is ever dropped.
 
 mod clock;
+pub mod component;
 mod error;
 mod handshake;
 mod layout;
@@ -36,10 +37,10 @@ mod wait;
 
 pub use clock::now_ns;
 pub use error::LockstepError;
-pub use handshake::{component_main, die_with_parent, parse_launch, ready_then_wait_for_go, Launch, EXIT_USAGE};
+pub use handshake::{die_with_parent, parse_launch, ready_then_wait_for_go, Launch, EXIT_USAGE};
 pub use layout::PlantLayout;
 pub use quiet::quiet_iceoryx2;
 pub use port::{Bus, Inlet, Outlet, Reader, FOLLOWER_LAG, RECORDER_BUFFER};
 pub use run::{cleanup_dead_runs, RunSpace, RUNS_DIR_ENV};
-pub use sample::{Header, Sample, MAX_VALUES};
+pub use sample::{Header, WireHeader, PROTOCOL_VERSION};
 pub use wait::Wait;

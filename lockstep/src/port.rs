@@ -1,8 +1,6 @@
 //! Ports on the bus: an [`Outlet`] publishes one sample per step, an [`Inlet`] waits for the
 //! sample of a given step, a [`Reader`] drains everything (the launcher's recorder).
 
-use std::mem::MaybeUninit;
-use std::ptr::addr_of_mut;
 use std::time::Duration;
 
 use iceoryx2::port::listener::Listener;
@@ -17,7 +15,7 @@ use crate::clock::now_ns;
 use crate::service::Service as Ipc;
 use crate::error::LockstepError;
 use crate::run::RunSpace;
-use crate::sample::{Header, Sample, MAX_VALUES};
+use crate::sample::{Header, WireHeader, PROTOCOL_VERSION};
 use crate::wait::Wait;
 
 /// Buffer of the recorder's subscribers: how many steps the launcher may lag behind.
@@ -47,11 +45,13 @@ impl Bus {
         Ok(Self { node, wait })
     }
 
-    fn service(&self, topic: &str) -> Result<PortFactory<Ipc, Sample, ()>, LockstepError> {
-        // Every port opens the service with the same settings, so any of them may create it.
+    fn service(&self, topic: &str) -> Result<PortFactory<Ipc, [f64], WireHeader>, LockstepError> {
+        // Every port opens the service with the same settings (PROTOCOL.md §4), so any of them
+        // may create it.
         self.node
             .service_builder(&ServiceName::new(topic).map_err(LockstepError::ipc)?)
-            .publish_subscribe::<Sample>()
+            .publish_subscribe::<[f64]>()
+            .user_header::<WireHeader>()
             .max_publishers(1)
             .max_subscribers(8)
             .max_nodes(16)
@@ -73,13 +73,14 @@ impl Bus {
             .map_err(LockstepError::ipc)
     }
 
-    /// The publishing end of `topic`.
-    pub fn outlet(&self, topic: &str) -> Result<Outlet, LockstepError> {
+    /// The publishing end of `topic`, whose samples hold `len` values each.
+    pub fn outlet(&self, topic: &str, len: usize) -> Result<Outlet, LockstepError> {
         let publisher = self
             .service(topic)?
             .publisher_builder()
             .backpressure_strategy(BackpressureStrategy::RetryUntilDelivered)
             .max_loaned_samples(1)
+            .initial_max_slice_len(len.max(1))
             .create()
             .map_err(LockstepError::ipc)?;
         let notifier = if self.wait.needs_events() {
@@ -87,7 +88,7 @@ impl Bus {
         } else {
             None
         };
-        Ok(Outlet { publisher, notifier })
+        Ok(Outlet { publisher, notifier, len })
     }
 
     /// A lockstep reading end of `topic`.
@@ -122,33 +123,31 @@ impl Bus {
 
 /// Publishes one sample per step.
 pub struct Outlet {
-    publisher: Publisher<Ipc, Sample, ()>,
+    publisher: Publisher<Ipc, [f64], WireHeader>,
     notifier: Option<Notifier<Ipc>>,
+    len: usize,
 }
 
 impl Outlet {
+    /// The number of values every sample holds.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Never: a sample holds at least one value (kept for the `len` convention).
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
     /// Loans a sample, writes header and values in place, sends it; returns the send time.
     pub fn send(&self, step: u64, sim_time: f64, taken_ns: u64, values: &[f64]) -> Result<u64, LockstepError> {
-        let n = values.len();
-        assert!(n <= MAX_VALUES, "sample of {n} values exceeds {MAX_VALUES}");
-        let mut sample = self.publisher.loan_uninit().map_err(LockstepError::ipc)?;
-        let p: &mut MaybeUninit<Sample> = sample.payload_mut();
-        let p = p.as_mut_ptr();
+        if values.len() != self.len {
+            return Err(LockstepError::Length { topic: "own output".into(), expected: self.len, got: values.len() });
+        }
+        let mut sample = self.publisher.loan_slice_uninit(values.len()).map_err(LockstepError::ipc)?;
         let sent_ns = now_ns();
-        // SAFETY: every field of the sample is written exactly once below, through raw
-        // pointers into the loaned shared-memory slot, before `assume_init`.
-        let sample = unsafe {
-            addr_of_mut!((*p).step).write(step);
-            addr_of_mut!((*p).sim_time).write(sim_time);
-            addr_of_mut!((*p).sent_ns).write(sent_ns);
-            addr_of_mut!((*p).taken_ns).write(taken_ns);
-            addr_of_mut!((*p).len).write(n as u32);
-            addr_of_mut!((*p).reserved).write(0);
-            let v = addr_of_mut!((*p).values) as *mut f64;
-            std::ptr::copy_nonoverlapping(values.as_ptr(), v, n);
-            std::ptr::write_bytes(v.add(n), 0, MAX_VALUES - n);
-            sample.assume_init()
-        };
+        *sample.user_header_mut() = WireHeader { step, sim_time, sent_ns, taken_ns, protocol: PROTOCOL_VERSION, reserved: 0 };
+        let sample = sample.write_from_slice(values);
         sample.send().map_err(LockstepError::ipc)?;
         if let Some(notifier) = &self.notifier {
             notifier.notify().map_err(LockstepError::ipc)?;
@@ -166,7 +165,7 @@ struct WaitSetWait {
 
 /// Waits for the sample of a given step.
 pub struct Inlet {
-    subscriber: Subscriber<Ipc, Sample, ()>,
+    subscriber: Subscriber<Ipc, [f64], WireHeader>,
     listener: Option<Listener<Ipc>>,
     waitset: Option<WaitSetWait>,
     topic: String,
@@ -185,15 +184,19 @@ impl Inlet {
     pub fn try_step(&self, step: u64, out: &mut [f64]) -> Result<Option<Header>, LockstepError> {
         let Some(sample) = self.subscriber.receive().map_err(LockstepError::ipc)? else { return Ok(None) };
         let received_ns = now_ns();
-        let s: &Sample = &sample;
-        if s.step != step {
-            return Err(LockstepError::Step { topic: self.topic.clone(), expected: step, got: s.step });
+        let h = sample.user_header();
+        let values = sample.payload();
+        if h.protocol != PROTOCOL_VERSION {
+            return Err(LockstepError::Protocol { topic: self.topic.clone(), got: h.protocol });
         }
-        if s.len as usize != out.len() {
-            return Err(LockstepError::Length { topic: self.topic.clone(), expected: out.len(), got: s.len as usize });
+        if h.step != step {
+            return Err(LockstepError::Step { topic: self.topic.clone(), expected: step, got: h.step });
         }
-        out.copy_from_slice(&s.values[..out.len()]);
-        Ok(Some(Header { step: s.step, sim_time: s.sim_time, sent_ns: s.sent_ns, taken_ns: s.taken_ns, received_ns }))
+        if values.len() != out.len() {
+            return Err(LockstepError::Length { topic: self.topic.clone(), expected: out.len(), got: values.len() });
+        }
+        out.copy_from_slice(values);
+        Ok(Some(Header::of(h, received_ns)))
     }
 
     /// Waits for the sample of `step`, copying its values into `out`.
@@ -279,15 +282,17 @@ impl Inlet {
 
 /// Drains a service without blocking (the recorder).
 pub struct Reader {
-    subscriber: Subscriber<Ipc, Sample, ()>,
+    subscriber: Subscriber<Ipc, [f64], WireHeader>,
 }
 
 impl Reader {
-    /// Calls `f` for every pending sample, in order; returns how many there were.
-    pub fn drain(&self, mut f: impl FnMut(&Sample)) -> Result<usize, LockstepError> {
+    /// Calls `f` with the header and values of every pending sample, in order; returns how
+    /// many there were. The header is as sent: checking it is the caller's (the launcher names
+    /// the component that broke the protocol).
+    pub fn drain(&self, mut f: impl FnMut(&WireHeader, &[f64])) -> Result<usize, LockstepError> {
         let mut count = 0;
         while let Some(sample) = self.subscriber.receive().map_err(LockstepError::ipc)? {
-            f(&sample);
+            f(sample.user_header(), sample.payload());
             count += 1;
         }
         Ok(count)

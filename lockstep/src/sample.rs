@@ -1,34 +1,34 @@
-//! The one payload type on every service.
+//! The wire format of every service (PROTOCOL.md §4): a slice of `f64` whose length a run's
+//! configuration fixes per service, behind a fixed user header.
 //!
-//! iceoryx2 checks the payload's type name and layout when a port opens a service; keeping the
-//! type in this one crate is what lets separately built binaries agree (else
-//! `IncompatibleTypes`).
+//! iceoryx2 checks the payload's and the header's type names and layouts when a port opens a
+//! service; keeping the header type in this one crate is what lets separately built binaries
+//! agree (else `IncompatibleTypes`). The value count belongs to the run, not to the type, so a
+//! sample may hold any number of values without a new protocol version.
 
 use iceoryx2::prelude::*;
 
-/// Capacity of a sample, in f64 values.
-pub const MAX_VALUES: usize = 64;
+/// The protocol version every sample and configuration carries (PROTOCOL.md §8).
+pub const PROTOCOL_VERSION: u32 = 1;
 
-/// A fixed-layout sample: header plus up to [`MAX_VALUES`] values.
-#[derive(Debug, Clone, Copy, ZeroCopySend)]
-#[type_name("uio_observers::Sample")]
+/// The user header of every sample (PROTOCOL.md §4): 40 bytes, little-endian, align 8.
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[type_name("uio_observers::Header")]
 #[repr(C)]
-pub struct Sample {
+pub struct WireHeader {
     /// Step counter k.
     pub step: u64,
     /// Simulation time t_k = k·dt, s.
     pub sim_time: f64,
-    /// Monotonic time at which the publisher sent the sample, ns.
+    /// CLOCK_MONOTONIC at which the publisher sent the sample, ns.
     pub sent_ns: u64,
-    /// Monotonic time at which the publisher took the input that completed this step, ns
+    /// CLOCK_MONOTONIC at which the publisher took the input that completed this step, ns
     /// (0 when there was none).
     pub taken_ns: u64,
-    /// Number of meaningful values.
-    pub len: u32,
-    /// Padding, always 0.
+    /// [`PROTOCOL_VERSION`].
+    pub protocol: u32,
+    /// Always 0.
     pub reserved: u32,
-    /// The values; entries past `len` are 0.
-    pub values: [f64; MAX_VALUES],
 }
 
 /// The header of a received sample, plus the time this process took it.
@@ -44,4 +44,11 @@ pub struct Header {
     pub taken_ns: u64,
     /// When this process took the sample, ns.
     pub received_ns: u64,
+}
+
+impl Header {
+    /// The header of a received sample, taken at `received_ns`.
+    pub fn of(w: &WireHeader, received_ns: u64) -> Self {
+        Header { step: w.step, sim_time: w.sim_time, sent_ns: w.sent_ns, taken_ns: w.taken_ns, received_ns }
+    }
 }

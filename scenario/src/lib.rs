@@ -52,6 +52,8 @@ pub struct Scenario {
     pub observers: Vec<ObserverEntry>,
     /// The state feedback, if any.
     pub controller: Option<ControllerEntry>,
+    /// Who simulates the true plant, when not the built-in exact linear plant.
+    pub plant_process: Option<ProcessSpec>,
     /// What the run must achieve.
     pub expect: RawExpect,
     /// The file's text (to locate fields in later messages).
@@ -89,13 +91,32 @@ impl Named {
     }
 }
 
+/// An external component (PROTOCOL.md §7): a command run in the scenario file's folder, and
+/// the parameters it receives as JSON.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProcessSpec {
+    /// Program and arguments.
+    pub command: Vec<String>,
+    /// The scenario's `params` table, as JSON (an empty object when there is none).
+    pub params: serde_json::Value,
+}
+
 /// One `[[observer]]`.
 #[derive(Debug, Clone)]
 pub struct ObserverEntry {
     /// Unique name.
     pub name: String,
-    /// The design.
-    pub spec: Spec,
+    /// The design (`None` for an external observer).
+    pub spec: Option<Spec>,
+    /// The external observer, for `kind = "process"`.
+    pub process: Option<ProcessSpec>,
+}
+
+impl ObserverEntry {
+    /// Its kind as the scenario writes it.
+    pub fn kind(&self) -> &'static str {
+        self.spec.as_ref().map_or("process", Spec::kind)
+    }
 }
 
 /// The `[controller]`.
@@ -103,10 +124,12 @@ pub struct ObserverEntry {
 pub struct ControllerEntry {
     /// Whose estimate it feeds back.
     pub observer: String,
-    /// How G is obtained.
-    pub spec: FeedbackSpec,
+    /// How G is obtained (`None` for an external controller).
+    pub spec: Option<FeedbackSpec>,
     /// Tracked outputs z = C_t x (l×n): the prefilter makes them follow r.
     pub track: Option<Mat>,
+    /// The external controller, for `kind = "process"`.
+    pub process: Option<ProcessSpec>,
 }
 
 /// A problem with a scenario file.

@@ -67,6 +67,16 @@ pub struct RawPlant {
     pub measurement_disturbance_names: Option<Vec<String>>,
     /// Units of the measurement disturbances.
     pub measurement_disturbance_units: Option<Vec<String>>,
+    /// Who simulates the true plant, when not the built-in exact linear plant.
+    pub process: Option<RawProcess>,
+}
+
+/// An external component: its command and parameters (PROTOCOL.md §7).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawProcess {
+    pub command: Vec<String>,
+    pub params: Option<toml::Table>,
 }
 
 /// One pole as written: a real number, or [re, im] for a complex pair.
@@ -89,6 +99,9 @@ pub struct RawObserver {
     pub h: Option<Rows>,
     pub decay: Option<f64>,
     pub path: Option<String>,
+    /// `kind = "process"`: the command and its parameters.
+    pub command: Option<Vec<String>>,
+    pub params: Option<toml::Table>,
 }
 
 /// `[controller]`.
@@ -102,6 +115,9 @@ pub struct RawController {
     pub placement: Option<String>,
     /// Rows of C_t: the state combinations that follow the reference.
     pub track: Option<Rows>,
+    /// `kind = "process"`: the command and its parameters.
+    pub command: Option<Vec<String>>,
+    pub params: Option<toml::Table>,
 }
 
 /// `[expect]`: per-observer upper bounds on the run's figures.

@@ -11,9 +11,9 @@ use observer::design::Path as HuiZakPath;
 use observer::Spec;
 
 use super::locate::{line_col, offset, parse_path};
-use super::raw::{RawController, RawExpect, RawObserver, RawPole, RawScenario, Rows};
+use super::raw::{RawController, RawExpect, RawObserver, RawPole, RawProcess, RawScenario, Rows};
 use super::untrusted::quoted;
-use super::{ControllerEntry, Named, ObserverEntry, Scenario, ScenarioError, SignalNames};
+use super::{ControllerEntry, Named, ObserverEntry, ProcessSpec, Scenario, ScenarioError, SignalNames};
 
 /// Observer kinds a scenario may name.
 pub const KINDS: [&str; 7] = ["luenberger", "chen-patton-uio", "das-ghosal", "das-ghosal-uio", "gi-full-order", "cumming", "hui-zak-uio"];
@@ -217,10 +217,6 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
     if state_bound <= 0.0 {
         return Err(bad("plant.state_bound", "must be > 0"));
     }
-    let layout = lockstep::PlantLayout { n, p: pn, q: e.ncols(), r: d.ncols(), l: b.ncols() };
-    if layout.len() > lockstep::MAX_VALUES {
-        return Err(bad("plant", format!("n + p + q + r + 2l = {} values exceed the {} a sample holds", layout.len(), lockstep::MAX_VALUES)));
-    }
     let layout_names = SignalNames {
         state: names("plant.state", p.state_names.as_ref(), p.state_units.as_ref(), n, "the plant has {} state{s}", "x")?,
         output: names("plant.output", p.output_names.as_ref(), p.output_units.as_ref(), pn, "C has {} row{s} (outputs)", "y")?,
@@ -250,7 +246,20 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
         if !seen.insert(o.name.clone()) {
             return Err(bad(format!("{f}.name"), format!("two observers are named {}", quoted(&o.name))));
         }
-        observers.push(ObserverEntry { name: o.name.clone(), spec: observer_spec(&f, o, &model)? });
+        observers.push(if o.kind == "process" {
+            let process = process_spec(&f, &o.command, &o.params)?;
+            for (key, given) in [("poles", o.poles.is_some()), ("placement", o.placement.is_some()), ("H", o.h.is_some()), ("decay", o.decay.is_some()), ("path", o.path.is_some())] {
+                if given {
+                    return Err(bad(format!("{f}.{key}"), "a process observer takes no design keys (only command and params)"));
+                }
+            }
+            ObserverEntry { name: o.name.clone(), spec: None, process: Some(process) }
+        } else {
+            if o.command.is_some() || o.params.is_some() {
+                return Err(bad(format!("{f}.command"), format!("only kind = \"process\" takes command and params, not {}", quoted(&o.kind))));
+            }
+            ObserverEntry { name: o.name.clone(), spec: Some(observer_spec(&f, o, &model)?), process: None }
+        });
     }
 
     let controller = raw.controller.as_ref().map(|c| controller_entry(c, &model, &seen)).transpose()?;
@@ -272,6 +281,7 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
         inputs,
         observers,
         controller,
+        plant_process: plant_process(&p.process)?,
         expect,
         source: String::new(),
     })
@@ -279,7 +289,7 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
 
 fn observer_spec(f: &str, o: &RawObserver, model: &Model) -> Result<Spec, Bad> {
     if !KINDS.contains(&o.kind.as_str()) {
-        return Err(bad(format!("{f}.kind"), format!("{} is not an observer kind ({})", quoted(&o.kind), KINDS.join(", "))));
+        return Err(bad(format!("{f}.kind"), format!("{} is not an observer kind ({}, process)", quoted(&o.kind), KINDS.join(", "))));
     }
     let method = placement(&format!("{f}.placement"), &o.placement)?;
     let needs_poles = || match &o.poles {
@@ -332,13 +342,46 @@ fn observer_spec(f: &str, o: &RawObserver, model: &Model) -> Result<Spec, Bad> {
     })
 }
 
+/// An external component's command and parameters (PROTOCOL.md §7).
+fn process_spec(f: &str, command: &Option<Vec<String>>, params: &Option<toml::Table>) -> Result<ProcessSpec, Bad> {
+    let command = command.clone().ok_or_else(|| bad(format!("{f}.command"), "a process needs command = [\"program\", \"arg\", …]"))?;
+    if command.first().is_none_or(|p| p.trim().is_empty()) {
+        return Err(bad(format!("{f}.command"), "must name a program first"));
+    }
+    if let Some(i) = command.iter().position(|a| a.contains('\0')) {
+        return Err(bad(format!("{f}.command[{i}]"), "holds a NUL character"));
+    }
+    let params = match params {
+        Some(t) => serde_json::to_value(t).map_err(|e| bad(format!("{f}.params"), e.to_string()))?,
+        None => serde_json::Value::Object(Default::default()),
+    };
+    Ok(ProcessSpec { command, params })
+}
+
+/// `[plant.process]`, if given.
+pub(crate) fn plant_process(p: &Option<RawProcess>) -> Result<Option<ProcessSpec>, Bad> {
+    p.as_ref().map(|p| process_spec("plant.process", &Some(p.command.clone()), &p.params)).transpose()
+}
+
 fn controller_entry(c: &RawController, model: &Model, observers: &BTreeSet<String>) -> Result<ControllerEntry, Bad> {
-    if c.kind != "state-feedback" {
-        return Err(bad("controller.kind", format!("{} is not a controller kind (state-feedback)", quoted(&c.kind))));
+    if c.kind != "state-feedback" && c.kind != "process" {
+        return Err(bad("controller.kind", format!("{} is not a controller kind (state-feedback, process)", quoted(&c.kind))));
     }
     if !observers.contains(&c.observer) {
         let known: Vec<&str> = observers.iter().map(String::as_str).collect();
         return Err(bad("controller.observer", format!("no observer named {} (observers: {})", quoted(&c.observer), known.join(", "))));
+    }
+    if c.kind == "process" {
+        let process = process_spec("controller", &c.command, &c.params)?;
+        for (key, given) in [("poles", c.poles.is_some()), ("gain", c.gain.is_some()), ("placement", c.placement.is_some()), ("track", c.track.is_some())] {
+            if given {
+                return Err(bad(format!("controller.{key}"), "a process controller takes no design keys (only command, observer and params)"));
+            }
+        }
+        return Ok(ControllerEntry { observer: c.observer.clone(), spec: None, track: None, process: Some(process) });
+    }
+    if c.command.is_some() || c.params.is_some() {
+        return Err(bad("controller.command", "only kind = \"process\" takes command and params"));
     }
     let method = placement("controller.placement", &c.placement)?;
     let spec = match (&c.poles, &c.gain) {
@@ -348,7 +391,7 @@ fn controller_entry(c: &RawController, model: &Model, observers: &BTreeSet<Strin
         (None, None) => return Err(bad("controller.poles", "a state-feedback controller needs poles = […] or gain = [[…]]")),
     };
     let track = c.track.as_ref().map(|t| matrix("controller.track", t, (Some(model.l()), Some(model.n())), "one row per input: the state combination that follows it")).transpose()?;
-    Ok(ControllerEntry { observer: c.observer.clone(), spec, track })
+    Ok(ControllerEntry { observer: c.observer.clone(), spec: Some(spec), track, process: None })
 }
 
 fn check_expect(e: &RawExpect, observers: &BTreeSet<String>) -> Result<(), Bad> {

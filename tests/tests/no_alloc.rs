@@ -5,14 +5,15 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use controller::shell::ControllerLoop;
+use controller::shell::ControllerComponent;
 use controller::Controller;
 use launcher::plan::plan;
 use launcher::run::configs;
 use scenario::Scenario;
+use lockstep::component::{Component, Runner};
 use lockstep::{Bus, RunSpace, Wait};
-use observer::shell::ObserverLoop;
-use plant::shell::PlantLoop;
+use observer::shell::ObserverComponent;
+use plant::shell::PlantComponent;
 use plant::Plant;
 use tests::*;
 
@@ -76,7 +77,7 @@ fn step_functions_do_not_allocate() {
         let Ok(p) = plan(&s) else { panic!("{} does not design", s.name) };
         let cfg = configs(&s, &p);
         let mut plant = Plant::new(&cfg.plant.plant).unwrap();
-        let mut observers: Vec<_> = cfg.observers.iter().map(|(_, o)| o.observer.instantiate()).collect();
+        let mut observers: Vec<_> = cfg.observers.iter().map(|(_, o)| o.as_ref().unwrap().observer.instantiate()).collect();
         let mut controller = cfg.controller.as_ref().map(|c| Controller::new(c).unwrap());
         let c_obs = cfg.controller.as_ref().and_then(|c| cfg.observers.iter().position(|(n, _)| *n == c.observer)).unwrap_or(0);
         let lay = cfg.layout;
@@ -123,20 +124,25 @@ fn process_loops_do_not_allocate() {
     let space = Cleanup(RunSpace::create().unwrap());
     let space = &space.0;
     {
-        let plant_bus = Bus::join(space, "plant", Wait::Yield).unwrap();
-        let obs_buses: Vec<Bus> = cfg.observers.iter().map(|(n, _)| Bus::join(space, &format!("observer-{n}"), Wait::Yield).unwrap()).collect();
-        let ctrl_bus = Bus::join(space, "controller", Wait::Yield).unwrap();
-        let mut plant = PlantLoop::new(&cfg.plant, &plant_bus).unwrap();
-        let mut observers: Vec<ObserverLoop> = cfg.observers.iter().zip(&obs_buses).map(|((n, o), b)| ObserverLoop::new(o, n, b).unwrap()).collect();
-        let mut controller = ControllerLoop::new(cfg.controller.as_ref().unwrap(), &ctrl_bus).unwrap();
+        let components = launcher::run::envelopes(&s, &cfg, space, Wait::Yield);
+        let bus = |c: &launcher::run::Launchable| Bus::join(space, &c.config.name, Wait::Yield).unwrap();
+        let (plant_bus, ctrl_bus) = (bus(&components[0]), bus(components.last().unwrap()));
+        let obs_buses: Vec<Bus> = components[1..components.len() - 1].iter().map(bus).collect();
+        let mut plant = Runner::new(&components[0].config, &plant_bus, PlantComponent::new(&components[0].config).unwrap()).unwrap();
+        let mut observers: Vec<Runner<ObserverComponent>> = components[1..components.len() - 1]
+            .iter()
+            .zip(&obs_buses)
+            .map(|(c, b)| Runner::new(&c.config, b, ObserverComponent::new(&c.config).unwrap()).unwrap())
+            .collect();
+        let c = components.last().unwrap();
+        let mut controller = Runner::new(&c.config, &ctrl_bus, ControllerComponent::new(&c.config).unwrap()).unwrap();
         // Every component steps in lockstep order; each wait finds its sample already there.
         let mut step = |k: u64| {
-            plant.publish(k).unwrap();
+            plant.step(k).unwrap();
             for o in observers.iter_mut() {
                 o.step(k).unwrap();
             }
             controller.step(k).unwrap();
-            plant.complete(k).unwrap();
         };
         for k in 0..100 {
             step(k);

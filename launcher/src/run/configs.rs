@@ -14,9 +14,9 @@ use scenario::Scenario;
 pub struct Configs {
     /// The plant's.
     pub plant: PlantRun,
-    /// (name, config) per observer.
-    pub observers: Vec<(String, ObserverRun)>,
-    /// The controller's.
+    /// (name, config) per observer; none for an external observer.
+    pub observers: Vec<(String, Option<ObserverRun>)>,
+    /// The built-in controller's (none without one, or for an external one).
     pub controller: Option<ControllerConfig>,
     /// The plant sample layout.
     pub layout: PlantLayout,
@@ -29,7 +29,7 @@ pub struct Configs {
 pub const FOLLOWER_SLEEP_US: u32 = 5000;
 
 /// In closed loop, observers the controller does not read are off the critical path.
-fn is_follower(s: &Scenario, observer: &str) -> bool {
+pub fn is_follower(s: &Scenario, observer: &str) -> bool {
     s.controller.as_ref().is_some_and(|c| c.observer != observer)
 }
 
@@ -59,10 +59,7 @@ pub fn configs(s: &Scenario, plan: &Plan) -> Configs {
     let observers = plan
         .observers
         .iter()
-        .map(|(name, d)| {
-            let follower_sleep_us = is_follower(s, name).then_some(FOLLOWER_SLEEP_US);
-            (name.clone(), ObserverRun { observer: d.runtime.clone(), layout, steps: s.steps, follower_sleep_us })
-        })
+        .map(|(name, d)| (name.clone(), d.as_ref().map(|d| ObserverRun { observer: d.runtime.clone(), layout })))
         .collect();
     let controller = match (&s.controller, &plan.feedback) {
         (Some(c), Some(fb)) => Some(ControllerConfig { g: (&fb.g).into(), n: (&fb.n).into(), references: s.inputs.clone(), dt: s.dt, steps: s.steps, observer: c.observer.clone() }),

@@ -1,6 +1,7 @@
 //! Running a scenario: output checks, the chosen mode, the recording, the summary.
 
 mod configs;
+mod envelope;
 pub mod interrupt;
 mod in_process;
 mod processes;
@@ -15,6 +16,7 @@ use std::time::Instant;
 use lockstep::Wait;
 
 pub use configs::{configs, Configs};
+pub use envelope::{envelopes, Launchable, Program};
 pub use session::{hop_entity, hop_names, Session};
 
 use crate::error::LaunchError;
@@ -110,6 +112,17 @@ fn prepare_output(out: &Path, name: &str, force: bool) -> Result<(PathBuf, PathB
     Ok((rrd, summary))
 }
 
+/// The first component the scenario runs as an external process, if any.
+fn external_component(s: &Scenario) -> Option<String> {
+    if s.plant_process.is_some() {
+        return Some("the plant".into());
+    }
+    if let Some(o) = s.observers.iter().find(|o| o.process.is_some()) {
+        return Some(format!("observer '{}'", o.name));
+    }
+    s.controller.as_ref().filter(|c| c.process.is_some()).map(|_| "the controller".into())
+}
+
 /// Runs a designed scenario.
 pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchError> {
     if let Some(fb) = &plan.feedback
@@ -117,6 +130,11 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
         && !opts.allow_unstable
     {
         return Err(LaunchError::BadInput(format!("{}: controller: {why}; pass --allow-unstable to run it anyway", s.path.display())));
+    }
+    if opts.mode == Mode::InProcess
+        && let Some(what) = external_component(s)
+    {
+        return Err(LaunchError::BadInput(format!("{}: {what} is an external process: --mode in-process runs only built-in components", s.path.display())));
     }
     let (rrd, summary_path) = if opts.record { prepare_output(&opts.out, &s.name, opts.force).map(|(a, b)| (Some(a), Some(b)))? } else { (None, None) };
     // The recording is written under a temporary name and renamed when the run ends, however it
@@ -137,7 +155,7 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
     let start = Instant::now();
     let stop = match opts.mode {
         Mode::InProcess => in_process::run(&cfg, &mut session),
-        Mode::Processes => processes::run(&cfg, &mut session, opts.wait, opts.pin),
+        Mode::Processes => processes::run(s, &cfg, &mut session, opts.wait, opts.pin),
     };
     let wall = start.elapsed().as_secs_f64();
     // An error once the recording has started ends the run like a failed component: the

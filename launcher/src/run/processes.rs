@@ -9,14 +9,17 @@
 use std::collections::VecDeque;
 use std::io::{BufRead, BufReader, Read, Write};
 use std::os::unix::process::{CommandExt, ExitStatusExt};
+use std::path::Path;
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::sync::mpsc;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use lockstep::{cleanup_dead_runs, Bus, Header, Reader, RunSpace, Sample, Wait};
+use lockstep::{cleanup_dead_runs, Bus, Header, Reader, RunSpace, Wait, WireHeader, PROTOCOL_VERSION};
+use scenario::Scenario;
 
 use super::configs::Configs;
+use super::envelope::{envelopes, Launchable, Program};
 use super::session::Session;
 use super::{interrupt, Stop};
 use crate::error::LaunchError;
@@ -89,6 +92,10 @@ fn signal_name(sig: i32) -> &'static str {
 fn stop_all(procs: &mut [Proc]) {
     for p in procs.iter_mut() {
         if p.status.is_none() {
+            // The whole process group: an external command may have started children of its
+            // own (a shell script, an interpreter's workers).
+            // SAFETY: kill(2) on the group this launcher created for the child (pgid = its pid).
+            unsafe { libc::kill(-(p.child.id() as i32), libc::SIGKILL) };
             let _ = p.child.kill();
         }
     }
@@ -152,7 +159,7 @@ fn placement(cfg: &Configs, pin: bool) -> (Option<usize>, Vec<Option<usize>>, Op
         return (None, vec![None; nobs], None);
     }
     let ring_observers: Vec<bool> = cfg.plant.followers.iter().map(|f| !f).collect();
-    let ring = 1 + ring_observers.iter().filter(|&&r| r).count() + usize::from(cfg.controller.is_some());
+    let ring = 1 + ring_observers.iter().filter(|&&r| r).count() + usize::from(cfg.plant.controller);
     let mut next = 1;
     let mut cpu_for = |_: ()| {
         let c = if cpus.len() >= ring { cpus[next] } else { cpus[1 + (next - 1) % (cpus.len() - 1)] };
@@ -160,14 +167,32 @@ fn placement(cfg: &Configs, pin: bool) -> (Option<usize>, Vec<Option<usize>>, Op
         Some(c)
     };
     let observers = ring_observers.iter().map(|&r| if r { cpu_for(()) } else { None }).collect();
-    let controller = if cfg.controller.is_some() { cpu_for(()) } else { None };
+    let controller = if cfg.plant.controller { cpu_for(()) } else { None };
     (Some(cpus[0]), observers, controller)
 }
 
-#[allow(clippy::too_many_arguments)]
-fn spawn(kind: &str, label: String, name: &str, space: &RunSpace, wait: Wait, cpu: Option<usize>, tx: &mpsc::Sender<(usize, String)>, index: usize) -> Result<Proc, LaunchError> {
-    let mut cmd = component_command(kind);
-    cmd.args(["--run", space.id(), "--name", name, "--wait", &wait.to_string()])
+/// Starts a component (PROTOCOL.md §1): our binary, or the scenario's command in the scenario
+/// file's folder; either way with the protocol's environment, in its own process group.
+fn spawn(c: &Launchable, workdir: &Path, space: &RunSpace, cpu: Option<usize>, tx: &mpsc::Sender<(usize, String)>, index: usize) -> Result<Proc, LaunchError> {
+    let label = c.label.clone();
+    let mut cmd = match &c.program {
+        Program::Builtin(kind) => {
+            let mut cmd = component_command(kind);
+            cmd.args(["--run", space.id(), "--name", &c.config.name, "--wait", &c.config.wait]);
+            cmd
+        }
+        Program::External(p) => {
+            let mut cmd = Command::new(&p.command[0]);
+            cmd.args(&p.command[1..]).current_dir(workdir);
+            cmd
+        }
+    };
+    cmd.env("UIO_PROTOCOL", PROTOCOL_VERSION.to_string())
+        .env("UIO_RUN", space.id())
+        .env("UIO_NAME", &c.config.name)
+        .env("UIO_ROLE", c.config.role.name())
+        .env("UIO_CONFIG", space.config_path(&c.file()))
+        .env(lockstep::RUNS_DIR_ENV, space.dir().parent().unwrap_or(space.dir()))
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -181,7 +206,13 @@ fn spawn(kind: &str, label: String, name: &str, space: &RunSpace, wait: Wait, cp
             });
         }
     }
-    let mut child = cmd.spawn().map_err(|e| LaunchError::Component(format!("cannot start {label}: {e}")))?;
+    let mut child = cmd.spawn().map_err(|e| {
+        let what = match &c.program {
+            Program::External(p) => format!(" ({})", scenario::untrusted::quoted(&p.command[0])),
+            Program::Builtin(_) => String::new(),
+        };
+        LaunchError::Component(format!("cannot start {label}{what}: {e}"))
+    })?;
     let out = child.stdout.take().expect("piped");
     let tx = tx.clone();
     std::thread::spawn(move || {
@@ -208,16 +239,69 @@ fn spawn(kind: &str, label: String, name: &str, space: &RunSpace, wait: Wait, cp
     Ok(Proc { label, child, stderr, status: None })
 }
 
-/// Per-topic queues of received samples, assembled into rows in step order.
-struct Assembly {
-    plant: VecDeque<(Header, Sample)>,
-    observers: Vec<VecDeque<(Header, Sample)>>,
-    controller: Option<VecDeque<(Header, Sample)>>,
-    next: u64,
+/// The samples received from one component, in order. Their value buffers are recycled, so
+/// once the queue has been as deep as it gets, receiving allocates nothing.
+struct Queue {
+    /// How messages name the component.
+    label: String,
+    /// Names of its values (1-based), for messages.
+    names: Vec<String>,
+    items: VecDeque<(WireHeader, Vec<f64>)>,
+    free: Vec<Vec<f64>>,
 }
 
-fn header(s: &Sample) -> Header {
-    Header { step: s.step, sim_time: s.sim_time, sent_ns: s.sent_ns, taken_ns: s.taken_ns, received_ns: 0 }
+impl Queue {
+    fn new(c: &Launchable) -> Self {
+        Queue { label: c.label.clone(), names: c.config.publishes.names.clone(), items: VecDeque::new(), free: Vec::new() }
+    }
+
+    fn is_empty(&self) -> bool {
+        self.items.is_empty()
+    }
+
+    /// Moves every pending sample of `reader` in; returns how many there were.
+    fn drain(&mut self, reader: &Reader) -> Result<usize, LaunchError> {
+        let (items, free) = (&mut self.items, &mut self.free);
+        reader
+            .drain(|h, v| {
+                let mut buf = free.pop().unwrap_or_default();
+                buf.clear();
+                buf.extend_from_slice(v);
+                items.push_back((*h, buf));
+            })
+            .map_err(|e| LaunchError::Component(format!("{}: {e}", self.label)))
+    }
+
+    /// Takes the sample of step `k` into `out`, checking it against the protocol (PROTOCOL.md
+    /// §6): the step, the protocol version, the number of values, and that each is finite.
+    fn take(&mut self, k: u64, out: &mut [f64]) -> Result<Header, LaunchError> {
+        let (h, values) = self.items.pop_front().expect("non-empty");
+        let broken = |why: String| LaunchError::Component(format!("{} broke the protocol at step {k}: {why}", self.label));
+        if h.protocol != PROTOCOL_VERSION {
+            return Err(broken(format!("its sample says protocol version {}, the run speaks {PROTOCOL_VERSION}", h.protocol)));
+        }
+        if h.step != k {
+            return Err(broken(format!("its sample is of step {}", h.step)));
+        }
+        if values.len() != out.len() {
+            return Err(broken(format!("its sample has {} values, the run's configuration says {}", values.len(), out.len())));
+        }
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            let name = self.names.get(i).map_or(String::new(), |n| format!(" ({})", scenario::untrusted::quoted(n)));
+            return Err(broken(format!("value {}{name} is {}", i + 1, values[i])));
+        }
+        out.copy_from_slice(&values);
+        self.free.push(values);
+        Ok(Header::of(&h, 0))
+    }
+}
+
+/// Per-component queues of received samples, assembled into rows in step order.
+struct Assembly {
+    plant: Queue,
+    observers: Vec<Queue>,
+    controller: Option<Queue>,
+    next: u64,
 }
 
 impl Assembly {
@@ -243,46 +327,25 @@ impl Assembly {
                 return Ok(done);
             }
             let k = self.next;
-            // The step and the number of values must be what this run's layout says.
-            let check = |h: &Header, s: &Sample, len: usize, topic: &str| {
-                if h.step != k {
-                    Err(LaunchError::Component(format!("lockstep broken on {topic}: expected step {k}, got {}", h.step)))
-                } else if s.len as usize != len {
-                    Err(LaunchError::Component(format!("{topic} sent {} values at step {k}, expected {len}", s.len)))
-                } else {
-                    Ok(())
-                }
-            };
-            let (ph, ps) = self.plant.pop_front().expect("non-empty");
-            let len = row.plant.len();
-            check(&ph, &ps, len, "plant")?;
+            row.plant_hdr = self.plant.take(k, &mut row.plant)?;
             row.k = k;
-            row.t = ps.sim_time;
-            row.plant.copy_from_slice(&ps.values[..len]);
-            row.plant_hdr = ph;
+            row.t = row.plant_hdr.sim_time;
             for (i, q) in self.observers.iter_mut().enumerate() {
-                let (h, s) = q.pop_front().expect("non-empty");
-                let n = row.xhat[i].len();
-                check(&h, &s, n, "observer")?;
-                row.xhat[i].copy_from_slice(&s.values[..n]);
-                row.xhat_hdr[i] = h;
+                row.xhat_hdr[i] = q.take(k, &mut row.xhat[i])?;
             }
             if let Some(q) = &mut self.controller {
-                let (h, s) = q.pop_front().expect("non-empty");
-                let l = row.u.len();
-                check(&h, &s, l, "controller")?;
-                row.u.copy_from_slice(&s.values[..l]);
-                row.u_hdr = h;
+                row.u_hdr = q.take(k, &mut row.u)?;
             }
             session.record(row)?;
             self.next += 1;
             done += 1;
         }
     }
-}
 
-fn drain(reader: &Reader, q: &mut VecDeque<(Header, Sample)>) -> Result<usize, LaunchError> {
-    reader.drain(|s| q.push_back((header(s), *s))).map_err(|e| LaunchError::Component(e.to_string()))
+    /// The plant's end sample (step K), if it has arrived once every step was assembled.
+    fn end(&self, steps: u64) -> Option<Header> {
+        self.plant.items.front().filter(|(h, _)| h.step == steps && h.protocol == PROTOCOL_VERSION).map(|(h, _)| Header::of(h, 0))
+    }
 }
 
 /// The launcher's recording subscribers, one per topic.
@@ -295,62 +358,61 @@ struct Readers<'a> {
 impl Readers<'_> {
     /// Moves every pending sample into its queue; returns how many there were.
     fn drain_all(&self, asm: &mut Assembly) -> Result<usize, LaunchError> {
-        let mut got = drain(self.plant, &mut asm.plant)?;
+        let mut got = asm.plant.drain(self.plant)?;
         for (r, q) in self.observers.iter().zip(asm.observers.iter_mut()) {
-            got += drain(r, q)?;
+            got += q.drain(r)?;
         }
         if let (Some(r), Some(q)) = (self.controller, asm.controller.as_mut()) {
-            got += drain(r, q)?;
+            got += q.drain(r)?;
         }
         Ok(got)
     }
 }
 
 /// Runs the scenario across processes.
-pub fn run(cfg: &Configs, session: &mut Session, wait: Wait, pin: bool) -> Result<Stop, LaunchError> {
+pub fn run(s: &Scenario, cfg: &Configs, session: &mut Session, wait: Wait, pin: bool) -> Result<Stop, LaunchError> {
     cleanup_dead_runs();
     let space = RunSpace::create().map_err(|e| LaunchError::Component(e.to_string()))?;
-    let result = run_in(&space, cfg, session, wait, pin);
+    let result = run_in(s, &space, cfg, session, wait, pin);
     space.remove();
     result
 }
 
-fn run_in(space: &RunSpace, cfg: &Configs, session: &mut Session, wait: Wait, pin: bool) -> Result<Stop, LaunchError> {
+fn run_in(s: &Scenario, space: &RunSpace, cfg: &Configs, session: &mut Session, wait: Wait, pin: bool) -> Result<Stop, LaunchError> {
     let ipc = |e: lockstep::LockstepError| LaunchError::Component(e.to_string());
-    space.write_config("plant", &to_json(&cfg.plant)).map_err(ipc)?;
-    for (name, o) in &cfg.observers {
-        space.write_config(&format!("observer-{name}"), &to_json(o)).map_err(ipc)?;
-    }
-    if let Some(c) = &cfg.controller {
-        space.write_config("controller", &to_json(c)).map_err(ipc)?;
+    let components = envelopes(s, cfg, space, wait);
+    for c in &components {
+        space.write_config(&c.file(), &to_json(&c.config)).map_err(ipc)?;
     }
 
-    // The recorder's subscribers exist before any component can publish.
+    // The recorder's subscribers exist before any component can publish: they create every
+    // service of the run (PROTOCOL.md §4).
     let bus = Bus::join(space, "launcher", Wait::Yield).map_err(ipc)?;
     space.restrict_shm().map_err(ipc)?;
-    let plant_reader = bus.reader("plant").map_err(ipc)?;
-    let observer_readers = cfg.observers.iter().map(|(n, _)| bus.reader(&format!("observer/{n}"))).collect::<Result<Vec<_>, _>>().map_err(ipc)?;
-    let controller_reader = cfg.controller.as_ref().map(|_| bus.reader("controller")).transpose().map_err(ipc)?;
+    let readers: Vec<Reader> = components.iter().map(|c| bus.reader(&c.config.publishes.service)).collect::<Result<_, _>>().map_err(ipc)?;
+    let nobs = s.observers.len();
 
     let (tx, rx) = mpsc::channel();
     let mut procs: Vec<Proc> = Vec::new();
     let (plant_cpu, observer_cpus, controller_cpu) = placement(cfg, pin);
+    let cpus: Vec<Option<usize>> = std::iter::once(plant_cpu).chain(observer_cpus).chain(s.controller.as_ref().map(|_| controller_cpu)).collect();
+    let workdir = s.path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let result = (|| {
-        procs.push(spawn("plant", "plant".into(), "plant", space, wait, plant_cpu, &tx, 0)?);
-        for ((name, _), &cpu) in cfg.observers.iter().zip(&observer_cpus) {
-            let i = procs.len();
-            procs.push(spawn("observer", format!("observer '{name}'"), name, space, wait, cpu, &tx, i)?);
-        }
-        if cfg.controller.is_some() {
-            let i = procs.len();
-            procs.push(spawn("controller", "controller".into(), "controller", space, wait, controller_cpu, &tx, i)?);
+        for (i, (c, &cpu)) in components.iter().zip(&cpus).enumerate() {
+            procs.push(spawn(c, workdir, space, cpu, &tx, i)?);
         }
         handshake(&mut procs, &rx)?;
-        let readers = Readers { plant: &plant_reader, observers: &observer_readers, controller: controller_reader.as_ref() };
-        supervise(cfg, session, &mut procs, &readers)
+        let r = Readers { plant: &readers[0], observers: &readers[1..1 + nobs], controller: readers.get(1 + nobs) };
+        let mut asm = Assembly {
+            plant: Queue::new(&components[0]),
+            observers: components[1..1 + nobs].iter().map(Queue::new).collect(),
+            controller: components.get(1 + nobs).map(Queue::new),
+            next: 0,
+        };
+        supervise(cfg, session, &mut procs, &r, &mut asm)
     })();
     stop_all(&mut procs);
-    drop((plant_reader, observer_readers, controller_reader, bus));
+    drop((readers, bus));
     result
 }
 
@@ -389,26 +451,20 @@ fn handshake(procs: &mut [Proc], rx: &mpsc::Receiver<(usize, String)>) -> Result
     Ok(())
 }
 
-fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: &Readers) -> Result<Stop, LaunchError> {
+fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: &Readers, asm: &mut Assembly) -> Result<Stop, LaunchError> {
     let steps = cfg.plant.plant.steps;
-    let mut asm = Assembly {
-        plant: VecDeque::new(),
-        observers: readers.observers.iter().map(|_| VecDeque::new()).collect(),
-        controller: readers.controller.map(|_| VecDeque::new()),
-        next: 0,
-    };
     let mut row = StepRow::new(cfg.layout, readers.observers.len(), readers.controller.is_some());
     let mut last_progress = Instant::now();
     loop {
-        let got = readers.drain_all(&mut asm)?;
+        let got = readers.drain_all(asm)?;
         if asm.assemble(&mut row, session)? > 0 {
             last_progress = Instant::now();
         }
         if asm.next == steps {
             // The plant's end sample (step K) closes the last step's timing; a plant that has
             // exited without one ends the run all the same.
-            if let Some((h, _)) = asm.plant.front().filter(|(h, _)| h.step == steps) {
-                session.close_last(h)?;
+            if let Some(h) = asm.end(steps) {
+                session.close_last(&h)?;
                 return Ok(Stop::Completed);
             }
             if procs[0].status.is_some() {
@@ -430,7 +486,7 @@ fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: 
             }
             // Collect what it published before it went, then stop the others.
             std::thread::sleep(Duration::from_millis(20));
-            let _ = readers.drain_all(&mut asm);
+            let _ = readers.drain_all(asm);
             asm.assemble(&mut row, session)?;
             stop_all(procs);
             let what = procs[i].describe_exit();

@@ -1,0 +1,133 @@
+//! The configuration file of every component of a run (PROTOCOL.md §3), and who runs it: one
+//! of our binaries, with its designed matrices as `params`, or the scenario's command.
+
+use std::collections::BTreeMap;
+
+use lockstep::component::{ComponentConfig, Iceoryx2Place, PublishSpec, ReadSpec, Role};
+use lockstep::{PlantLayout, RunSpace, Wait, FOLLOWER_LAG, PROTOCOL_VERSION};
+use scenario::{Named, ProcessSpec, Scenario};
+use serde_json::{json, Value};
+
+use super::configs::{is_follower, Configs};
+
+/// Who runs a component.
+#[derive(Debug, Clone)]
+pub enum Program {
+    /// Our binary of this name (`plant`, `observer`, `controller`).
+    Builtin(&'static str),
+    /// The scenario's command.
+    External(ProcessSpec),
+}
+
+/// A component ready to be started.
+#[derive(Debug, Clone)]
+pub struct Launchable {
+    /// How messages name it: `plant`, `observer 'uio'`, `controller`.
+    pub label: String,
+    /// Who runs it.
+    pub program: Program,
+    /// Its configuration.
+    pub config: ComponentConfig,
+}
+
+impl Launchable {
+    /// The configuration's file name in the run directory (without `.json`).
+    pub fn file(&self) -> String {
+        match self.config.role {
+            Role::Observer => format!("observer-{}", self.config.name),
+            r => r.name().to_string(),
+        }
+    }
+}
+
+fn names(list: &[Named]) -> Vec<String> {
+    list.iter().map(|n| n.name.clone()).collect()
+}
+
+fn rows(m: &lti::Mat) -> Vec<Vec<f64>> {
+    (0..m.nrows()).map(|i| m.row(i).iter().copied().collect()).collect()
+}
+
+/// The named ranges of the plant's sample (PROTOCOL.md §4).
+fn fields(l: PlantLayout) -> BTreeMap<String, [usize; 2]> {
+    [("x", l.x()), ("y", l.y()), ("w", l.w()), ("v", l.v()), ("r", l.r()), ("u_prev", l.u_prev())]
+        .into_iter()
+        .map(|(k, r)| (k.to_string(), [r.start, r.end]))
+        .collect()
+}
+
+/// Every component of the run, in start order: plant, observers, controller.
+pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> Vec<Launchable> {
+    let lay = cfg.layout;
+    let m = &s.model;
+    let base = |name: &str, role: Role, publishes: PublishSpec, reads: Vec<ReadSpec>, params: Value| ComponentConfig {
+        protocol: PROTOCOL_VERSION,
+        run: space.id().to_string(),
+        name: name.to_string(),
+        role,
+        iceoryx2: Iceoryx2Place { prefix: format!("uio{}_", space.id()), root: format!("{}/", space.dir().join("iox2").display()) },
+        wait: wait.to_string(),
+        dt: s.dt,
+        steps: s.steps,
+        publishes,
+        reads,
+        model: json!({ "A": rows(&m.a), "B": rows(&m.b), "C": rows(&m.c), "D": rows(&m.d), "E": rows(&m.e), "x0": s.x0 }),
+        signals: Value::Null,
+        params,
+    };
+    let plant_read = |sleep_us| ReadSpec { service: "plant".into(), len: lay.len(), lag: 0, sleep_us, fields: fields(lay) };
+    let estimate = |name: &str| PublishSpec { service: format!("observer/{name}"), len: lay.n, names: names(&s.names.state) };
+    let mut out = Vec::new();
+
+    // The plant reads every observer (a follower may trail) and the controller.
+    let mut reads: Vec<ReadSpec> = s
+        .observers
+        .iter()
+        .map(|o| ReadSpec { service: format!("observer/{}", o.name), len: lay.n, lag: if is_follower(s, &o.name) { FOLLOWER_LAG } else { 0 }, sleep_us: None, fields: BTreeMap::new() })
+        .collect();
+    if s.controller.is_some() {
+        reads.push(ReadSpec { service: "controller".into(), len: lay.l, lag: 0, sleep_us: None, fields: BTreeMap::new() });
+    }
+    let sample_names = [&s.names.state, &s.names.output, &s.names.disturbance, &s.names.measurement_disturbance, &s.names.input, &s.names.input]
+        .iter()
+        .flat_map(|l| names(l))
+        .collect();
+    let publishes = PublishSpec { service: "plant".into(), len: lay.len(), names: sample_names };
+    let (program, params) = match &s.plant_process {
+        Some(p) => (Program::External(p.clone()), p.params.clone()),
+        None => (Program::Builtin("plant"), serde_json::to_value(&cfg.plant.plant).expect("serialises")),
+    };
+    let mut plant = base("plant", Role::Plant, publishes, reads, params);
+    plant.signals = json!({
+        "disturbances": s.disturbances,
+        "measurement_disturbances": s.measurement_disturbances,
+        "inputs": s.inputs,
+        "state_bound": s.state_bound,
+    });
+    out.push(Launchable { label: "plant".into(), program, config: plant });
+
+    for (o, (name, run)) in s.observers.iter().zip(&cfg.observers) {
+        let sleep = is_follower(s, name).then_some(super::configs::FOLLOWER_SLEEP_US);
+        let (program, params) = match (&o.process, run) {
+            (Some(p), _) => (Program::External(p.clone()), p.params.clone()),
+            (None, Some(r)) => (Program::Builtin("observer"), serde_json::to_value(r).expect("serialises")),
+            (None, None) => unreachable!("a designed observer has a runtime"),
+        };
+        let config = base(name, Role::Observer, estimate(name), vec![plant_read(sleep)], params);
+        out.push(Launchable { label: format!("observer '{name}'"), program, config });
+    }
+
+    if let Some(c) = &s.controller {
+        let publishes = PublishSpec { service: "controller".into(), len: lay.l, names: names(&s.names.input).iter().enumerate().map(|(i, _)| format!("u{}", i + 1)).collect() };
+        let reads = vec![ReadSpec { service: format!("observer/{}", c.observer), len: lay.n, lag: 0, sleep_us: None, fields: BTreeMap::new() }];
+        let (program, params) = match (&c.process, &cfg.controller) {
+            (Some(p), _) => (Program::External(p.clone()), p.params.clone()),
+            (None, Some(cc)) => (Program::Builtin("controller"), serde_json::to_value(cc).expect("serialises")),
+            (None, None) => unreachable!("a designed controller has a configuration"),
+        };
+        let mut config = base("controller", Role::Controller, publishes, reads, params);
+        config.signals = json!({ "inputs": s.inputs });
+        out.push(Launchable { label: "controller".into(), program, config });
+    }
+    out
+}

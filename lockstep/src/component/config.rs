@@ -1,0 +1,115 @@
+//! The configuration file every component reads from `$UIO_CONFIG` (PROTOCOL.md §3).
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+/// What a component is in the ring (PROTOCOL.md §5): the plant publishes step k from the inputs
+/// of step k − 1; observers and the controller publish step k from the inputs of step k.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Role {
+    /// The true plant: the ring's one source.
+    Plant,
+    /// An observer: reads the plant, publishes x̂.
+    Observer,
+    /// The controller: reads an observer, publishes u.
+    Controller,
+}
+
+impl Role {
+    /// Its name in the configuration and in `UIO_ROLE`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Role::Plant => "plant",
+            Role::Observer => "observer",
+            Role::Controller => "controller",
+        }
+    }
+}
+
+/// The run's iceoryx2 settings (PROTOCOL.md §2).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Iceoryx2Place {
+    /// `global.prefix`.
+    pub prefix: String,
+    /// `global.root_path`.
+    pub root: String,
+}
+
+/// The service a component publishes on.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PublishSpec {
+    /// Service name.
+    pub service: String,
+    /// Values per sample, fixed for the run.
+    pub len: usize,
+    /// Names of the values (1-based, as everywhere).
+    #[serde(default)]
+    pub names: Vec<String>,
+}
+
+/// A service a component reads.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ReadSpec {
+    /// Service name.
+    pub service: String,
+    /// Values per sample.
+    pub len: usize,
+    /// How many steps this input may trail (0: exactly the step's sample).
+    #[serde(default)]
+    pub lag: u64,
+    /// Poll with this sleep (µs) instead of the run's wait strategy (an input off the critical
+    /// path); not part of the protocol, a hint for our components.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sleep_us: Option<u32>,
+    /// Named ranges [start, end) of the values (the plant's sample layout).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub fields: BTreeMap<String, [usize; 2]>,
+}
+
+/// The whole configuration (PROTOCOL.md §3).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ComponentConfig {
+    /// Protocol version.
+    pub protocol: u32,
+    /// Run id.
+    pub run: String,
+    /// Component name.
+    pub name: String,
+    /// Its role.
+    pub role: Role,
+    /// The run's iceoryx2 settings.
+    pub iceoryx2: Iceoryx2Place,
+    /// The run's wait strategy.
+    pub wait: String,
+    /// Sample period, s.
+    pub dt: f64,
+    /// Steps K of the run.
+    pub steps: u64,
+    /// What it publishes.
+    pub publishes: PublishSpec,
+    /// What it reads, in order.
+    pub reads: Vec<ReadSpec>,
+    /// The scenario's design model: A, B, C, D, E (rows) and x0.
+    #[serde(default)]
+    pub model: serde_json::Value,
+    /// The scenario's signals (for plants): disturbances, measurement_disturbances, inputs.
+    #[serde(default)]
+    pub signals: serde_json::Value,
+    /// The component's own parameters.
+    #[serde(default)]
+    pub params: serde_json::Value,
+}
+
+impl ComponentConfig {
+    /// Index of the input read from `service`, if any.
+    pub fn read_index(&self, service: &str) -> Option<usize> {
+        self.reads.iter().position(|r| r.service == service)
+    }
+
+    /// The `params`, deserialised.
+    pub fn params<T: serde::de::DeserializeOwned>(&self) -> Result<T, String> {
+        serde_json::from_value(self.params.clone()).map_err(|e| format!("params: {e}"))
+    }
+}
