@@ -16,6 +16,26 @@ if [ ${#need[@]} -gt 0 ]; then
     || { $sudo apt-get update >/dev/null && $sudo apt-get install -y --no-install-recommends "${need[@]}" >/dev/null; }
 fi
 
+# The Python kit (python/) and the Python components (components/) run in a virtual
+# environment the script makes itself (pip from PyPI): made once, and again when the kit
+# changes. Its bin/ goes first on PATH, so the launcher's `python3` is the environment's.
+venv="${UIO_VENV:-$PWD/.venv}"
+stamp="$venv/.uio-installed"
+if [ ! -x "$venv/bin/python3" ] || [ ! -e "$stamp" ] \
+   || [ -n "$(find python/pyproject.toml python/uio_component -newer "$stamp" -print -quit)" ]; then
+  if ! python3 -c 'import ensurepip, venv' 2>/dev/null; then
+    echo "installing python3-venv (for the Python kit's environment)"
+    sudo=""; [ "$(id -u)" -eq 0 ] || sudo="sudo"
+    $sudo apt-get install -y --no-install-recommends python3-venv >/dev/null \
+      || { $sudo apt-get update >/dev/null && $sudo apt-get install -y --no-install-recommends python3-venv >/dev/null; }
+  fi
+  echo "preparing the Python environment $venv"
+  [ -x "$venv/bin/python3" ] || python3 -m venv "$venv"
+  "$venv/bin/pip" install -q --disable-pip-version-check ./python pytest scipy
+  touch "$stamp"
+fi
+export PATH="$venv/bin:$PATH"
+
 # The multi-process tests start the component binaries: build them all first.
 cargo build --release --workspace --bins
 
@@ -25,5 +45,15 @@ cargo test --release --workspace 2>&1 | tee "$log"
 # The same design tests with the LMI solver compiled in.
 cargo test --release -p observer --features lmi 2>&1 | tee -a "$log"
 
-# One closing line for the whole suite.
-awk '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed\n", p, f }' "$log"
+# The Python kit and components.
+python -m pytest -q python/tests 2>&1 | tee -a "$log"
+
+# One closing line for the whole suite: cargo's `test result:` lines and pytest's summary.
+awk '/^test result:/ { p += $4; f += $6 }
+     /^[0-9]+ (passed|failed)/ || /^=+ .*[0-9]+ (passed|failed).* in [0-9.]+s/ {
+       for (i = 2; i <= NF; i++) {
+         if ($i ~ /^passed/) p += $(i - 1)
+         if ($i ~ /^(failed|errors?)/) f += $(i - 1)
+       }
+     }
+     END { printf "tests: %d passed, %d failed\n", p, f }' "$log"

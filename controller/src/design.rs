@@ -84,7 +84,13 @@ pub fn design(model: &Model, spec: &FeedbackSpec, track: Option<&Mat>, dt: f64) 
     let unstable: Vec<C64> = closed_loop.iter().copied().filter(|z| z.re >= 0.0).collect();
     let n = match track {
         None => Mat::identity(model.l(), model.l()),
-        Some(ct) => prefilter(model, &g, ct)?,
+        // An unstable loop is refused (or run on request) for its instability, the reason that
+        // matters; a prefilter that cannot be formed for it is then left at I.
+        Some(ct) => match prefilter(model, &g, ct) {
+            Ok(n) => n,
+            Err(_) if !unstable.is_empty() => Mat::identity(model.l(), model.l()),
+            Err(e) => return Err(e),
+        },
     };
     Ok(FeedbackDesign { g, n, closed_loop, discrete_closed_loop, unstable })
 }
@@ -95,7 +101,7 @@ fn prefilter(model: &Model, g: &Mat, ct: &Mat) -> Result<Mat, String> {
         return Err(format!("track is {}×{}, must be {}×{} (one tracked output per input)", ct.nrows(), ct.ncols(), model.l(), model.n()));
     }
     let acl = &model.a - &model.b * g;
-    let x = acl.lu().solve(&model.b).ok_or("A − BG is singular: the loop has an integrator, so no prefilter is needed or possible")?;
+    let x = acl.lu().solve(&model.b).ok_or("A − BG has an eigenvalue at 0: the closed loop has no finite DC gain, so no prefilter can make the tracked outputs follow r")?;
     let dc = ct * x;
     let inv = dc.clone().try_inverse().filter(|i| i.iter().all(|v| v.is_finite()));
     inv.map(|i| -i).ok_or_else(|| format!("the closed loop's DC gain to the tracked outputs, C_t(A − BG)⁻¹B = {dc:.4}, is singular: those outputs cannot follow r"))

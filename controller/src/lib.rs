@@ -57,9 +57,8 @@ impl Controller {
 
     /// u_k = N r(t_k) − G x̂_k.
     pub fn step(&mut self, k: u64, xhat: &[f64]) -> &[f64] {
-        let t = k as f64 * self.dt;
         for (r, s) in self.r.iter_mut().zip(&self.references) {
-            *r = s.sample(t, self.dt);
+            *r = s.sample_step(k, self.dt);
         }
         mul_into(self.u.as_mut_slice(), &self.n, self.r.as_slice());
         mul_into(self.gx.as_mut_slice(), &self.g, xhat);

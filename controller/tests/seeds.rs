@@ -35,14 +35,15 @@ fn seed000_printed_gain_is_reported_unstable() {
 }
 
 /// The prefilter N makes the tracked output settle on a constant reference: iterate the sampled
-/// closed loop x_{k+1} = (A_d − B_dG)x_k + B_dN r until it settles, and read θ (the simulation
-/// is the independent check of N's formula), in a loop with the unit DC gain the formula claims.
+/// closed loop x_{k+1} = (A_d − B_dG)x_k + B_dN r until it settles, and read the angle of attack
+/// α (the simulation is the independent check of N's formula), in a loop with the unit DC gain
+/// the formula claims. α is what scenarios/seed003-charlie-closed-loop.toml tracks.
 #[test]
-fn seed003_prefilter_makes_the_pitch_angle_follow_the_reference() {
+fn seed003_prefilter_makes_the_angle_of_attack_follow_the_reference() {
     let m = &seeds()["seed_003"]["model"];
     let model = Model { a: mat(&m["A"]), b: mat(&m["B"]), c: mat(&m["C"]), e: Mat::zeros(4, 0), d: Mat::zeros(2, 0) };
     let poles = Poles::new([-4.0, -5.0, -6.0, -7.0].map(PoleSpec::Real)).unwrap();
-    let track = Mat::from_row_slice(1, 4, &[0.0, 0.0, 1.0, 0.0]);
+    let track = Mat::from_row_slice(1, 4, &[0.0, 1.0, 0.0, 0.0]);
     let dt = 1e-3;
     let fb = design(&model, &FeedbackSpec::Poles { poles, placement: Method::Ackermann }, Some(&track), dt).unwrap();
     let dm = model.discretize(dt);
@@ -52,13 +53,13 @@ fn seed003_prefilter_makes_the_pitch_angle_follow_the_reference() {
     for _ in 0..20_000 {
         x = &acl * &x + &bn * &r;
     }
-    assert!((x[(2, 0)] - 0.1).abs() < 1e-12, "θ settles at {}", x[(2, 0)]);
+    assert!((x[(1, 0)] - 0.1).abs() < 1e-12, "α settles at {}", x[(1, 0)]);
     // Without N (u = r − Gx) it settles elsewhere: the prefilter is what makes it track.
     let mut x = Mat::zeros(4, 1);
     for _ in 0..20_000 {
         x = &acl * &x + &dm.b * &r;
     }
-    assert!((x[(2, 0)] - 0.1).abs() > 1e-2, "θ without N: {}", x[(2, 0)]);
+    assert!((x[(1, 0)] - 0.1).abs() > 1e-2, "α without N: {}", x[(1, 0)]);
     // A tracked output the input cannot move in steady state is refused, with the reason.
     let e = design(&model, &FeedbackSpec::Poles { poles: Poles::new([-4.0, -5.0, -6.0, -7.0].map(PoleSpec::Real)).unwrap(), placement: Method::Ackermann }, Some(&Mat::zeros(1, 4)), dt).unwrap_err();
     assert!(e.contains("singular"), "{e}");

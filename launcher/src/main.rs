@@ -188,7 +188,7 @@ fn main() -> ExitCode {
                 eprintln!("warning: {w}");
             }
             let mode = if mode == "in-process" { Mode::InProcess } else { Mode::Processes };
-            let opts = Options { out, mode, wait: wait.unwrap_or_else(Wait::default_for_machine), force, allow_unstable, record: true, pin: pin == "auto", select };
+            let opts = Options { out, mode, wait: wait.unwrap_or_else(Wait::default_for_machine), force, allow_unstable, record: true, pin: pin == "auto", select, progress: true };
             match run::run(&s, &p, &opts) {
                 Ok(o) => {
                     print!("{}", o.summary.table());
@@ -292,7 +292,7 @@ fn main() -> ExitCode {
             }
         }
         Command::Plot { recording, out, signals, from, to } => {
-            let selection = recording::plot::Selection { signals, from, to };
+            let selection = recording::plot::PlotSelection { signals, from, to };
             if let Err(e) = selection.validate() {
                 return fail(&LaunchError::BadInput(e));
             }

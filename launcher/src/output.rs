@@ -32,6 +32,7 @@ macro_rules! print {
 /// `println!` through [`out`].
 #[macro_export]
 macro_rules! println {
+    () => { $crate::output::out("\n") };
     ($($t:tt)*) => { $crate::output::out(&format!("{}\n", format_args!($($t)*))) };
 }
 

@@ -47,7 +47,7 @@ pub fn plan(s: &Scenario) -> Result<Plan, PlanError> {
                 ("", format!("{} observer '{}': {} does not hold: {}", e.kind, o.name, e.condition, e.detail))
             };
             PlanError {
-                error: locate(format!("observer[{i}]{sub}"), reason),
+                error: locate(format!("observer[{}]{sub}", i + 1), reason),
                 conditions: e.conditions.clone(),
                 observer: Some(i),
             }

@@ -3,14 +3,16 @@
 //!
 //! ## Protocol
 //!
-//! Every run has its own iceoryx2 prefix and root directory ([`RunSpace`]), so runs never meet.
-//! Each component publishes one sample ([`WireHeader`] and its values) per step on its own service and waits for exactly the
-//! samples of the same step from the services it reads:
+//! PROTOCOL.md (at the repository's root) is the whole contract; this is its summary. Every run
+//! has its own iceoryx2 prefix and root directory ([`RunSpace`]), so runs never meet. Each
+//! component publishes one sample — a [`WireHeader`] and a slice of values whose length the
+//! run's configuration fixes — per step on its own service and waits for exactly the samples of
+//! the same step from the services it reads:
 //!
 //! ```text
 //! plant:       publish y_k ─▶ wait x̂_k of every observer, and u_k of the controller ─▶ x_{k+1}
 //! observer i:  wait y_k    ─▶ x̂_k = step(y_k, u_{k−1}) ─▶ publish x̂_k
-//! controller:  wait x̂_k of its observer ─▶ u_k = r_k − G x̂_k ─▶ publish u_k
+//! controller:  wait x̂_k of its observer ─▶ u_k = N r_k − G x̂_k ─▶ publish u_k
 //! ```
 //!
 //! A sample whose step counter is not the one expected is an error ([`LockstepError::Step`]).
@@ -21,7 +23,8 @@
 //! No first sample is lost: components create all their ports, report "ready" to the launcher,
 //! and publish only after the launcher's "go", when every subscriber already exists.
 //! The launcher records every sample from its own subscribers, whose large buffers and the
-//! publishers' retry-until-delivered back-pressure mean no sample is ever dropped.
+//! publishers' retry-until-delivered back-pressure mean no sample is ever dropped. A component
+//! is written with the kit in [`component`]: a step function and a one-line `main`.
 
 mod clock;
 pub mod component;

@@ -144,9 +144,17 @@ impl Outlet {
         if values.len() != self.len {
             return Err(LockstepError::Length { topic: "own output".into(), expected: self.len, got: values.len() });
         }
+        self.send_header(WireHeader { step, sim_time, sent_ns: 0, taken_ns, protocol: PROTOCOL_VERSION, reserved: 0 }, values)
+    }
+
+    /// Sends `values` behind `header` as given (its `sent_ns` set to now), without checking
+    /// either against the protocol: for a component that fills its headers itself — or a test
+    /// that breaks the protocol on purpose. Returns the send time.
+    pub fn send_header(&self, mut header: WireHeader, values: &[f64]) -> Result<u64, LockstepError> {
         let mut sample = self.publisher.loan_slice_uninit(values.len()).map_err(LockstepError::ipc)?;
         let sent_ns = now_ns();
-        *sample.user_header_mut() = WireHeader { step, sim_time, sent_ns, taken_ns, protocol: PROTOCOL_VERSION, reserved: 0 };
+        header.sent_ns = sent_ns;
+        *sample.user_header_mut() = header;
         let sample = sample.write_from_slice(values);
         sample.send().map_err(LockstepError::ipc)?;
         if let Some(notifier) = &self.notifier {

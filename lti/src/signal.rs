@@ -299,7 +299,8 @@ impl Signal {
     }
 
     /// The piecewise-constant part c(t), right-continuous, comparing t with the switching times
-    /// as binary numbers (for plots; sampling and the plant use [`Signal::held_at_step`]).
+    /// as binary numbers: the part of [`Signal::value`], and the constant part of a signal that
+    /// does not switch. Sampling and the plant use [`Signal::held_at_step`].
     pub fn held(&self, t: f64) -> f64 {
         match self {
             Signal::Constant { value } => *value,

@@ -126,7 +126,6 @@ pub fn observability_staircase(a: &DMatrix<f64>, c: &DMatrix<f64>) -> Observabil
     }
 }
 
-/// Orthonormal basis of the range of `m`, counting singular values above an absolute `tol`.
 /// The rank tolerance n²·ε·max(‖A‖₁, ‖B‖₁): SLICOT's default for its staircase (AB01ND, TOLDEF
 /// = N²·ε·norm), not MATLAB `ctrbf`'s n·ε. The blocks that should vanish carry the rounding of
 /// every product that formed A — a plant given in other coordinates, TA = (I − HC)A — a few tens
@@ -135,6 +134,7 @@ fn tolerance(n: usize, norm: f64) -> f64 {
     (n * n) as f64 * f64::EPSILON * norm.max(f64::MIN_POSITIVE)
 }
 
+/// Orthonormal basis of the range of `m`, counting singular values above an absolute `tol`.
 fn range_with_tol(m: &DMatrix<f64>, tol: f64) -> DMatrix<f64> {
     if m.is_empty() {
         return DMatrix::zeros(m.nrows(), 0);

@@ -6,9 +6,13 @@
 //! written (step order), each row as three little-endian 8-byte words: the `step` (i64), the
 //! `sim_time` in nanoseconds (i64; 0 where the recording has no such timeline) and the value's
 //! `f64` bit pattern. The scenario text stored in the recording is digested as the key
-//! `scenario` (its UTF-8 bytes). Digests are written as 16 lowercase hex digits. What is left
-//! out is Rerun's own bookkeeping (row ids, legends, the blueprint), whose damage changes no
-//! value. XXH64 is no defence against a deliberate forgery, only against damage.
+//! `scenario` (its UTF-8 bytes). Digests are written as 16 lowercase hex digits. An entity with
+//! rows that the digest does not list, or one it lists that has none, is damage too. Left out
+//! is everything else: Rerun's row and chunk ids, each series' static `SeriesLines` (legend,
+//! colour, width), the blueprint and the recording's other properties. Damage there changes no
+//! signal's steps, times or values, but it can change a legend, a colour, the layout the viewer
+//! shows or what a property says. XXH64 is no defence against a deliberate forgery, only
+//! against damage.
 
 use std::collections::BTreeMap;
 use std::hash::Hasher as _;
@@ -43,14 +47,16 @@ impl Default for Running {
 impl Running {
     /// Adds rows, in the order written: steps, sim_time in ns (None: no such timeline), values.
     pub fn update(&mut self, steps: &[i64], times_ns: Option<&[i64]>, values: &[f64]) {
-        let mut buf = Vec::with_capacity(24 * values.len());
+        // One row at a time through a stack buffer: XXH64's streaming state gives the same hash
+        // as one write of all rows, and nothing is allocated.
+        let mut row = [0u8; 24];
         for (i, (k, v)) in steps.iter().zip(values).enumerate() {
             let t = times_ns.and_then(|t| t.get(i)).copied().unwrap_or(0);
-            buf.extend_from_slice(&k.to_le_bytes());
-            buf.extend_from_slice(&t.to_le_bytes());
-            buf.extend_from_slice(&v.to_bits().to_le_bytes());
+            row[..8].copy_from_slice(&k.to_le_bytes());
+            row[8..16].copy_from_slice(&t.to_le_bytes());
+            row[16..].copy_from_slice(&v.to_bits().to_le_bytes());
+            self.0.write(&row);
         }
-        self.0.write(&buf);
     }
 
     /// 16 hex digits.
@@ -66,7 +72,7 @@ pub fn of_text(text: &str) -> String {
 
 /// The digest as stored: `{"algorithm": …, "entities": {entity: hex}}`.
 pub fn to_json(entities: &BTreeMap<String, String>) -> String {
-    serde_json::json!({ "algorithm": "xxh64 seed 0 over (i64 step, f64 bits) little-endian pairs in step order", "entities": entities }).to_string()
+    serde_json::json!({ "algorithm": "xxh64 seed 0 over (i64 step, i64 sim_time ns, f64 bits) little-endian triples in step order", "entities": entities }).to_string()
 }
 
 /// Checks what was read — each entity's running digest over its rows in file order, and the

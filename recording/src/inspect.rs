@@ -1,6 +1,6 @@
 //! `launcher inspect`: what a recording holds — its entities with their row counts and time
 //! ranges — and the run's figures recomputed from the recorded data alone: per observer the
-//! largest |x − x̂| and |y − Cx̂| over the last quarter of the run, and the latency percentiles.
+//! largest |x − x̂| and |y − Cx̂| over the tail (the last quarter of the steps completed), and the latency percentiles.
 
 use std::collections::BTreeMap;
 
@@ -55,8 +55,10 @@ pub struct Inspection {
     pub scenario: Option<String>,
     /// Steps the scenario asked for, if recorded.
     pub steps_planned: Option<u64>,
-    /// Steps in the recording.
+    /// Rows of x1 in the recording (fewer than the steps when it was thinned).
     pub steps_recorded: u64,
+    /// Steps the run completed.
+    pub steps_completed: u64,
     /// Every entity.
     pub entities: Vec<EntityInfo>,
     /// Per observer.
@@ -72,6 +74,10 @@ pub fn inspect(file: &str, r: &Recording) -> Inspection {
     let scenario = recorded_scenario(r);
     let dt = scenario.as_ref().map(|s| s.dt);
     let steps_recorded = r.series.get(&crate::signals::state(0)).map_or(0, |s| s.values.len() as u64);
+    // What the run completed: as its writer stored it, else (a killed writer's file) the last
+    // step anything was recorded at — a thinned or filtered recording holds fewer rows.
+    let last_step = r.series.values().filter_map(|s| s.steps.last()).max().map_or(0, |&k| k.max(-1) + 1) as u64;
+    let steps_completed = r.steps_completed.unwrap_or(last_step);
     let steps_planned = scenario.as_ref().map(|s| s.steps);
     let mut warnings = Vec::new();
     if !r.complete {
@@ -81,9 +87,9 @@ pub fn inspect(file: &str, r: &Recording) -> Inspection {
         });
     }
     if let Some(planned) = steps_planned
-        && steps_recorded < planned
+        && steps_completed < planned
     {
-        warnings.push(format!("the run stopped early: {steps_recorded} of {planned} steps recorded"));
+        warnings.push(format!("the run stopped early: {steps_completed} of {planned} steps completed"));
     }
     let entities = r
         .series
@@ -94,7 +100,7 @@ pub fn inspect(file: &str, r: &Recording) -> Inspection {
         })
         .collect();
     // The tail as the run defined it: the last quarter of the steps it completed.
-    let tail_start = crate::write::tail::tail_start(steps_recorded, steps_planned.unwrap_or(steps_recorded)).map(|s| s as i64);
+    let tail_start = crate::write::tail::tail_start(steps_completed, steps_planned.unwrap_or(steps_completed)).map(|s| s as i64);
     let tail_max = |prefix: &str| -> Option<f64> {
         let start = tail_start?;
         Some(
@@ -142,6 +148,7 @@ pub fn inspect(file: &str, r: &Recording) -> Inspection {
         scenario: scenario.map(|s| s.name),
         steps_planned,
         steps_recorded,
+        steps_completed,
         entities,
         observers,
         latency_ns: LatencyFigures { step: percentiles("/latency/step"), hops },
@@ -153,12 +160,13 @@ impl Inspection {
     /// The printed report.
     pub fn text(&self) -> String {
         let mut t = format!(
-            "{}: {} ({}), {} steps recorded{}\n",
+            "{}: {} ({}), {} steps completed{}, {} recorded\n",
             self.file,
             self.scenario.as_deref().unwrap_or("unknown scenario"),
             if self.complete { "complete" } else { "INCOMPLETE" },
-            self.steps_recorded,
-            self.steps_planned.map_or(String::new(), |p| format!(" of {p}"))
+            self.steps_completed,
+            self.steps_planned.map_or(String::new(), |p| format!(" of {p}")),
+            self.steps_recorded
         );
         for w in &self.warnings {
             t += &format!("warning: {w}\n");

@@ -6,6 +6,7 @@
 pub mod compare;
 pub mod digest;
 pub mod export;
+mod globs;
 pub mod inspect;
 pub mod palette;
 pub mod plot;

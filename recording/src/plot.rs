@@ -15,7 +15,7 @@ use plotters::style::FontStyle;
 use scenario::{Named, Scenario};
 
 pub use figure::{Curve, Figure, Scale, SIZE};
-pub use select::{Matcher, Selection};
+pub use select::{Matcher, PlotSelection};
 
 use crate::palette;
 use crate::read::{Recording, Series};
@@ -69,10 +69,13 @@ fn decimate(points: &[(f64, f64)], width: usize) -> Vec<(f64, f64)> {
     out
 }
 
-/// Numbered members of a group, ascending: "/plant/x" → [(1, "/plant/x/1"), …].
+/// Numbered members of a group, ascending: "/plant/x" → [(1, "/plant/x/1"), …]. Components
+/// number from 1; a member numbered 0 (a recording from before that rule) is left out, so
+/// that every k here has a component k − 1.
 fn members(r: &Recording, group: &str) -> Vec<(usize, String)> {
     let prefix = format!("{group}/");
-    let mut v: Vec<(usize, String)> = r.series.keys().filter_map(|p| p.strip_prefix(&prefix).and_then(|m| m.parse().ok()).map(|k| (k, p.clone()))).collect();
+    let mut v: Vec<(usize, String)> =
+        r.series.keys().filter_map(|p| p.strip_prefix(&prefix).and_then(|m| m.parse().ok()).filter(|&k: &usize| k >= 1).map(|k| (k, p.clone()))).collect();
     v.sort();
     v
 }
@@ -158,7 +161,7 @@ fn log_max_error(r: &Recording, o: &str) -> Option<Series> {
 
 /// The figures of every selected view of `r`, with their file names; an error names what is
 /// wrong (a bad selection, nothing selected).
-pub fn figures(r: &Recording, selection: &Selection) -> Result<Vec<(String, Figure)>, String> {
+pub fn figures(r: &Recording, selection: &PlotSelection) -> Result<Vec<(String, Figure)>, String> {
     let sel = selection.matcher()?;
     let scenario = recorded_scenario(r);
     let s = scenario.as_ref();
@@ -215,7 +218,7 @@ pub fn figures(r: &Recording, selection: &Selection) -> Result<Vec<(String, Figu
 }
 
 /// Draws every selected view of `r` into `dir`; returns the files written.
-pub fn plot(r: &Recording, dir: &Path, sel: &Selection) -> Result<Vec<PathBuf>, String> {
+pub fn plot(r: &Recording, dir: &Path, sel: &PlotSelection) -> Result<Vec<PathBuf>, String> {
     let figures = figures(r, sel)?;
     register_font();
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
@@ -227,4 +230,24 @@ pub fn plot(r: &Recording, dir: &Path, sel: &Selection) -> Result<Vec<PathBuf>, 
         }
     }
     Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_member_numbered_0_is_left_out_so_no_index_wraps() {
+        let mut r = Recording::default();
+        for p in ["/plant/x/0", "/plant/x/1", "/plant/x/2", "/observer/uio/error/0", "/observer/uio/xhat/0"] {
+            r.series.insert(p.into(), Series { steps: vec![0], values: vec![1.0] });
+        }
+        assert_eq!(members(&r, "/plant/x"), [(1, "/plant/x/1".to_string()), (2, "/plant/x/2".to_string())]);
+        assert!(members(&r, "/observer/uio/error").is_empty());
+        // Every view of such a recording is built without an index k − 1 wrapping.
+        let views = views(&r, None, &["uio".to_string()]);
+        let states: Vec<&str> = views.iter().filter(|v| v.file.starts_with("state_")).map(|v| v.file.as_str()).collect();
+        assert_eq!(states.len(), 2, "{states:?}");
+        assert!(views.iter().find(|v| v.file == "error_uio.png").is_some_and(|v| v.series.is_empty()));
+    }
 }

@@ -40,6 +40,9 @@ pub struct Recording {
     pub problem: Option<String>,
     /// Whether the data matches the digest written with it.
     pub integrity: Integrity,
+    /// How many steps the run completed, as its writer stored it when it closed the file (none
+    /// for a killed writer's file).
+    pub steps_completed: Option<u64>,
 }
 
 /// Why a file could not be read at all.
@@ -96,6 +99,8 @@ pub fn read(path: &Path) -> Result<Recording, ReadError> {
             if let Some(s) = chunk.iter_slices::<String>(text).next().and_then(|v| v.into_iter().next()) {
                 if path.starts_with("/__properties") && path.ends_with("/digest") {
                     stored_digest = Some(s.to_string());
+                } else if path.starts_with("/__properties") && path.ends_with("/steps") {
+                    rec.steps_completed = s.trim().parse().ok();
                 } else {
                     rec.scenario = Some(s.to_string());
                 }

@@ -40,7 +40,7 @@ fn the_viewer_opens_on_sim_time_paused_with_the_palettes_colours() {
         let line = palette::line(&p, &observers);
         sink.series(g, &p, "legend", line.color, palette::viewer_width(&p, &observers));
     }
-    sink.finish().unwrap();
+    sink.finish(0).unwrap();
     let all = chunks(&path);
     let _ = std::fs::remove_dir_all(&dir);
     let panel = &all[&(true, "/time_panel".to_string())];

@@ -9,7 +9,9 @@ pub enum Seg {
     Index(usize),
 }
 
-/// Parses "plant.A[1]" or "observer[0].poles" into segments.
+/// Parses "plant.A[2]" or "observer[1].poles" into segments. Field paths in messages number
+/// array entries from 1, like every other numbering the user sees (`observer[1]` is the first
+/// `[[observer]]`); segments index from 0.
 pub fn parse_path(path: &str) -> Vec<Seg> {
     let mut out = Vec::new();
     for part in path.split('.') {
@@ -20,8 +22,10 @@ pub fn parse_path(path: &str) -> Vec<Seg> {
             }
             rest = &rest[i..];
             while let Some(end) = rest.find(']') {
-                if let Ok(k) = rest[1..end].parse() {
-                    out.push(Seg::Index(k));
+                if let Ok(k) = rest[1..end].parse::<usize>()
+                    && k >= 1
+                {
+                    out.push(Seg::Index(k - 1));
                 }
                 rest = &rest[end + 1..];
             }
@@ -29,6 +33,24 @@ pub fn parse_path(path: &str) -> Vec<Seg> {
             out.push(Seg::Key(rest.to_string()));
         }
     }
+    out
+}
+
+/// A serde field path ("observer[0].colour", indices from 0) as messages write it, from 1.
+pub fn one_based(path: &str) -> String {
+    let mut out = String::with_capacity(path.len());
+    let mut rest = path;
+    while let Some(open) = rest.find('[') {
+        out.push_str(&rest[..=open]);
+        rest = &rest[open + 1..];
+        let close = rest.find(']').unwrap_or(rest.len());
+        match rest[..close].parse::<usize>() {
+            Ok(k) => out.push_str(&(k + 1).to_string()),
+            Err(_) => out.push_str(&rest[..close]),
+        }
+        rest = &rest[close..];
+    }
+    out.push_str(rest);
     out
 }
 

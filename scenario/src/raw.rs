@@ -124,10 +124,10 @@ pub struct RawController {
 #[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawExpect {
-    /// Max |x − x̂| over the last quarter of the run, per observer.
+    /// Max |x − x̂| over the tail (the last quarter of the steps completed), per observer.
     #[serde(default)]
     pub tail_max_abs_error: BTreeMap<String, f64>,
-    /// Max |y − Cx̂| over the last quarter of the run, per observer.
+    /// Max |y − Cx̂| over the tail, per observer.
     #[serde(default)]
     pub tail_max_abs_residual: BTreeMap<String, f64>,
     /// Pairs of observers whose estimates must agree at every step: "a/b" = tolerance.

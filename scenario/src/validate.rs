@@ -10,7 +10,7 @@ use lti::{Mat, Model, PoleSpec, Poles};
 use observer::design::Path as HuiZakPath;
 use observer::Spec;
 
-use super::locate::{line_col, offset, parse_path};
+use super::locate::{line_col, offset, one_based, parse_path};
 use super::raw::{RawController, RawExpect, RawObserver, RawPole, RawProcess, RawScenario, Rows};
 use super::untrusted::quoted;
 use super::{ControllerEntry, Named, ObserverEntry, ProcessSpec, Scenario, ScenarioError, SignalNames};
@@ -35,7 +35,7 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<Scenario, ScenarioError> 
         reason: format!("malformed TOML: {}", first_line(e.message())),
     })?;
     let raw: RawScenario = serde_path_to_error::deserialize(de).map_err(|e| {
-        let field = e.path().to_string();
+        let field = one_based(&e.path().to_string());
         let field = if field == "." { String::new() } else { field };
         let mut reason = first_line(e.inner().message()).to_string();
         if field.contains("poles") && reason.contains("untagged") {
@@ -67,11 +67,11 @@ fn matrix(field: &str, rows: &Rows, shape: (Option<usize>, Option<usize>), why: 
     let cols = rows[0].len();
     for (i, r) in rows.iter().enumerate() {
         if r.len() != cols {
-            return Err(bad(format!("{field}[{i}]"), format!("ragged: row {i} has {} entries, row 0 has {cols}", r.len())));
+            return Err(bad(format!("{field}[{}]", i + 1), format!("ragged: row {} has {} entries, row 1 has {cols}", i + 1, r.len())));
         }
         for (j, &v) in r.iter().enumerate() {
             if !v.is_finite() {
-                return Err(bad(format!("{field}[{i}]"), format!("entry {j} is {v}, not a finite number")));
+                return Err(bad(format!("{field}[{}]", i + 1), format!("entry {} is {v}, not a finite number", j + 1)));
             }
         }
     }
@@ -91,7 +91,7 @@ fn signals(field: &str, list: &[Signal], count: usize, source: &str) -> Result<V
         ));
     }
     for (i, s) in list.iter().enumerate() {
-        s.validate().map_err(|(f, reason)| bad(format!("{field}[{i}].{f}"), reason))?;
+        s.validate().map_err(|(f, reason)| bad(format!("{field}[{}].{f}", i + 1), reason))?;
     }
     Ok(list.to_vec())
 }
@@ -108,7 +108,13 @@ fn names(prefix: &str, names: Option<&Vec<String>>, units: Option<&Vec<String>>,
         }
     }
     if let Some(i) = names.and_then(|v| v.iter().position(|s| s.trim().is_empty())) {
-        return Err(bad(format!("{prefix}_names[{i}]"), "must not be empty"));
+        return Err(bad(format!("{prefix}_names[{}]", i + 1), "must not be empty"));
+    }
+    // Names and units end up in plot text, view titles and CSV headers: no control characters.
+    for (key, list) in [("names", names), ("units", units)] {
+        if let Some((i, s)) = list.and_then(|v| v.iter().enumerate().find(|(_, s)| s.chars().any(char::is_control))) {
+            return Err(bad(format!("{prefix}_{key}[{}]", i + 1), format!("{} holds a control character", quoted(s))));
+        }
     }
     Ok((0..count)
         .map(|i| Named {
@@ -121,7 +127,7 @@ fn names(prefix: &str, names: Option<&Vec<String>>, units: Option<&Vec<String>>,
 fn poles(field: &str, raw: &[RawPole]) -> Result<Poles, Bad> {
     let mut specs = Vec::new();
     for (i, p) in raw.iter().enumerate() {
-        let f = format!("{field}[{i}]");
+        let f = format!("{field}[{}]", i + 1);
         match p {
             RawPole::Real(x) => specs.push(PoleSpec::Real(finite(&f, *x)?)),
             RawPole::Pair(v) if v.len() == 2 => {
@@ -211,7 +217,7 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
         return Err(bad("plant.x0", format!("has {} entries, the plant has {n} states", p.x0.len())));
     }
     for (i, &v) in p.x0.iter().enumerate() {
-        finite(&format!("plant.x0[{i}]"), v)?;
+        finite(&format!("plant.x0[{}]", i + 1), v)?;
     }
     let state_bound = finite("plant.state_bound", p.state_bound.unwrap_or(1e9))?;
     if state_bound <= 0.0 {
@@ -241,7 +247,7 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
     let mut seen = BTreeSet::new();
     let mut observers = Vec::new();
     for (i, o) in raw.observer.iter().enumerate() {
-        let f = format!("observer[{i}]");
+        let f = format!("observer[{}]", i + 1);
         check_name(&format!("{f}.name"), &o.name, "it names signals, files and a process")?;
         if !seen.insert(o.name.clone()) {
             return Err(bad(format!("{f}.name"), format!("two observers are named {}", quoted(&o.name))));
@@ -349,7 +355,7 @@ fn process_spec(f: &str, command: &Option<Vec<String>>, params: &Option<toml::Ta
         return Err(bad(format!("{f}.command"), "must name a program first"));
     }
     if let Some(i) = command.iter().position(|a| a.contains('\0')) {
-        return Err(bad(format!("{f}.command[{i}]"), "holds a NUL character"));
+        return Err(bad(format!("{f}.command[{}]", i + 1), "holds a NUL character"));
     }
     let params = match params {
         Some(t) => serde_json::to_value(t).map_err(|e| bad(format!("{f}.params"), e.to_string()))?,

@@ -83,7 +83,7 @@ fn a_wrong_length_or_an_empty_name_is_one_line_naming_file_and_field() {
         ("disturbance_units = []", "plant.disturbance_units", "E has 1 column (unknown inputs)"),
         ("measurement_disturbance_names = [\"a\", \"b\"]", "plant.measurement_disturbance_names", "D has 1 column ("),
         ("measurement_disturbance_units = [\"a\", \"b\"]", "plant.measurement_disturbance_units", "D has 1 column ("),
-        ("output_names = [\"a\", \" \"]", "plant.output_names[1]", "must not be empty"),
+        ("output_names = [\"a\", \" \"]", "plant.output_names[2]", "must not be empty"),
     ] {
         let e = with(line).unwrap_err();
         assert!(e.starts_with("names.toml:") && e.contains(field) && e.contains(reason), "{line}: {e}");

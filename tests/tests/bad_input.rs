@@ -61,14 +61,14 @@ fn cases() -> Vec<(&'static str, String, &'static str)> {
         ("E-size", r("E = [[2.0], [0.0], [0.5]]", "E = [[2.0], [0.0]]"), "plant.E"),
         ("D-size", r("x0 = [1.0, -1.0, 2.0]", "D = [[1.0], [2.0], [3.0]]\nx0 = [1.0, -1.0, 2.0]"), "plant.D"),
         ("x0-size", r("x0 = [1.0, -1.0, 2.0]", "x0 = [1.0, -1.0]"), "plant.x0"),
-        ("H-size", r("kind = \"chen-patton-uio\"\npoles = [-1.0, -2.0, -3.0]", "kind = \"das-ghosal-uio\"\nH = [[1.0, 2.0, 3.0]]"), "observer[0].H"),
+        ("H-size", r("kind = \"chen-patton-uio\"\npoles = [-1.0, -2.0, -3.0]", "kind = \"das-ghosal-uio\"\nH = [[1.0, 2.0, 3.0]]"), "observer[1].H"),
         ("gain-size", r("poles = [-4.0, -5.0, -6.0]", "gain = [[1.0, 2.0, 3.0]]"), "controller.gain"),
-        ("ragged", r("A = [[0.0, 1.0, 0.0], [-2.0, -3.0, 0.0], [0.0, 0.0, -2.0]]", "A = [[0.0, 1.0, 0.0], [-2.0, -3.0], [0.0, 0.0, -2.0]]"), "plant.A[1]"),
+        ("ragged", r("A = [[0.0, 1.0, 0.0], [-2.0, -3.0, 0.0], [0.0, 0.0, -2.0]]", "A = [[0.0, 1.0, 0.0], [-2.0, -3.0], [0.0, 0.0, -2.0]]"), "plant.A[2]"),
         ("empty-B", r("B = [[0.0, 0.0], [4.0, 0.0], [0.0, 1.0]]", "B = []"), "plant.B"),
         ("empty-rows", r("B = [[0.0, 0.0], [4.0, 0.0], [0.0, 1.0]]", "B = [[], [], []]"), "plant.B"),
-        ("nan-in-matrix", r("[-2.0, -3.0, 0.0]", "[-2.0, nan, 0.0]"), "plant.A[1]"),
-        ("inf-amplitude", r("amplitude = 1.0", "amplitude = inf"), "disturbance[0].amplitude"),
-        ("inf-pole", r("poles = [-1.0, -2.0, -3.0]", "poles = [-1.0, -inf, -3.0]"), "observer[0].poles[1]"),
+        ("nan-in-matrix", r("[-2.0, -3.0, 0.0]", "[-2.0, nan, 0.0]"), "plant.A[2]"),
+        ("inf-amplitude", r("amplitude = 1.0", "amplitude = inf"), "disturbance[1].amplitude"),
+        ("inf-pole", r("poles = [-1.0, -2.0, -3.0]", "poles = [-1.0, -inf, -3.0]"), "observer[1].poles[2]"),
         ("dt-zero", r("dt = 0.001", "dt = 0.0"), "dt"),
         ("dt-negative", r("dt = 0.001", "dt = -0.001"), "dt"),
         ("dt-nan", r("dt = 0.001", "dt = nan"), "dt"),
@@ -76,11 +76,11 @@ fn cases() -> Vec<(&'static str, String, &'static str)> {
         ("duration-below-dt", r("duration = 1.0", "duration = 0.0005"), "duration"),
         ("too-many-disturbances", r("[[input]]\nkind = \"constant\"\nvalue = 0.0\n\n[[input]]", "[[disturbance]]\nkind = \"constant\"\nvalue = 1.0\n\n[[input]]\nkind = \"constant\"\nvalue = 0.0\n\n[[input]]"), "disturbance"),
         ("too-few-inputs", r("[[input]]\nkind = \"constant\"\nvalue = 0.0\n\n[[input]]\nkind = \"constant\"\nvalue = 0.0\n", "[[input]]\nkind = \"constant\"\nvalue = 0.0\n"), "input"),
-        ("pole-not-a-pair", r("poles = [-1.0, -2.0, -3.0]", "poles = [-1.0, [-2.0, 3.0, 1.0]]"), "observer[0].poles[1]"),
-        ("conjugate-written-twice", r("poles = [-1.0, -2.0, -3.0]", "poles = [-1.0, [-2.0, 3.0], [-2.0, -3.0]]"), "observer[0].poles[2]"),
-        ("poles-repeated", r("name = \"luenberger\"\nkind = \"luenberger\"\npoles = [-1.0, -2.0, -3.0]", "name = \"luenberger\"\nkind = \"luenberger\"\npoles = [-1.0, -1.0, -1.0]"), "observer[1].poles"),
+        ("pole-not-a-pair", r("poles = [-1.0, -2.0, -3.0]", "poles = [-1.0, [-2.0, 3.0, 1.0]]"), "observer[1].poles[2]"),
+        ("conjugate-written-twice", r("poles = [-1.0, -2.0, -3.0]", "poles = [-1.0, [-2.0, 3.0], [-2.0, -3.0]]"), "observer[1].poles[3]"),
+        ("poles-repeated", r("name = \"luenberger\"\nkind = \"luenberger\"\npoles = [-1.0, -2.0, -3.0]", "name = \"luenberger\"\nkind = \"luenberger\"\npoles = [-1.0, -1.0, -1.0]"), "observer[2].poles"),
         ("missing-observer", r("observer = \"uio\"", "observer = \"ghost\""), "controller.observer"),
-        ("duplicate-names", r("name = \"luenberger\"", "name = \"uio\""), "observer[1].name"),
+        ("duplicate-names", r("name = \"luenberger\"", "name = \"uio\""), "observer[2].name"),
         ("missing-field", r("x0 = [1.0, -1.0, 2.0]\n", ""), "x0"),
         // E = [0, 1, 0]ᵀ is invisible to y = [x1, x3]: CE = 0, rank 0 ≠ 1.
         ("existence-condition", r("E = [[2.0], [0.0], [0.5]]", "E = [[0.0], [1.0], [0.0]]"), "rank(CE) = rank(E)"),
@@ -179,7 +179,7 @@ fn names_are_bounded_before_anything_is_created() {
     let s = Scratch::new("long-names");
     for (case, body, field) in [
         ("name-250", BASE.replacen("name = \"bad\"", &format!("name = \"{}\"", "n".repeat(250)), 1), "name"),
-        ("observer-name-300", BASE.replacen("name = \"luenberger\"", &format!("name = \"{}\"", "l".repeat(300)), 1), "observer[1].name"),
+        ("observer-name-300", BASE.replacen("name = \"luenberger\"", &format!("name = \"{}\"", "l".repeat(300)), 1), "observer[2].name"),
     ] {
         let err = refused(&s, case, &body);
         assert!(err.contains(&format!("{field}:")) && err.contains("64"), "{case}: {err}");

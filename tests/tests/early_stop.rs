@@ -103,3 +103,27 @@ fn a_run_of_fewer_than_four_steps_has_no_tail() {
     assert!(sum["observers"][0]["tail_max_abs_error"].is_null(), "{sum}");
     assert!(text(&out).0.contains("—"));
 }
+
+/// A thinned recording holds fewer rows than steps: inspect takes the completed count from the
+/// recording, warns of nothing, and takes its tail from the same steps (of the rows it has).
+#[test]
+fn inspect_of_a_thinned_recording_knows_the_run_completed() {
+    let s = Scratch::new("thinned-inspect");
+    let out = run(&s, &scenario("seed002-sine"), &["--mode", "in-process", "--record-every", "10"]);
+    assert!(out.status.success(), "{:?}", text(&out));
+    let rrd = s.join("out/seed002-sine.rrd");
+    let ins = launcher(&s).arg("inspect").arg(&rrd).arg("--json").output().unwrap();
+    let j: serde_json::Value = serde_json::from_slice(&ins.stdout).unwrap();
+    assert_eq!(j["steps_completed"], 20_000, "{j}");
+    assert_eq!(j["steps_recorded"], 2_000, "{j}");
+    assert!(j["warnings"].as_array().unwrap().is_empty(), "{}", j["warnings"]);
+    let r = read(&rrd).unwrap();
+    let sum = summary(&s, "seed002-sine");
+    for o in j["observers"].as_array().unwrap() {
+        let name = o["name"].as_str().unwrap();
+        let got = o["tail_max_abs_error"].as_f64().unwrap();
+        assert_eq!(got, tail_max(&r, &format!("/observer/{name}/error/"), 15_000), "{name}");
+        let full = sum["observers"].as_array().unwrap().iter().find(|x| x["name"] == name).unwrap()["tail_max_abs_error"].as_f64().unwrap();
+        assert!(got > 0.0 && got <= full, "{name}: thinned {got} vs every step {full}");
+    }
+}

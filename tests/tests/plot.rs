@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use recording::plot::{figures, Scale, Selection};
+use recording::plot::{figures, PlotSelection, Scale};
 use tests::*;
 
 /// The plot rectangle of a PNG (left, top, right, bottom): the y axis is the longest vertical
@@ -96,7 +96,7 @@ fn one_colour_per_observer_a_log_error_view_and_one_based_names() {
     let r = read(&s.join("out/seed002-sine.rrd")).unwrap();
     assert!(r.series.contains_key("/plant/x/1") && r.series.contains_key("/plant/x/3") && !r.series.contains_key("/plant/x/0"));
     assert!(r.series.contains_key("/observer/uio/error/3") && r.series.contains_key("/input/2") && r.series.contains_key("/disturbance/1"));
-    let figs = figures(&r, &Selection::default()).unwrap();
+    let figs = figures(&r, &PlotSelection::default()).unwrap();
     let fig = |file: &str| &figs.iter().find(|(f, _)| f == file).unwrap_or_else(|| panic!("no {file}")).1;
     let colour_of = |file: &str, label_part: &str| fig(file).curves.iter().find(|c| c.label.contains(label_part)).unwrap_or_else(|| panic!("{file}: {label_part}")).line.color;
     // The same colour for an observer in every view; the true state apart and wider.
@@ -128,7 +128,7 @@ fn signals_and_a_time_window_choose_what_is_drawn() {
     files.sort();
     assert_eq!(files, ["error_uio.png", "errors_log.png", "residual_uio.png", "state_1_x1.png", "state_2_x2.png", "state_3_x3.png"]);
     let r = read(&rrd).unwrap();
-    let sel = Selection { signals: vec!["/observer/uio/**".into()], from: Some(5.0), to: Some(7.5) };
+    let sel = PlotSelection { signals: vec!["/observer/uio/**".into()], from: Some(5.0), to: Some(7.5) };
     for (file, fig) in figures(&r, &sel).unwrap() {
         for c in &fig.curves {
             assert!(c.label.contains("uio") || file.contains("uio"), "{file}: {}", c.label);
@@ -180,7 +180,7 @@ fn names_and_units_label_plots_and_csv_headers() {
     assert!(cols.contains(&"step_latency [ns]"), "{latency}");
     // Plots: titles, axis labels and legends carry the names and units.
     let r = read(&rrd).unwrap();
-    let figs = figures(&r, &Selection::default()).unwrap();
+    let figs = figures(&r, &PlotSelection::default()).unwrap();
     let (file, fig) = figs.iter().find(|(f, _)| f.starts_with("state_2")).unwrap();
     assert_eq!(file, "state_2_vel.png");
     assert_eq!(fig.y_label, "vel [m/s]");

@@ -62,6 +62,8 @@ pub struct Options {
     pub pin: bool,
     /// Which steps and entities are written to the recording (`--record-every`, `--record`).
     pub select: recording::write::Selection,
+    /// Show a progress bar on a terminal (not in benchmarks: it would disturb their timing).
+    pub progress: bool,
 }
 
 /// How a run ended.
@@ -102,11 +104,14 @@ fn prepare_output(out: &Path, name: &str, force: bool) -> Result<(PathBuf, PathB
     fs::write(&probe, b"").map_err(|e| LaunchError::BadInput(format!("{}: output directory is not writable: {e}", out.display())))?;
     let _ = fs::remove_file(&probe);
     let (rrd, summary) = output_paths(out, name);
-    if !force {
-        for p in [&rrd, &summary] {
-            if p.exists() {
+    for p in [&rrd, &summary] {
+        if p.exists() {
+            if !force {
                 return Err(LaunchError::BadInput(format!("{}: already exists (pass --force to overwrite)", p.display())));
             }
+            // Overwritten now, not when the new run ends: a run that fails must not leave the
+            // previous run's outputs looking like its own.
+            fs::remove_file(p).map_err(|e| LaunchError::BadInput(format!("{}: cannot overwrite: {e}", p.display())))?;
         }
     }
     Ok((rrd, summary))
@@ -149,7 +154,7 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
             let _ = fs::remove_file(p);
         }
     })?;
-    if opts.record {
+    if opts.progress {
         session.progress = progress::Progress::new(s.steps);
     }
     let start = Instant::now();
@@ -166,15 +171,24 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
         Err(e) => Stop::Failed(e.to_string()),
     };
     let steps_done = session.steps;
-    let (mut metrics, latency, digest) = session.finish().map_err(|e| salvage::recording_failed(&s.name, partial.as_deref(), &e.to_string(), steps_done))?;
+    let (mut metrics, latency, digest) = session.finish().map_err(|e| {
+        // Say why the run had stopped too, when the recording's failure is not the whole story.
+        let why = match &stop {
+            Stop::Completed => String::new(),
+            Stop::Diverged(w) | Stop::Failed(w) => format!(" (the run had stopped: {w})"),
+            Stop::Interrupted(sig) => format!(" (the run had been interrupted by {sig})"),
+        };
+        salvage::recording_failed(&s.name, partial.as_deref(), &format!("{e}{why}"), steps_done)
+    })?;
     metrics.finish();
+    // Failures after the run are of the run's outputs (a full disk, say): exit code 3, the file named.
     if let (Some(from), Some(to)) = (&partial, &rrd) {
-        fs::rename(from, to).map_err(|e| LaunchError::BadInput(format!("{}: cannot rename the recording: {e}", to.display())))?;
+        fs::rename(from, to).map_err(|e| LaunchError::Component(format!("{}: cannot rename the recording into place: {e}", to.display())))?;
     }
     let mut summary = Summary::new(s, plan, opts, &metrics, &latency, wall, &stop, rrd.as_deref());
     summary.recording_digest = digest;
     if let Some(path) = &summary_path {
-        summary.write(path).map_err(LaunchError::BadInput)?;
+        summary.write(path).map_err(LaunchError::Component)?;
     }
     Ok(Outcome { summary, rrd, summary_path, stop })
 }

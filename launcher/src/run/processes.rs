@@ -54,9 +54,7 @@ impl Proc {
         let err = self.stderr.lock().map(|s| s.trim().lines().last().unwrap_or("").to_string()).unwrap_or_default();
         if err.is_empty() { format!("{} (pid {}) {how}", self.label, self.child.id()) } else { format!("{} (pid {}) {how}: {err}", self.label, self.child.id()) }
     }
-}
 
-impl Proc {
     /// "observer 'uio' (pid N, stopped)": the process named with the state the kernel reports.
     fn describe_stall(&self) -> String {
         let pid = self.child.id();
@@ -118,6 +116,21 @@ fn component_command(kind: &str) -> Command {
         c.args(["component", kind]);
         c
     }
+}
+
+/// An external command's program: a bare name (no `/`) of a program built beside the launcher —
+/// a kit component of this workspace — is that one; anything else as given (a bare name then
+/// goes through `PATH`, a relative path from the scenario's folder).
+fn program_path(program: &str) -> std::path::PathBuf {
+    if !program.contains('/')
+        && let Ok(exe) = std::env::current_exe()
+    {
+        let sibling = exe.with_file_name(program);
+        if sibling.is_file() {
+            return sibling;
+        }
+    }
+    program.into()
 }
 
 /// The CPUs this process may run on.
@@ -182,7 +195,7 @@ fn spawn(c: &Launchable, workdir: &Path, space: &RunSpace, cpu: Option<usize>, t
             cmd
         }
         Program::External(p) => {
-            let mut cmd = Command::new(&p.command[0]);
+            let mut cmd = Command::new(program_path(&p.command[0]));
             cmd.args(&p.command[1..]).current_dir(workdir);
             cmd
         }
@@ -302,6 +315,8 @@ struct Assembly {
     observers: Vec<Queue>,
     controller: Option<Queue>,
     next: u64,
+    /// Steps K of the run: the plant's end sample (step K) is not a row.
+    steps: u64,
 }
 
 impl Assembly {
@@ -322,6 +337,9 @@ impl Assembly {
     fn assemble(&mut self, row: &mut StepRow, session: &mut Session) -> Result<usize, LaunchError> {
         let mut done = 0;
         loop {
+            if self.next >= self.steps {
+                return Ok(done);
+            }
             let ready = !self.plant.is_empty() && self.observers.iter().all(|q| !q.is_empty()) && self.controller.as_ref().is_none_or(|q| !q.is_empty());
             if !ready {
                 return Ok(done);
@@ -408,6 +426,7 @@ fn run_in(s: &Scenario, space: &RunSpace, cfg: &Configs, session: &mut Session, 
             observers: components[1..1 + nobs].iter().map(Queue::new).collect(),
             controller: components.get(1 + nobs).map(Queue::new),
             next: 0,
+            steps: s.steps,
         };
         supervise(cfg, session, &mut procs, &r, &mut asm)
     })();

@@ -56,6 +56,8 @@ pub struct Session {
     dt: f64,
     /// The progress bar, when the run shows one.
     pub progress: Option<Progress>,
+    /// The hops a row completes, reused from step to step (no allocation per step).
+    hop_values: Vec<(usize, u64)>,
 }
 
 /// A recording's digest: entity → 16 hex digits.
@@ -138,6 +140,7 @@ impl Session {
             steps: 0,
             dt: s.dt,
             progress: None,
+            hop_values: Vec::with_capacity(s.observers.len() + 2),
         })
     }
 
@@ -145,7 +148,8 @@ impl Session {
     pub fn record(&mut self, row: &StepRow) -> Result<(), LaunchError> {
         // Hops completed by this row.
         let nobs = row.xhat.len();
-        let mut hop_values: Vec<(usize, u64)> = Vec::with_capacity(nobs + 2);
+        let mut hop_values = std::mem::take(&mut self.hop_values);
+        hop_values.clear();
         for i in 0..nobs {
             hop_values.push((i, row.xhat_hdr[i].taken_ns.saturating_sub(row.plant_hdr.sent_ns)));
         }
@@ -167,7 +171,9 @@ impl Session {
         if let Some(ns) = step_ns {
             self.latency.step(ns);
         }
-        self.push(row, step_ns.map(|ns| (row.k - 1, ns)), &hop_values)
+        let pushed = self.push(row, step_ns.map(|ns| (row.k - 1, ns)), &hop_values);
+        self.hop_values = hop_values;
+        pushed
     }
 
     /// Closes the timing of the last step K − 1 with the plant's end sample (step K, published
@@ -248,7 +254,7 @@ impl Session {
             p.finish();
         }
         let digest = match self.sink {
-            Some((sink, _)) => Some(sink.finish().map_err(LaunchError::Component)?),
+            Some((sink, _)) => Some(sink.finish(self.steps).map_err(LaunchError::Component)?),
             None => None,
         };
         Ok((self.metrics, self.latency, digest))

@@ -1,12 +1,11 @@
 //! What `launcher plot` draws: entities chosen by glob (`--signals '/observer/uio/**'`) and a
 //! time window (`--from`, `--to`).
 
-use globset::{GlobBuilder, GlobSet, GlobSetBuilder};
-use scenario::quoted;
+use crate::globs::Globs;
 
-/// The choice of signals and time.
+/// What `launcher plot` draws: the choice of signals and time.
 #[derive(Debug, Clone, Default)]
-pub struct Selection {
+pub struct PlotSelection {
     /// Entity globs; empty means every entity. `*` matches within one path segment, `**` any
     /// number of segments (as `launcher run --record`).
     pub signals: Vec<String>,
@@ -16,7 +15,7 @@ pub struct Selection {
     pub to: Option<f64>,
 }
 
-impl Selection {
+impl PlotSelection {
     /// Checks the window (finite bounds, `from` before `to`) and the globs; the message names
     /// the option.
     pub fn validate(&self) -> Result<(), String> {
@@ -37,24 +36,15 @@ impl Selection {
         {
             return Err(format!("--from {a} must be before --to {b}"));
         }
-        let globs = if self.signals.is_empty() {
-            None
-        } else {
-            // The rules of `launcher run --record`: `*` stops at '/', a leading '/' is implied.
-            let mut set = GlobSetBuilder::new();
-            for g in &self.signals {
-                let rooted = if g.starts_with('/') { g.clone() } else { format!("/{g}") };
-                set.add(GlobBuilder::new(&rooted).literal_separator(true).build().map_err(|e| format!("--signals {}: {}", quoted(g), e.kind()))?);
-            }
-            Some(set.build().map_err(|e| format!("--signals: {e}"))?)
-        };
+        // The rules of `launcher run --record`: `*` stops at '/', a leading '/' is implied.
+        let globs = if self.signals.is_empty() { None } else { Some(Globs::new(&self.signals).map_err(|e| format!("--signals {e}"))?) };
         Ok(Matcher { globs, from: self.from, to: self.to })
     }
 }
 
-/// A checked [`Selection`].
+/// A checked [`PlotSelection`].
 pub struct Matcher {
-    globs: Option<GlobSet>,
+    globs: Option<Globs>,
     from: Option<f64>,
     to: Option<f64>,
 }
@@ -62,7 +52,7 @@ pub struct Matcher {
 impl Matcher {
     /// Whether the entity at `path` is selected.
     pub fn entity(&self, path: &str) -> bool {
-        self.globs.as_ref().is_none_or(|g| g.is_match(path))
+        self.globs.as_ref().is_none_or(|g| g.matches(path))
     }
 
     /// Whether time `x` is in the window.
@@ -77,7 +67,7 @@ mod tests {
 
     #[test]
     fn globs_match_by_segment() {
-        let m = |g: &str| Selection { signals: vec![g.to_string()], from: None, to: None }.matcher().unwrap();
+        let m = |g: &str| PlotSelection { signals: vec![g.to_string()], from: None, to: None }.matcher().unwrap();
         assert!(m("/observer/uio/**").entity("/observer/uio/xhat/1"));
         assert!(m("/observer/uio/**").entity("/observer/uio/log10_max_abs_error"));
         assert!(!m("/observer/uio/**").entity("/observer/luenberger/xhat/1"));
@@ -86,12 +76,12 @@ mod tests {
         assert!(!m("/plant/*").entity("/plant/x/1"));
         assert!(m("plant/x/?").entity("/plant/x/1"));
         assert!(m("/plant/x/1").entity("/plant/x/1") && !m("/plant/x/1").entity("/plant/x/10"));
-        assert!(Selection { signals: vec!["/plant/[x".into()], from: None, to: None }.validate().unwrap_err().contains("--signals"));
+        assert!(PlotSelection { signals: vec!["/plant/[x".into()], from: None, to: None }.validate().unwrap_err().starts_with("--signals '/plant/[x': "));
     }
 
     #[test]
     fn a_window_must_be_finite_and_ordered() {
-        let w = |from, to| Selection { signals: vec![], from, to }.validate();
+        let w = |from, to| PlotSelection { signals: vec![], from, to }.validate();
         assert!(w(Some(1.0), Some(2.0)).is_ok());
         assert!(w(Some(2.0), Some(1.0)).unwrap_err().contains("--from 2"));
         assert!(w(Some(1.0), Some(1.0)).is_err());

@@ -35,6 +35,10 @@ pub struct Metrics {
     layout: PlantLayout,
     c: Mat,
     planned: u64,
+    /// First step of the tail of a run that completes: [K − ⌊K/4⌋, K).
+    planned_tail: u64,
+    /// Per observer, max |e| and max |r| from `planned_tail` on: exact for a completed run.
+    exact: Vec<[f64; 2]>,
     /// Per observer, block maxima of max_i |e_i| and max_j |r_j| (the tail of an early stop).
     blocks: Vec<[BlockMax; 2]>,
     /// Per observer.
@@ -62,6 +66,8 @@ impl Metrics {
             layout,
             c,
             planned: steps,
+            planned_tail: steps - steps / 4,
+            exact: vec![[0.0; 2]; observers],
             blocks: (0..observers).map(|_| [BlockMax::new(steps), BlockMax::new(steps)]).collect(),
             observers: vec![ObserverFigures::default(); observers],
             differences,
@@ -77,11 +83,13 @@ impl Metrics {
     }
 
     /// Sets each observer's tail figures from the steps completed; call once the run has ended.
+    /// A run that completed has its exact tail; one stopped early the block maxima's.
     pub fn finish(&mut self) {
         let start = self.tail_start();
-        for (f, [e, r]) in self.observers.iter_mut().zip(&self.blocks) {
-            f.tail_max_abs_error = start.map(|s| e.max_from(s));
-            f.tail_max_abs_residual = start.map(|s| r.max_from(s));
+        let completed = self.steps >= self.planned;
+        for ((f, [e, r]), exact) in self.observers.iter_mut().zip(&self.blocks).zip(&self.exact) {
+            f.tail_max_abs_error = start.map(|s| if completed { exact[0] } else { e.max_from(s) });
+            f.tail_max_abs_residual = start.map(|s| if completed { exact[1] } else { r.max_from(s) });
         }
     }
 
@@ -109,6 +117,11 @@ impl Metrics {
             let [be, br] = &mut self.blocks[o];
             be.push(row.k, emax);
             br.push(row.k, rmax);
+            if row.k >= self.planned_tail {
+                let x = &mut self.exact[o];
+                x[0] = nan_max(x[0], emax);
+                x[1] = nan_max(x[1], rmax);
+            }
         }
         for ((a, b), d) in self.differences.iter_mut() {
             for i in 0..self.layout.n {

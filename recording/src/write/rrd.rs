@@ -156,7 +156,8 @@ impl RrdSink {
             return Ok(());
         }
         let rows = g.steps.len();
-        let step_values = std::mem::take(&mut g.steps);
+        // Fresh buffers of a whole batch: the per-step pushes never grow them again.
+        let step_values = std::mem::replace(&mut g.steps, Vec::with_capacity(FLUSH_STEPS));
         let offsets = OffsetBuffer::<i32>::from_lengths(std::iter::repeat_n(1, rows));
         let mut columns = Vec::new();
         for (path, values) in &mut g.series {
@@ -169,25 +170,27 @@ impl RrdSink {
                 return Err(format!("{path}: {} values for {rows} rows", values.len()));
             }
             self.digests.entry(path.clone()).or_default().update(&step_values, Some(&g.times_ns), values);
-            let array = Float64Array::from(std::mem::take(values));
+            let array = Float64Array::from(std::mem::replace(values, Vec::with_capacity(FLUSH_STEPS)));
             let list = ListArray::new(self.item.clone(), offsets.clone(), Arc::new(array), None);
             columns.push((path.clone(), SerializedComponentColumn::new(list, self.descriptor.clone())));
         }
         // One time column per group, shared (the buffers are reference-counted).
         let steps = TimeColumn::new(Some(true), Timeline::new_sequence("step"), ScalarBuffer::from(step_values));
-        let times = TimeColumn::new(Some(true), Timeline::new_duration("sim_time"), ScalarBuffer::from(std::mem::take(&mut g.times_ns)));
+        let times = TimeColumn::new(Some(true), Timeline::new_duration("sim_time"), ScalarBuffer::from(std::mem::replace(&mut g.times_ns, Vec::with_capacity(FLUSH_STEPS))));
         for (path, column) in columns {
             self.rec.send_columns(path.as_str(), [steps.clone(), times.clone()], [column]).map_err(|e| e.to_string())?;
         }
         Ok(())
     }
 
-    /// Sends what is left and the digest of everything sent, waits until it is on disk, and
-    /// closes the file (writing its footer). Returns the digest, entity → 16 hex digits.
-    pub fn finish(mut self) -> Result<BTreeMap<String, String>, String> {
+    /// Sends what is left, the number of steps the run completed (a thinned or filtered
+    /// recording cannot tell it), and the digest of everything sent; waits until it is on disk,
+    /// and closes the file (writing its footer). Returns the digest, entity → 16 hex digits.
+    pub fn finish(mut self, steps_completed: u64) -> Result<BTreeMap<String, String>, String> {
         for i in 0..self.groups.len() {
             self.send(i)?;
         }
+        self.rec.send_property("steps", &TextDocument::new(steps_completed.to_string())).map_err(|e| e.to_string())?;
         let mut digests: BTreeMap<String, String> = self.digests.iter().map(|(k, d)| (k.clone(), d.hex())).collect();
         digests.insert(digest::SCENARIO_KEY.into(), self.scenario_digest.clone());
         self.rec.send_property("digest", &TextDocument::new(digest::to_json(&digests))).map_err(|e| e.to_string())?;

@@ -1,11 +1,12 @@
 //! The tail of a run: its last quarter of steps, where transients have died out and the figures
 //! of merit (tail max|e|, tail max|r|) are taken.
 //!
-//! A run that completed all its K planned steps has the tail [K − ⌊K/4⌋, K), exactly. A run that
-//! stopped early after K' steps has the tail of the steps it completed: [K' − ⌊K'/4⌋, K'), with
-//! its start rounded down to a block of [`block_len`] steps — the figures are kept as block
-//! maxima so that memory stays bounded; for runs of up to [`MAX_BLOCKS`] planned steps a block is
-//! one step and the tail is exact. With ⌊K'/4⌋ = 0 (fewer than 4 steps) there is no tail.
+//! A run that completed all its K planned steps has the tail [K − ⌊K/4⌋, K), exactly (its
+//! maxima are kept from that step on as it runs). A run that stopped early after K' steps has
+//! the tail of the steps it completed: [K' − ⌊K'/4⌋, K'), with its start rounded down to a block
+//! of [`block_len`] steps — those figures are kept as block maxima so that memory stays bounded;
+//! for runs of up to [`MAX_BLOCKS`] planned steps a block is one step and that tail is exact
+//! too. With ⌊K'/4⌋ = 0 (fewer than 4 steps) there is no tail.
 
 use super::nan_max;
 

@@ -1,0 +1,153 @@
+//! A nonlinear plant for `scenarios/dc-motor-friction.toml`: the DC motor of
+//! `dc-motor-load-torque` with Coulomb friction on the shaft,
+//!
+//! ```text
+//! ẋ = A x + B u + E (w + τ_f(ω)),   τ_f(ω) = τ_c · tanh(ω / ω_s),   y = C x,
+//! ```
+//!
+//! x = [i, ω, θ], integrated with classical Runge–Kutta (`substeps` per sample, u held over the
+//! step, w evaluated at each stage). Its linearisation about rest without friction is the
+//! scenario's `[plant]`. The friction torque enters exactly where the unknown load torque does
+//! (the column E), so an unknown-input observer designed on the linear model rejects it as it
+//! rejects the load, while a Luenberger observer sees a model error.
+//!
+//! `params`: `coulomb` (τ_c, in the units of w, default 0.02), `stribeck_speed` (ω_s, rad/s,
+//! default 0.05), `substeps` (default 10).
+
+use examples::{DesignModel, Signals};
+use lockstep::component::{self, Component, ComponentConfig, Inputs, StepError};
+use lockstep::PlantLayout;
+use lti::Mat;
+use serde::Deserialize;
+
+#[derive(Deserialize)]
+#[serde(default, deny_unknown_fields)]
+struct Params {
+    coulomb: f64,
+    stribeck_speed: f64,
+    substeps: u32,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params { coulomb: 0.02, stribeck_speed: 0.05, substeps: 10 }
+    }
+}
+
+struct FrictionMotor {
+    m: DesignModel,
+    s: Signals,
+    p: Params,
+    lay: PlantLayout,
+    dt: f64,
+    controller: Option<usize>,
+    x: Vec<f64>,
+    u: Vec<f64>,
+    /// Scratch for the Runge–Kutta stages (no allocation per step).
+    k: [Vec<f64>; 4],
+    tmp: Vec<f64>,
+}
+
+impl FrictionMotor {
+    /// ẋ at (t, x) with u held: A x + B u + E (w(t) + τ_f(ω)) — ω is x[1].
+    fn f(m: &DesignModel, s: &Signals, p: &Params, t: f64, x: &[f64], u: &[f64], out: &mut [f64]) {
+        let friction = p.coulomb * (x[1] / p.stribeck_speed).tanh();
+        for (i, o) in out.iter_mut().enumerate() {
+            let mut v = 0.0;
+            for (j, xj) in x.iter().enumerate() {
+                v += m.a[(i, j)] * xj;
+            }
+            for (j, uj) in u.iter().enumerate() {
+                v += m.b[(i, j)] * uj;
+            }
+            for (j, w) in s.disturbances.iter().enumerate() {
+                v += m.e[(i, j)] * (w.value(t) + if j == 0 { friction } else { 0.0 });
+            }
+            *o = v;
+        }
+    }
+
+    /// x(t + h) by one Runge–Kutta step.
+    fn rk4(&mut self, t: f64, h: f64) {
+        let n = self.x.len();
+        let (m, s, p, u) = (&self.m, &self.s, &self.p, &self.u);
+        let [k1, k2, k3, k4] = &mut self.k;
+        Self::f(m, s, p, t, &self.x, u, k1);
+        for i in 0..n {
+            self.tmp[i] = self.x[i] + 0.5 * h * k1[i];
+        }
+        Self::f(m, s, p, t + 0.5 * h, &self.tmp, u, k2);
+        for i in 0..n {
+            self.tmp[i] = self.x[i] + 0.5 * h * k2[i];
+        }
+        Self::f(m, s, p, t + 0.5 * h, &self.tmp, u, k3);
+        for i in 0..n {
+            self.tmp[i] = self.x[i] + h * k3[i];
+        }
+        Self::f(m, s, p, t + h, &self.tmp, u, k4);
+        for i in 0..n {
+            self.x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+        }
+    }
+}
+
+fn mul(m: &Mat, x: &[f64], i: usize) -> f64 {
+    x.iter().enumerate().map(|(j, v)| m[(i, j)] * v).sum()
+}
+
+impl Component for FrictionMotor {
+    fn new(cfg: &ComponentConfig) -> Result<Self, String> {
+        let (m, s) = (DesignModel::of(cfg)?, Signals::of(cfg)?);
+        let p: Params = if cfg.params.as_object().is_some_and(|o| o.is_empty()) { Params::default() } else { cfg.params()? };
+        let lay = m.layout();
+        if lay.n != 3 || lay.q < 1 {
+            return Err(format!("this plant is x = [i, ω, θ] with the load torque as the first unknown input; the scenario has n = {}, q = {}", lay.n, lay.q));
+        }
+        if !(p.stribeck_speed > 0.0 && p.substeps > 0 && p.coulomb.is_finite()) {
+            return Err("params: stribeck_speed must be > 0, substeps ≥ 1, coulomb finite".into());
+        }
+        let x = m.x0.clone();
+        Ok(FrictionMotor { lay, dt: cfg.dt, controller: cfg.read_index("controller"), u: vec![0.0; lay.l], k: std::array::from_fn(|_| vec![0.0; 3]), tmp: vec![0.0; 3], x, m, s, p })
+    }
+
+    fn step(&mut self, k: u64, inputs: &Inputs, out: &mut [f64]) -> Result<(), StepError> {
+        if k > 0 {
+            match self.controller {
+                Some(i) => self.u.copy_from_slice(inputs.get(i)),
+                None => {
+                    for (u, r) in self.u.iter_mut().zip(&self.s.inputs) {
+                        *u = r.sample_step(k - 1, self.dt);
+                    }
+                }
+            }
+            let h = self.dt / self.p.substeps as f64;
+            for j in 0..self.p.substeps {
+                self.rk4((k - 1) as f64 * self.dt + j as f64 * h, h);
+            }
+            if let Some(i) = self.x.iter().position(|v| !v.is_finite() || v.abs() > self.s.state_bound) {
+                return Err(StepError { code: 4, message: format!("diverged: x{} = {} at step {k}", i + 1, self.x[i]) });
+            }
+        }
+        let (lay, dt) = (self.lay, self.dt);
+        out[lay.x()].copy_from_slice(&self.x);
+        for (j, y) in out[lay.y()].iter_mut().enumerate() {
+            let noise: f64 = self.s.measurement_disturbances.iter().enumerate().map(|(c, s)| self.m.d[(j, c)] * s.sample_step(k, dt)).sum();
+            *y = mul(&self.m.c, &self.x, j) + noise;
+        }
+        for (o, s) in out[lay.w()].iter_mut().zip(&self.s.disturbances) {
+            *o = s.sample_step(k, dt);
+        }
+        for (o, s) in out[lay.v()].iter_mut().zip(&self.s.measurement_disturbances) {
+            *o = s.sample_step(k, dt);
+        }
+        for (o, s) in out[lay.r()].iter_mut().zip(&self.s.inputs) {
+            *o = s.sample_step(k, dt);
+        }
+        out[lay.u_prev()].copy_from_slice(&self.u);
+        Ok(())
+    }
+}
+
+fn main() -> std::process::ExitCode {
+    component::main::<FrictionMotor>("dc_motor_friction")
+}

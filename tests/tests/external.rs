@@ -1,0 +1,128 @@
+//! Issue 11: components we did not write join a run through PROTOCOL.md — and one that breaks
+//! it is named, stops the run quickly, and leaves nothing behind.
+
+use std::time::{Duration, Instant};
+
+use tests::*;
+
+/// seed002-sine in open loop (the observers are in the ring) with a third observer, `bad`, run by
+/// the given command and params.
+fn with_bad_observer(s: &Scratch, seconds: u32, command: &str, params: &str) -> std::path::PathBuf {
+    let text = std::fs::read_to_string(scenario("seed002-sine")).unwrap();
+    let text = text.split("\n[controller]").next().unwrap().replace("duration = 20.0", &format!("duration = {seconds}.0"));
+    let text = format!("{text}\n[[observer]]\nname = \"bad\"\nkind = \"process\"\ncommand = {command}\nparams = {params}\n");
+    let p = s.join("bad.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// Runs `path`; returns exit code, stderr, how long it took; asserts nothing is left behind.
+fn run_checked(s: &Scratch, path: &std::path::Path) -> (Option<i32>, String, Duration) {
+    let started = Instant::now();
+    let child = launcher(s).arg("run").arg(path).arg("--out").arg(s.join("out")).stdout(std::process::Stdio::piped()).stderr(std::process::Stdio::piped()).spawn().unwrap();
+    let pid = child.id();
+    let out = child.wait_with_output().unwrap();
+    let took = started.elapsed();
+    assert_clean(s, pid);
+    (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned(), took)
+}
+
+#[test]
+fn a_component_that_breaks_the_protocol_is_named_and_nothing_is_left() {
+    let cases: [(&str, &[&str]); 7] = [
+        ("nan", &["observer 'bad' broke the protocol at step 100", "is NaN"]),
+        ("wrong_step", &["observer 'bad' broke the protocol at step 100", "of step 101"]),
+        ("wrong_len", &["observer 'bad' broke the protocol at step 0", "4 values", "says 3"]),
+        ("protocol", &["observer 'bad' broke the protocol at step 100", "protocol version 2"]),
+        ("exit", &["observer 'bad' (pid", "exited with status 7"]),
+        ("kill", &["observer 'bad' (pid", "SIGKILL"]),
+        ("refuse_version", &["observer 'bad' (pid", "before the run began", "protocol version 1, this component 2"]),
+    ];
+    for (fault, want) in cases {
+        let s = Scratch::new(&format!("bad-{fault}"));
+        let path = with_bad_observer(&s, 600, r#"["faulty_observer"]"#, &format!("{{ fault = \"{fault}\" }}"));
+        let (code, err, took) = run_checked(&s, &path);
+        assert_eq!(code, Some(3), "{fault}: {err}");
+        assert!(want.iter().all(|w| err.contains(w)), "{fault}: {err}");
+        assert!(took < Duration::from_secs(5), "{fault}: took {took:?}");
+    }
+}
+
+#[test]
+fn a_hung_component_is_named_within_the_stall_timeout() {
+    let s = Scratch::new("bad-hang");
+    let path = with_bad_observer(&s, 600, r#"["faulty_observer"]"#, r#"{ fault = "hang" }"#);
+    let (code, err, took) = run_checked(&s, &path);
+    assert_eq!(code, Some(3), "{err}");
+    assert!(err.contains("observer 'bad' (pid") && err.contains("published no sample for step 100"), "{err}");
+    assert!(took < Duration::from_secs(9), "took {took:?}");
+}
+
+#[test]
+fn a_component_that_never_says_ready_is_named() {
+    let s = Scratch::new("bad-never-ready");
+    let path = with_bad_observer(&s, 10, r#"["faulty_observer"]"#, r#"{ fault = "never_ready" }"#);
+    let (code, err, took) = run_checked(&s, &path);
+    assert_eq!(code, Some(3), "{err}");
+    assert!(err.contains("observer 'bad' did not report ready within 20 s"), "{err}");
+    assert!(took < Duration::from_secs(25), "took {took:?}");
+}
+
+#[test]
+fn a_command_that_does_not_exist_is_named() {
+    let s = Scratch::new("bad-command");
+    let path = with_bad_observer(&s, 10, r#"["./no_such_program_uio"]"#, "{}");
+    let (code, err, _) = run_checked(&s, &path);
+    assert_eq!(code, Some(3), "{err}");
+    assert!(err.contains("cannot start observer 'bad'") && err.contains("no_such_program_uio"), "{err}");
+}
+
+/// The built-in linear plant rebuilt from the protocol's configuration alone, run as an
+/// external process, gives the built-in plant's recording bit for bit.
+#[test]
+fn an_external_rust_plant_reproduces_the_built_in_one_bit_for_bit() {
+    let s = Scratch::new("external-linear");
+    let text = std::fs::read_to_string(scenario("seed002-sine")).unwrap();
+    let text = text.replacen("x0 = [1.0, -1.0, 2.0]\n", "x0 = [1.0, -1.0, 2.0]\n\n[plant.process]\ncommand = [\"linear_plant\"]\n", 1);
+    let path = s.join("seed002-sine.toml");
+    std::fs::write(&path, text).unwrap();
+    let out = launcher(&s).arg("run").arg(&path).arg("--out").arg(s.join("ext")).output().unwrap();
+    assert!(out.status.success(), "{:?}", text_of(&out));
+    let out = launcher(&s).arg("run").arg(scenario("seed002-sine")).arg("--out").arg(s.join("builtin")).output().unwrap();
+    assert!(out.status.success(), "{:?}", text_of(&out));
+    let cmp = launcher(&s).arg("compare").arg(s.join("ext/seed002-sine.rrd")).arg(s.join("builtin/seed002-sine.rrd")).output().unwrap();
+    let (stdout, _) = text_of(&cmp);
+    assert!(cmp.status.success() && stdout.contains("bit for bit"), "{stdout}");
+}
+
+fn text_of(o: &std::process::Output) -> (String, String) {
+    text(o)
+}
+
+/// In-process mode cannot run someone else's process: refused before anything is written.
+#[test]
+fn in_process_mode_refuses_external_components() {
+    let s = Scratch::new("external-in-process");
+    let out = launcher(&s).arg("run").arg(scenario("dc-motor-friction")).args(["--mode", "in-process", "--out"]).arg(s.join("out")).output().unwrap();
+    let (_, err) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("the plant is an external process"), "{err}");
+    assert!(!s.join("out").exists() || std::fs::read_dir(s.join("out")).unwrap().next().is_none());
+}
+
+/// A Python component (the kit on iceoryx2's Python binding) that hangs inside its step stops
+/// the run within the stall timeout, named.
+#[test]
+fn a_python_component_that_hangs_in_its_step_is_named() {
+    let s = Scratch::new("python-hang");
+    std::fs::write(
+        s.join("hang.py"),
+        "import time\nimport uio_component\n\ndef step(k, inputs):\n    if k == 100:\n        time.sleep(3600)\n    return inputs[0][:3]\n\nuio_component.run(step)\n",
+    )
+    .unwrap();
+    let path = with_bad_observer(&s, 600, r#"["python3", "hang.py"]"#, "{}");
+    let (code, err, took) = run_checked(&s, &path);
+    assert_eq!(code, Some(3), "{err}");
+    assert!(err.contains("observer 'bad' (pid") && err.contains("published no sample for step 100"), "{err}");
+    assert!(took < Duration::from_secs(12), "took {took:?}");
+}
