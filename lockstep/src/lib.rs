@@ -35,6 +35,7 @@ mod port;
 mod quiet;
 mod run;
 mod sample;
+pub mod settings;
 pub mod service;
 mod wait;
 

@@ -18,13 +18,8 @@ use crate::run::RunSpace;
 use crate::sample::{Header, WireHeader, PROTOCOL_VERSION};
 use crate::wait::Wait;
 
-/// Buffer of the recorder's subscribers: how many steps the launcher may lag behind.
-pub const RECORDER_BUFFER: usize = 4096;
-/// Buffer of the lockstep subscribers: a follower (an observer off the critical path) may be up
-/// to [`FOLLOWER_LAG`] steps behind, so its input and its acknowledgements queue that deep.
-const LOCKSTEP_BUFFER: usize = FOLLOWER_LAG as usize + 2;
-/// How many steps an observer the controller does not read may trail the plant.
-pub const FOLLOWER_LAG: u64 = 4096;
+pub use crate::settings::{FOLLOWER_LAG, RECORDER_BUFFER};
+use crate::settings::*;
 
 /// A process's node on the run's bus.
 pub struct Bus {
@@ -52,11 +47,11 @@ impl Bus {
             .service_builder(&ServiceName::new(topic).map_err(LockstepError::ipc)?)
             .publish_subscribe::<[f64]>()
             .user_header::<WireHeader>()
-            .max_publishers(1)
-            .max_subscribers(8)
-            .max_nodes(16)
-            .history_size(0)
-            .subscriber_max_buffer_size(RECORDER_BUFFER.max(LOCKSTEP_BUFFER))
+            .max_publishers(MAX_PUBLISHERS)
+            .max_subscribers(MAX_SUBSCRIBERS)
+            .max_nodes(MAX_NODES)
+            .history_size(HISTORY)
+            .subscriber_max_buffer_size(SUBSCRIBER_MAX_BUFFER)
             .enable_safe_overflow(false)
             .open_or_create()
             .map_err(LockstepError::ipc)
@@ -66,9 +61,9 @@ impl Bus {
         self.node
             .service_builder(&ServiceName::new(&format!("{topic}/wake")).map_err(LockstepError::ipc)?)
             .event()
-            .max_notifiers(1)
-            .max_listeners(8)
-            .max_nodes(16)
+            .max_notifiers(MAX_NOTIFIERS)
+            .max_listeners(MAX_LISTENERS)
+            .max_nodes(MAX_NODES)
             .open_or_create()
             .map_err(LockstepError::ipc)
     }

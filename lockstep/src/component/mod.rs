@@ -69,10 +69,10 @@ impl StepError {
 /// Reads the configuration a launched component was given (`$UIO_CONFIG`), refusing one of
 /// another protocol version.
 pub fn read_config() -> Result<ComponentConfig, String> {
-    if let Ok(v) = std::env::var("UIO_PROTOCOL")
-        && v.trim() != PROTOCOL_VERSION.to_string()
-    {
-        return Err(format!("the run speaks protocol version {v}, this component {PROTOCOL_VERSION}"));
+    match std::env::var("UIO_PROTOCOL") {
+        Ok(v) if v.trim() == PROTOCOL_VERSION.to_string() => {}
+        Ok(v) => return Err(format!("the run speaks protocol version {v}, this component {PROTOCOL_VERSION}")),
+        Err(_) => return Err("UIO_PROTOCOL is not set: components are started by the launcher".into()),
     }
     let path = std::env::var_os("UIO_CONFIG").ok_or("UIO_CONFIG is not set")?;
     let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.to_string_lossy()))?;
