@@ -49,20 +49,7 @@ fn sinusoidal_disturbance_matches_scipy() {
 /// lands on x(t) = 1 − e^{−(t − t_b)} exactly.
 #[test]
 fn switching_inside_a_step_is_integrated_exactly() {
-    let cfg = PlantConfig {
-        a: md(1, 1, &[-1.0]),
-        b: md(1, 1, &[0.0]),
-        c: md(1, 1, &[1.0]),
-        e: md(1, 1, &[1.0]),
-        d: md(1, 0, &[]),
-        x0: vec![0.0],
-        disturbances: vec![Signal::Piecewise { times: vec![0.0, 1.5e-3, 2.7e-3], values: vec![0.0, 1.0, -2.0] }],
-        measurement_disturbances: vec![],
-        inputs: vec![Signal::Constant { value: 0.0 }],
-        dt: 1e-3,
-        steps: 10,
-        state_bound: 1e9,
-    };
+    let cfg = scalar(Signal::Piecewise { times: vec![0.0, 1.5e-3, 2.7e-3], values: vec![0.0, 1.0, -2.0] }, 10);
     let mut plant = Plant::new(&cfg).unwrap();
     let exact = |t: f64| {
         let x_at = 1.0 - (-(2.7e-3f64 - 1.5e-3)).exp();
@@ -112,22 +99,27 @@ fn divergence_names_the_state_and_step() {
     assert!(err.to_string().contains("step 2"), "{err}");
 }
 
-/// ẋ = −x + w, x(0) = 0, w a step 0 → 1 at `time`, dt = 1 ms, run to sample 5001.
-fn scalar_step_plant(time: f64) -> (Vec<f64>, Vec<f64>) {
-    let cfg = PlantConfig {
+/// ẋ = −x + w, y = x, x(0) = 0, dt = 1 ms, for `steps` steps.
+fn scalar(w: Signal, steps: u64) -> PlantConfig {
+    PlantConfig {
         a: md(1, 1, &[-1.0]),
         b: md(1, 1, &[0.0]),
         c: md(1, 1, &[1.0]),
         e: md(1, 1, &[1.0]),
         d: md(1, 0, &[]),
         x0: vec![0.0],
-        disturbances: vec![Signal::Step { time, before: 0.0, after: 1.0 }],
+        disturbances: vec![w],
         measurement_disturbances: vec![],
         inputs: vec![Signal::Constant { value: 0.0 }],
         dt: 1e-3,
-        steps: 5002,
+        steps,
         state_bound: 1e9,
-    };
+    }
+}
+
+/// [`scalar`] with w a step 0 → 1 at `time`, run to sample 5001.
+fn scalar_step_plant(time: f64) -> (Vec<f64>, Vec<f64>) {
+    let cfg = scalar(Signal::Step { time, before: 0.0, after: 1.0 }, 5002);
     let mut plant = Plant::new(&cfg).unwrap();
     let w_at = plant.layout().w().start;
     let (mut x, mut w) = (Vec::new(), Vec::new());
