@@ -7,7 +7,7 @@ use scenario::quoted;
 
 /// A compiled set of entity globs; an entity matches when any pattern matches it.
 #[derive(Debug, Clone)]
-pub struct Globs(GlobSet);
+pub struct Globs(GlobSet, Vec<String>);
 
 impl Globs {
     /// Compiles `patterns`; an error quotes the pattern that is not a glob and says why.
@@ -17,7 +17,18 @@ impl Globs {
             let rooted = if p.starts_with('/') { p.clone() } else { format!("/{p}") };
             set.add(GlobBuilder::new(&rooted).literal_separator(true).build().map_err(|e| format!("{}: {}", quoted(p), e.kind()))?);
         }
-        set.build().map(Globs).map_err(|e| e.to_string())
+        set.build().map(|g| Globs(g, patterns.to_vec())).map_err(|e| e.to_string())
+    }
+
+    /// The patterns that match none of `paths` (a typo, most likely: worth a warning).
+    pub fn unmatched<'a>(&self, paths: impl IntoIterator<Item = &'a str>) -> Vec<String> {
+        let mut hit = vec![false; self.1.len()];
+        for p in paths {
+            for i in self.0.matches(p) {
+                hit[i] = true;
+            }
+        }
+        self.1.iter().zip(hit).filter(|(_, h)| !h).map(|(p, _)| p.clone()).collect()
     }
 
     /// Whether the entity at `path` matches any pattern.
@@ -40,5 +51,6 @@ mod tests {
         let two = Globs::new(&["/plant/x/*".into(), "/plant/y/*".into()]).unwrap();
         assert!(two.matches("/plant/x/2") && two.matches("/plant/y/1") && !two.matches("/input/1"));
         assert!(Globs::new(&["/plant/[x".into()]).unwrap_err().starts_with("'/plant/[x': "));
+        assert_eq!(two.unmatched(["/plant/x/1", "/input/1"]), ["/plant/y/*"]);
     }
 }

@@ -162,6 +162,11 @@ fn recording_can_be_thinned_and_restricted() {
     assert_eq!(r.series.keys().collect::<Vec<_>>(), wanted);
     assert_eq!(r.series.keys().filter(|k| k.starts_with("/plant/x/")).count(), 3);
     assert_eq!(sum(&some)["observers"], sa["observers"]);
+    assert!(!text(&out).1.contains("matches no signal"), "{:?}", text(&out));
+
+    // A glob that selects nothing (a typo) is warned of.
+    let out = launcher(&s).arg("run").arg(scenario(name)).args(["--mode", "in-process", "--record", "/plant/z/*", "--out"]).arg(s.join("none")).output().unwrap();
+    assert!(out.status.success() && text(&out).1.contains("warning: --record '/plant/z/*': matches no signal"), "{:?}", text(&out));
 
     // A bad glob and a zero step are bad input, before any output.
     for (args, what) in [(["--record", "/plant/[x"], "/plant/[x"), (["--record-every", "0"], "record-every")] {

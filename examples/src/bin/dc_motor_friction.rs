@@ -72,18 +72,18 @@ impl FrictionMotor {
         let n = self.x.len();
         let (m, s, p, u) = (&self.m, &self.s, &self.p, &self.u);
         let [k1, k2, k3, k4] = &mut self.k;
+        // tmp = x + c·k, the point each next stage is evaluated at.
+        let stage = |tmp: &mut [f64], x: &[f64], c: f64, k: &[f64]| {
+            for ((t, xi), ki) in tmp.iter_mut().zip(x).zip(k) {
+                *t = xi + c * ki;
+            }
+        };
         Self::f(m, s, p, t, &self.x, u, k1);
-        for i in 0..n {
-            self.tmp[i] = self.x[i] + 0.5 * h * k1[i];
-        }
+        stage(&mut self.tmp, &self.x, 0.5 * h, k1);
         Self::f(m, s, p, t + 0.5 * h, &self.tmp, u, k2);
-        for i in 0..n {
-            self.tmp[i] = self.x[i] + 0.5 * h * k2[i];
-        }
+        stage(&mut self.tmp, &self.x, 0.5 * h, k2);
         Self::f(m, s, p, t + 0.5 * h, &self.tmp, u, k3);
-        for i in 0..n {
-            self.tmp[i] = self.x[i] + h * k3[i];
-        }
+        stage(&mut self.tmp, &self.x, h, k3);
         Self::f(m, s, p, t + h, &self.tmp, u, k4);
         for i in 0..n {
             self.x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);

@@ -91,8 +91,10 @@ impl Session {
                 let (signals, hops_now, hops_late) = (sink.group(), sink.group(), sink.group());
                 let names = &s.names;
                 let observer_names: Vec<String> = s.observers.iter().map(|o| o.name.clone()).collect();
+                let mut paths: Vec<String> = Vec::new();
                 // Colours and widths by the palette's rule, which the PNG plots follow too.
                 let mut series = |g: usize, path: String, legend: String| {
+                    paths.push(path.clone());
                     let line = palette::line(&path, &observer_names);
                     sink.series(g, &path, &legend, line.color, palette::viewer_width(&path, &observer_names))
                 };
@@ -126,6 +128,9 @@ impl Session {
                     .enumerate()
                     .map(|(i, h)| series(if late && i == hops.len() - 1 { hops_late } else { hops_now }, hop_entity(h), h.clone()))
                     .collect();
+                for p in select.unmatched(paths.iter().map(String::as_str)) {
+                    eprintln!("warning: --record {}: matches no signal of this run, so records nothing", scenario::quoted(&p));
+                }
                 Some((sink, Channels { signals, hops_now, hops_late, x, y, w, v, r, u, observers, step_latency, hops: hop_ids }))
             }
             None => None,

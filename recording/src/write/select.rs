@@ -40,6 +40,11 @@ impl Selection {
         self.every == 1 || k.is_multiple_of(self.every)
     }
 
+    /// The `--record` patterns that select none of `paths`.
+    pub fn unmatched<'a>(&self, paths: impl IntoIterator<Item = &'a str>) -> Vec<String> {
+        self.globs.as_ref().map_or_else(Vec::new, |g| g.unmatched(paths))
+    }
+
     /// Whether entity `path` is recorded.
     pub fn entity(&self, path: &str) -> bool {
         self.globs.as_ref().is_none_or(|g| g.matches(path))
