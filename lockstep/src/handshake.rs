@@ -1,7 +1,8 @@
 //! How a component process is started and synchronised by the launcher.
 //!
-//! The launcher starts each component with `--run <id> --name <name> --wait <strategy>` (or the
-//! same in `UIO_RUN`, `UIO_NAME` and the configuration, PROTOCOL.md §1), its stdin and stdout piped. The component reads its configuration from the run directory, creates
+//! The launcher starts each component with `UIO_RUN`, `UIO_NAME` and the rest of PROTOCOL.md §1
+//! in its environment (our built-in components also get `--run <id> --name <name> --wait
+//! <strategy>`), its stdin and stdout piped. The component reads its configuration from the run directory, creates
 //! all its ports, writes `ready` on stdout, and starts stepping only when it reads `go` on stdin:
 //! by then every subscriber of the run exists, so no first sample is lost. If the launcher dies,
 //! the kernel kills the component (PR_SET_PDEATHSIG).

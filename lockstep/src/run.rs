@@ -29,8 +29,11 @@ pub struct RunSpace {
     config: Config,
 }
 
+/// Where run directories live, made absolute: components run in other working directories (an
+/// external one in its scenario's folder) and are handed these paths.
 fn runs_dir() -> PathBuf {
-    std::env::var_os(RUNS_DIR_ENV).map_or_else(|| PathBuf::from("/tmp/uio-observers"), PathBuf::from)
+    let dir = std::env::var_os(RUNS_DIR_ENV).map_or_else(|| PathBuf::from("/tmp/uio-observers"), PathBuf::from);
+    std::path::absolute(&dir).unwrap_or(dir)
 }
 
 fn io(what: &str, path: &Path, e: std::io::Error) -> LockstepError {

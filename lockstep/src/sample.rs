@@ -22,8 +22,8 @@ pub struct WireHeader {
     pub sim_time: f64,
     /// CLOCK_MONOTONIC at which the publisher sent the sample, ns.
     pub sent_ns: u64,
-    /// CLOCK_MONOTONIC at which the publisher took the input that completed this step, ns
-    /// (0 when there was none).
+    /// CLOCK_MONOTONIC at which the publisher took the last exact input of this step, ns; with
+    /// none, when it took its inputs; 0 at the plant's k = 0.
     pub taken_ns: u64,
     /// [`PROTOCOL_VERSION`].
     pub protocol: u32,

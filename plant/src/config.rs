@@ -33,14 +33,13 @@ pub struct PlantConfig {
     pub state_bound: f64,
 }
 
-/// The plant process's configuration: the model plus who it exchanges samples with.
+/// The plant of a run as the launcher plans it: its configuration (the built-in plant's
+/// `params`) and the shape of the ring around it, which places the processes on CPUs.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PlantRun {
     /// The plant itself.
     pub plant: PlantConfig,
-    /// Names of the observers whose estimates complete each step.
-    pub observers: Vec<String>,
-    /// Which of them may trail the plant (followers, see [`lockstep::FOLLOWER_LAG`]).
+    /// Per observer, whether it may trail the plant (a follower, see [`lockstep::FOLLOWER_LAG`]).
     pub followers: Vec<bool>,
     /// Whether a controller provides u (else u = the input signals).
     pub controller: bool,

@@ -9,7 +9,7 @@ A component is a step function and one call::
         return {"gain": config.params.get("gain", 1.0)}
 
     def step(k, inputs, state):        # inputs: one numpy array per `reads` entry
-        return state["gain"] * inputs[0]   # the `publishes.len` values of sample k
+        return state["gain"] * inputs[0][:3]   # the `publishes.len` (here 3) values of sample k
 
     if __name__ == "__main__":
         run(step, setup)

@@ -102,6 +102,9 @@ class Stepper:
             raise ComponentExit(EXIT_DIVERGED, f"step {k}: diverged: {e}") from None
         except ComponentExit:
             raise
+        except SystemExit as e:
+            # sys.exit() inside a step would end the process with status 0 before the run's end.
+            raise ComponentExit(EXIT_FAILED, f"step {k}: the step called sys.exit({e.code!r})") from None
         except Exception as e:  # noqa: BLE001 — any failure of the user's code ends the run
             if os.environ.get("UIO_TRACEBACK"):
                 traceback.print_exc()
@@ -133,8 +136,9 @@ class Stepper:
             taken, sim_time = (0, 0.0) if k == 0 else (self._transport(k, self.take, k - 1), k * dt)
         else:
             taken = self._transport(k, self.take, k)
-            first = self.headers[0] if self.headers else None
-            sim_time = first.sim_time if first is not None else k * dt
+            # t_k as the first exact (lag 0) input carries it; k·dt with none.
+            exact = [h for h, lag in zip(self.headers, self.lags) if lag == 0]
+            sim_time = exact[0].sim_time if exact and exact[0] is not None else k * dt
         out = self.call(k)
         self._transport(k, self.outlet.send, k, sim_time, taken, out)
 

@@ -59,10 +59,18 @@ impl Drop for Scratch {
     }
 }
 
-/// A launcher command whose runs live in `scratch`.
+/// A launcher command whose runs live in `scratch`. The Python environment that
+/// `scripts/test.sh` makes (`.venv/`, with the Python kit) comes first in its `PATH`, so the
+/// Python components' `python3` finds the kit under plain `cargo test` too.
 pub fn launcher(scratch: &Scratch) -> Command {
     let mut c = Command::new(bin_dir().join("launcher"));
     c.env(lockstep_runs_env(), scratch.runs()).current_dir(&scratch.0);
+    let venv = std::env::var_os("UIO_VENV").map_or_else(|| repo().join(".venv"), std::path::PathBuf::from).join("bin");
+    if venv.is_dir() {
+        let path = std::env::var_os("PATH").unwrap_or_default();
+        let joined = std::env::join_paths(std::iter::once(venv).chain(std::env::split_paths(&path))).expect("PATH entries");
+        c.env("PATH", joined);
+    }
     c
 }
 
@@ -95,16 +103,17 @@ pub fn shm_of(pid: u32) -> Vec<String> {
         .unwrap_or_default()
 }
 
-/// Processes whose command line names a run of launcher `pid`.
+/// Processes of a run of launcher `pid`: our components (their command line names the run) and
+/// external ones and whatever they started (their environment holds `UIO_RUN=<run>`, inherited
+/// by their children).
 pub fn processes_of(pid: u32) -> Vec<String> {
-    let needle = format!("--run\0{pid}x");
+    let (arg, env) = (format!("--run\0{pid}x"), format!("UIO_RUN={pid}x"));
     let mut found = Vec::new();
     for e in std::fs::read_dir("/proc").into_iter().flatten().flatten() {
-        if let Ok(cmd) = std::fs::read(e.path().join("cmdline")) {
-            let cmd = String::from_utf8_lossy(&cmd);
-            if cmd.contains(&needle) {
-                found.push(format!("{}: {}", e.file_name().to_string_lossy(), cmd.replace('\0', " ")));
-            }
+        let cmd = std::fs::read(e.path().join("cmdline")).map(|c| String::from_utf8_lossy(&c).into_owned()).unwrap_or_default();
+        let environ = std::fs::read(e.path().join("environ")).map(|c| String::from_utf8_lossy(&c).into_owned()).unwrap_or_default();
+        if cmd.contains(&arg) || environ.split('\0').any(|v| v.starts_with(&env)) {
+            found.push(format!("{}: {}", e.file_name().to_string_lossy(), cmd.replace('\0', " ")));
         }
     }
     found

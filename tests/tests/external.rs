@@ -29,12 +29,15 @@ fn run_checked(s: &Scratch, path: &std::path::Path) -> (Option<i32>, String, Dur
 
 #[test]
 fn a_component_that_breaks_the_protocol_is_named_and_nothing_is_left() {
-    let cases: [(&str, &[&str]); 7] = [
+    let cases: [(&str, &[&str]); 10] = [
         ("nan", &["observer 'bad' broke the protocol at step 100", "is NaN"]),
         ("wrong_step", &["observer 'bad' broke the protocol at step 100", "of step 101"]),
         ("wrong_len", &["observer 'bad' broke the protocol at step 0", "4 values", "says 3"]),
         ("protocol", &["observer 'bad' broke the protocol at step 100", "protocol version 2"]),
         ("exit", &["observer 'bad' (pid", "exited with status 7"]),
+        ("exit0", &["observer 'bad' (pid", "exited with status 0 before the end of the run", "its last sample: of step 99"]),
+        ("orphan", &["observer 'bad' (pid", "exited with status 7"]),
+        ("no_read", &["observer 'bad' broke the protocol at step", "does not read its input"]),
         ("kill", &["observer 'bad' (pid", "SIGKILL"]),
         ("refuse_version", &["observer 'bad' (pid", "before the run began", "protocol version 1, this component 2"]),
     ];
@@ -125,4 +128,31 @@ fn a_python_component_that_hangs_in_its_step_is_named() {
     assert_eq!(code, Some(3), "{err}");
     assert!(err.contains("observer 'bad' (pid") && err.contains("published no sample for step 100"), "{err}");
     assert!(took < Duration::from_secs(12), "took {took:?}");
+}
+
+/// The kit's own version check: a component told the run speaks another protocol version
+/// refuses to start (exit 2, one line), and the launcher names it.
+#[test]
+fn the_kit_refuses_another_protocol_version() {
+    let s = Scratch::new("kit-version");
+    let text = std::fs::read_to_string(scenario("seed002-sine")).unwrap();
+    let plant = bin_dir().join("linear_plant");
+    let process = format!("\n[plant.process]\ncommand = [\"env\", \"UIO_PROTOCOL=2\", {:?}]\n", plant.display().to_string());
+    let text = text.replacen("x0 = [1.0, -1.0, 2.0]\n", &format!("x0 = [1.0, -1.0, 2.0]\n{process}"), 1);
+    let path = s.join("version.toml");
+    std::fs::write(&path, text).unwrap();
+    let (code, err, _) = run_checked(&s, &path);
+    assert_eq!(code, Some(3), "{err}");
+    assert!(err.contains("plant (pid") && err.contains("exited with status 2") && err.contains("before the run began") && err.contains("protocol version 2, this component 1"), "{err}");
+}
+
+/// A plant's params that JSON cannot carry are refused with the key named.
+#[test]
+fn params_must_be_representable_in_json() {
+    let s = Scratch::new("params-json");
+    let path = with_bad_observer(&s, 10, r#"["faulty_observer"]"#, "{ fault = \"nan\", gain = nan }");
+    let out = launcher(&s).arg("run").arg(&path).output().unwrap();
+    let (_, err) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("observer[3].params.gain") && err.contains("not a finite number"), "{err}");
 }

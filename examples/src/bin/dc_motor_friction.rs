@@ -6,7 +6,8 @@
 //! ```
 //!
 //! x = [i, ω, θ], integrated with classical Runge–Kutta (`substeps` per sample, u held over the
-//! step, w evaluated at each stage). Its linearisation about rest without friction is the
+//! step; w's piecewise-constant part held at its value of the step's sample — switching on the
+//! samples as the published w does — and its sine part evaluated at each stage). Its linearisation about rest without friction is the
 //! scenario's `[plant]`. The friction torque enters exactly where the unknown load torque does
 //! (the column E), so an unknown-input observer designed on the linear model rejects it as it
 //! rejects the load, while a Luenberger observer sees a model error.
@@ -46,11 +47,15 @@ struct FrictionMotor {
     /// Scratch for the Runge–Kutta stages (no allocation per step).
     k: [Vec<f64>; 4],
     tmp: Vec<f64>,
+    /// The piecewise-constant part of each w over the current step.
+    held: Vec<f64>,
 }
 
 impl FrictionMotor {
-    /// ẋ at (t, x) with u held: A x + B u + E (w(t) + τ_f(ω)) — ω is x[1].
-    fn f(m: &DesignModel, s: &Signals, p: &Params, t: f64, x: &[f64], u: &[f64], out: &mut [f64]) {
+    /// ẋ at (t, x) with u held: A x + B u + E (w(t) + τ_f(ω)) — ω is x[1]; `held` is the
+    /// piecewise-constant part of each w over this step.
+    #[allow(clippy::too_many_arguments)]
+    fn f(m: &DesignModel, s: &Signals, p: &Params, t: f64, x: &[f64], u: &[f64], held: &[f64], out: &mut [f64]) {
         let friction = p.coulomb * (x[1] / p.stribeck_speed).tanh();
         for (i, o) in out.iter_mut().enumerate() {
             let mut v = 0.0;
@@ -61,7 +66,8 @@ impl FrictionMotor {
                 v += m.b[(i, j)] * uj;
             }
             for (j, w) in s.disturbances.iter().enumerate() {
-                v += m.e[(i, j)] * (w.value(t) + if j == 0 { friction } else { 0.0 });
+                let sine = w.sine().map_or(0.0, |(a, om, ph)| a * (om * t + ph).sin());
+                v += m.e[(i, j)] * (held[j] + sine + if j == 0 { friction } else { 0.0 });
             }
             *o = v;
         }
@@ -70,7 +76,7 @@ impl FrictionMotor {
     /// x(t + h) by one Runge–Kutta step.
     fn rk4(&mut self, t: f64, h: f64) {
         let n = self.x.len();
-        let (m, s, p, u) = (&self.m, &self.s, &self.p, &self.u);
+        let (m, s, p, u, held) = (&self.m, &self.s, &self.p, &self.u, &self.held);
         let [k1, k2, k3, k4] = &mut self.k;
         // tmp = x + c·k, the point each next stage is evaluated at.
         let stage = |tmp: &mut [f64], x: &[f64], c: f64, k: &[f64]| {
@@ -78,13 +84,13 @@ impl FrictionMotor {
                 *t = xi + c * ki;
             }
         };
-        Self::f(m, s, p, t, &self.x, u, k1);
+        Self::f(m, s, p, t, &self.x, u, held, k1);
         stage(&mut self.tmp, &self.x, 0.5 * h, k1);
-        Self::f(m, s, p, t + 0.5 * h, &self.tmp, u, k2);
+        Self::f(m, s, p, t + 0.5 * h, &self.tmp, u, held, k2);
         stage(&mut self.tmp, &self.x, 0.5 * h, k2);
-        Self::f(m, s, p, t + 0.5 * h, &self.tmp, u, k3);
+        Self::f(m, s, p, t + 0.5 * h, &self.tmp, u, held, k3);
         stage(&mut self.tmp, &self.x, h, k3);
-        Self::f(m, s, p, t + h, &self.tmp, u, k4);
+        Self::f(m, s, p, t + h, &self.tmp, u, held, k4);
         for i in 0..n {
             self.x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
         }
@@ -98,7 +104,7 @@ fn mul(m: &Mat, x: &[f64], i: usize) -> f64 {
 impl Component for FrictionMotor {
     fn new(cfg: &ComponentConfig) -> Result<Self, String> {
         let (m, s) = (DesignModel::of(cfg)?, Signals::of(cfg)?);
-        let p: Params = if cfg.params.as_object().is_some_and(|o| o.is_empty()) { Params::default() } else { cfg.params()? };
+        let p: Params = cfg.params()?;
         let lay = m.layout();
         if lay.n != 3 || lay.q < 1 {
             return Err(format!("this plant is x = [i, ω, θ] with the load torque as the first unknown input; the scenario has n = {}, q = {}", lay.n, lay.q));
@@ -107,7 +113,8 @@ impl Component for FrictionMotor {
             return Err("params: stribeck_speed must be > 0, substeps ≥ 1, coulomb finite".into());
         }
         let x = m.x0.clone();
-        Ok(FrictionMotor { lay, dt: cfg.dt, controller: cfg.read_index("controller"), u: vec![0.0; lay.l], k: std::array::from_fn(|_| vec![0.0; 3]), tmp: vec![0.0; 3], x, m, s, p })
+        let held = vec![0.0; lay.q];
+        Ok(FrictionMotor { held, lay, dt: cfg.dt, controller: cfg.read_index("controller"), u: vec![0.0; lay.l], k: std::array::from_fn(|_| vec![0.0; 3]), tmp: vec![0.0; 3], x, m, s, p })
     }
 
     fn step(&mut self, k: u64, inputs: &Inputs, out: &mut [f64]) -> Result<(), StepError> {
@@ -120,12 +127,16 @@ impl Component for FrictionMotor {
                     }
                 }
             }
+            for (c, w) in self.held.iter_mut().zip(&self.s.disturbances) {
+                let sine = w.sine().map_or(0.0, |(a, om, ph)| a * (om * (k - 1) as f64 * self.dt + ph).sin());
+                *c = w.sample_step(k - 1, self.dt) - sine;
+            }
             let h = self.dt / self.p.substeps as f64;
             for j in 0..self.p.substeps {
                 self.rk4((k - 1) as f64 * self.dt + j as f64 * h, h);
             }
             if let Some(i) = self.x.iter().position(|v| !v.is_finite() || v.abs() > self.s.state_bound) {
-                return Err(StepError { code: 4, message: format!("diverged: x{} = {} at step {k}", i + 1, self.x[i]) });
+                return Err(StepError { code: plant::shell::EXIT_DIVERGED, message: format!("diverged: x{} = {} at step {k}", i + 1, self.x[i]) });
             }
         }
         let (lay, dt) = (self.lay, self.dt);

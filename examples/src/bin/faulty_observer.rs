@@ -4,9 +4,12 @@
 //!
 //! `params.fault`, from step `params.at` (default 100) on: `nan` (a value is NaN), `wrong_step`
 //! (the sample carries step k + 1), `wrong_len` (one value too many), `protocol` (the header says
-//! version 2), `hang` (stops publishing and sleeps), `exit` (exits with status 7), `kill` (dies
-//! by SIGKILL), `never_ready` (never writes `ready`), `refuse_version` (refuses the run's
-//! protocol version at start, as a component of another version must). Until then it publishes
+//! version 2), `hang` (stops publishing and sleeps), `exit` (exits with status 7), `exit0` (exits
+//! with status 0, before the run's end), `orphan` (starts a child process, then exits with status
+//! 7: the child must not outlive the run), `kill` (dies by SIGKILL), `no_read` (publishes every
+//! step at once, without reading the plant's samples), `never_ready` (never writes `ready`),
+//! `refuse_version` (refuses the run's protocol version at start, as a component of another
+//! version must). Until then it publishes
 //! y's first n values padded with zeros — a poor estimate, but a well-formed one.
 
 use std::process::ExitCode;
@@ -70,6 +73,20 @@ fn main() -> ExitCode {
     if let Err(e) = ready_then_wait_for_go() {
         return fail(e.to_string());
     }
+    if p.fault == "orphan" {
+        // A child in the component's process group, which the launcher must kill with it.
+        let _ = std::process::Command::new("sleep").arg("600").spawn();
+    }
+    if p.fault == "no_read" {
+        let out = vec![0.0; out_len];
+        for k in 0..cfg.steps {
+            let header = WireHeader { step: k, sim_time: k as f64 * cfg.dt, sent_ns: 0, taken_ns: lockstep::now_ns(), protocol: PROTOCOL_VERSION, reserved: 0 };
+            if let Err(e) = outlet.send_header(header, &out) {
+                return fail(e.to_string());
+            }
+        }
+        return ExitCode::SUCCESS;
+    }
     let (mut sample, mut out) = (vec![0.0; plant_len], vec![0.0; out_len]);
     let y0 = cfg.reads[0].fields.get("y").map_or(0, |r| r[0]);
     for k in 0..cfg.steps {
@@ -89,7 +106,8 @@ fn main() -> ExitCode {
                 "hang" => loop {
                     std::thread::sleep(std::time::Duration::from_secs(60));
                 },
-                "exit" => return ExitCode::from(7),
+                "exit" | "orphan" => return ExitCode::from(7),
+                "exit0" => return ExitCode::SUCCESS,
                 // SAFETY: raise(3) with a valid signal number.
                 "kill" => unsafe {
                     libc::raise(libc::SIGKILL);

@@ -40,7 +40,7 @@ impl Component for LinearPlant {
                 Some(i) => self.u.copy_from_slice(inputs.get(i)),
                 None => self.u.copy_from_slice(self.plant.reference()),
             }
-            self.plant.advance(k - 1, &self.u).map_err(|d| StepError { code: 4, message: format!("diverged: {d}") })?;
+            self.plant.advance(k - 1, &self.u).map_err(|d| StepError { code: plant::shell::EXIT_DIVERGED, message: format!("diverged: {d}") })?;
         }
         out.copy_from_slice(self.plant.sample(k));
         Ok(())

@@ -52,7 +52,6 @@ pub fn configs(s: &Scenario, plan: &Plan) -> Configs {
             steps: s.steps,
             state_bound: s.state_bound,
         },
-        observers: s.observers.iter().map(|o| o.name.clone()).collect(),
         followers: s.observers.iter().map(|o| is_follower(s, &o.name)).collect(),
         controller: s.controller.is_some(),
     };

@@ -34,6 +34,8 @@ const STALL_TIMEOUT: Duration = Duration::from_secs(5);
 /// wake-up takes a core from it for a moment: drain rarely, in large batches. At the fastest
 /// step rate measured (~250k steps/s) 5 ms is ~1300 samples, well inside the recorder's buffer.
 const POLL: Duration = Duration::from_millis(5);
+/// How much of a component's stderr is kept for the message that quotes its last line.
+const STDERR_KEPT: usize = 4096;
 
 /// A started component.
 struct Proc {
@@ -89,11 +91,12 @@ fn signal_name(sig: i32) -> &'static str {
 /// Kills and reaps every child still running; safe to call twice.
 fn stop_all(procs: &mut [Proc]) {
     for p in procs.iter_mut() {
+        // The whole process group, also of a component that has exited already: an external
+        // command may have started children of its own (a shell script, an interpreter's
+        // workers) that outlive it. A group that is gone (ESRCH) is fine.
+        // SAFETY: kill(2) on the group this launcher created for the child (pgid = its pid).
+        unsafe { libc::kill(-(p.child.id() as i32), libc::SIGKILL) };
         if p.status.is_none() {
-            // The whole process group: an external command may have started children of its
-            // own (a shell script, an interpreter's workers).
-            // SAFETY: kill(2) on the group this launcher created for the child (pgid = its pid).
-            unsafe { libc::kill(-(p.child.id() as i32), libc::SIGKILL) };
             let _ = p.child.kill();
         }
     }
@@ -121,16 +124,19 @@ fn component_command(kind: &str) -> Command {
 /// An external command's program: a bare name (no `/`) of a program built beside the launcher —
 /// a kit component of this workspace — is that one; anything else as given (a bare name then
 /// goes through `PATH`, a relative path from the scenario's folder).
-fn program_path(program: &str) -> std::path::PathBuf {
-    if !program.contains('/')
-        && let Ok(exe) = std::env::current_exe()
-    {
-        let sibling = exe.with_file_name(program);
-        if sibling.is_file() {
-            return sibling;
+fn program_path(program: &str, workdir: &Path) -> std::path::PathBuf {
+    if !program.contains('/') {
+        if let Ok(exe) = std::env::current_exe() {
+            let sibling = exe.with_file_name(program);
+            if sibling.is_file() {
+                return sibling;
+            }
         }
+        return program.into();
     }
-    program.into()
+    // Relative to the scenario's folder, spelled out: how a relative program resolves together
+    // with a changed working directory is left to the platform.
+    workdir.join(program)
 }
 
 /// The CPUs this process may run on.
@@ -195,7 +201,7 @@ fn spawn(c: &Launchable, workdir: &Path, space: &RunSpace, cpu: Option<usize>, t
             cmd
         }
         Program::External(p) => {
-            let mut cmd = Command::new(program_path(&p.command[0]));
+            let mut cmd = Command::new(program_path(&p.command[0], workdir));
             cmd.args(&p.command[1..]).current_dir(workdir);
             cmd
         }
@@ -221,6 +227,10 @@ fn spawn(c: &Launchable, workdir: &Path, space: &RunSpace, cpu: Option<usize>, t
     }
     let mut child = cmd.spawn().map_err(|e| {
         let what = match &c.program {
+            Program::External(p) if !p.command[0].contains('/') && e.kind() == std::io::ErrorKind::NotFound => format!(
+                " ({}: neither beside the launcher nor in PATH; a kit component of this workspace is built with `cargo build --release --workspace`)",
+                scenario::untrusted::quoted(&p.command[0])
+            ),
             Program::External(p) => format!(" ({})", scenario::untrusted::quoted(&p.command[0])),
             Program::Builtin(_) => String::new(),
         };
@@ -229,11 +239,16 @@ fn spawn(c: &Launchable, workdir: &Path, space: &RunSpace, cpu: Option<usize>, t
     let out = child.stdout.take().expect("piped");
     let tx = tx.clone();
     std::thread::spawn(move || {
-        for line in BufReader::new(out).lines().map_while(Result::ok) {
-            if tx.send((index, line)).is_err() {
+        // Until `ready` the lines go to the handshake; after it a component's stdout is read
+        // and dropped, so a chatty component neither blocks on a full pipe nor fills memory.
+        let mut lines = BufReader::new(out).lines().map_while(Result::ok);
+        for line in lines.by_ref() {
+            let ready = line.trim() == "ready";
+            if tx.send((index, line)).is_err() || ready {
                 break;
             }
         }
+        lines.for_each(drop);
     });
     let mut err = child.stderr.take().expect("piped");
     let stderr = Arc::new(Mutex::new(String::new()));
@@ -246,6 +261,14 @@ fn spawn(c: &Launchable, workdir: &Path, space: &RunSpace, cpu: Option<usize>, t
             }
             if let Ok(mut s) = sink.lock() {
                 s.push_str(&String::from_utf8_lossy(&buf[..n]));
+                // Only the end is quoted in messages: keep the last few KiB.
+                if s.len() > 2 * STDERR_KEPT {
+                    let mut cut = s.len() - STDERR_KEPT;
+                    while !s.is_char_boundary(cut) {
+                        cut += 1;
+                    }
+                    s.drain(..cut);
+                }
             }
         }
     });
@@ -261,11 +284,13 @@ struct Queue {
     names: Vec<String>,
     items: VecDeque<(WireHeader, Vec<f64>)>,
     free: Vec<Vec<f64>>,
+    /// The highest step any of its samples carried.
+    last: Option<u64>,
 }
 
 impl Queue {
     fn new(c: &Launchable) -> Self {
-        Queue { label: c.label.clone(), names: c.config.publishes.names.clone(), items: VecDeque::new(), free: Vec::new() }
+        Queue { label: c.label.clone(), names: c.config.publishes.names.clone(), items: VecDeque::new(), free: Vec::new(), last: None }
     }
 
     fn is_empty(&self) -> bool {
@@ -274,12 +299,13 @@ impl Queue {
 
     /// Moves every pending sample of `reader` in; returns how many there were.
     fn drain(&mut self, reader: &Reader) -> Result<usize, LaunchError> {
-        let (items, free) = (&mut self.items, &mut self.free);
+        let (items, free, last) = (&mut self.items, &mut self.free, &mut self.last);
         reader
             .drain(|h, v| {
                 let mut buf = free.pop().unwrap_or_default();
                 buf.clear();
                 buf.extend_from_slice(v);
+                *last = Some(last.map_or(h.step, |l| l.max(h.step)));
                 items.push_back((*h, buf));
             })
             .map_err(|e| LaunchError::Component(format!("{}: {e}", self.label)))
@@ -307,6 +333,19 @@ impl Queue {
         self.free.push(values);
         Ok(Header::of(&h, 0))
     }
+
+    /// Checks that the sample of step k was made from its input's sample k: it cannot have taken
+    /// its input (`taken_ns`) before that input was sent. A component that publishes without
+    /// reading would otherwise go unnoticed until its full subscriber buffer blocks the plant.
+    fn made_after(&self, k: u64, own: &Header, input: &Header, input_label: &str) -> Result<(), LaunchError> {
+        if own.taken_ns < input.sent_ns {
+            return Err(LaunchError::Component(format!(
+                "{} broke the protocol at step {k}: it published the step before {input_label}'s sample {k} was sent (it does not read its input)",
+                self.label
+            )));
+        }
+        Ok(())
+    }
 }
 
 /// Per-component queues of received samples, assembled into rows in step order.
@@ -317,6 +356,10 @@ struct Assembly {
     next: u64,
     /// Steps K of the run: the plant's end sample (step K) is not a row.
     steps: u64,
+    /// Sample period: the recording's time is k·dt, whatever a plant's header says.
+    dt: f64,
+    /// Index of the observer the controller reads.
+    controller_observer: Option<usize>,
 }
 
 impl Assembly {
@@ -347,12 +390,16 @@ impl Assembly {
             let k = self.next;
             row.plant_hdr = self.plant.take(k, &mut row.plant)?;
             row.k = k;
-            row.t = row.plant_hdr.sim_time;
+            row.t = k as f64 * self.dt;
             for (i, q) in self.observers.iter_mut().enumerate() {
                 row.xhat_hdr[i] = q.take(k, &mut row.xhat[i])?;
+                q.made_after(k, &row.xhat_hdr[i], &row.plant_hdr, "the plant")?;
             }
             if let Some(q) = &mut self.controller {
                 row.u_hdr = q.take(k, &mut row.u)?;
+                if let Some(c) = self.controller_observer {
+                    q.made_after(k, &row.u_hdr, &row.xhat_hdr[c], &self.observers[c].label)?;
+                }
             }
             session.record(row)?;
             self.next += 1;
@@ -360,9 +407,33 @@ impl Assembly {
         }
     }
 
-    /// The plant's end sample (step K), if it has arrived once every step was assembled.
-    fn end(&self, steps: u64) -> Option<Header> {
-        self.plant.items.front().filter(|(h, _)| h.step == steps && h.protocol == PROTOCOL_VERSION).map(|(h, _)| Header::of(h, 0))
+    /// The plant's end sample (step K), checked like every other, once every step was assembled.
+    fn end(&mut self, row: &mut StepRow) -> Result<Option<Header>, LaunchError> {
+        if self.plant.is_empty() {
+            return Ok(None);
+        }
+        self.plant.take(self.steps, &mut row.plant).map(Some)
+    }
+
+    /// Whether component `i` (spawn order) has published its last sample: step K for the plant
+    /// (its end sample), K − 1 for the others.
+    fn published_all(&self, i: usize) -> bool {
+        let nobs = self.observers.len();
+        let (q, last) = match i {
+            0 => (&self.plant, self.steps),
+            i if i <= nobs => (&self.observers[i - 1], self.steps.saturating_sub(1)),
+            _ => (self.controller.as_ref().expect("a controller"), self.steps.saturating_sub(1)),
+        };
+        q.last.is_some_and(|l| l >= last)
+    }
+
+    fn queue(&self, i: usize) -> &Queue {
+        let nobs = self.observers.len();
+        match i {
+            0 => &self.plant,
+            i if i <= nobs => &self.observers[i - 1],
+            _ => self.controller.as_ref().expect("a controller"),
+        }
     }
 }
 
@@ -415,6 +486,7 @@ fn run_in(s: &Scenario, space: &RunSpace, cfg: &Configs, session: &mut Session, 
     let (plant_cpu, observer_cpus, controller_cpu) = placement(cfg, pin);
     let cpus: Vec<Option<usize>> = std::iter::once(plant_cpu).chain(observer_cpus).chain(s.controller.as_ref().map(|_| controller_cpu)).collect();
     let workdir = s.path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let workdir = &std::path::absolute(workdir).unwrap_or_else(|_| workdir.to_path_buf());
     let result = (|| {
         for (i, (c, &cpu)) in components.iter().zip(&cpus).enumerate() {
             procs.push(spawn(c, workdir, space, cpu, &tx, i)?);
@@ -427,6 +499,8 @@ fn run_in(s: &Scenario, space: &RunSpace, cfg: &Configs, session: &mut Session, 
             controller: components.get(1 + nobs).map(Queue::new),
             next: 0,
             steps: s.steps,
+            dt: s.dt,
+            controller_observer: s.controller.as_ref().and_then(|c| s.observers.iter().position(|o| o.name == c.observer)),
         };
         supervise(cfg, session, &mut procs, &r, &mut asm)
     })();
@@ -482,7 +556,7 @@ fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: 
         if asm.next == steps {
             // The plant's end sample (step K) closes the last step's timing; a plant that has
             // exited without one ends the run all the same.
-            if let Some(h) = asm.end(steps) {
+            if let Some(h) = asm.end(&mut row)? {
                 session.close_last(&h)?;
                 return Ok(Stop::Completed);
             }
@@ -500,15 +574,25 @@ fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: 
             }
             let Ok(Some(st)) = procs[i].child.try_wait() else { continue };
             procs[i].status = Some(st);
-            if st.success() {
+            // Status 0 is the end of its part only when it published all of it; collect what it
+            // published before it went (its last samples may still be on their way).
+            readers.drain_all(asm)?;
+            asm.assemble(&mut row, session)?;
+            if st.success() && asm.published_all(i) {
                 continue;
             }
-            // Collect what it published before it went, then stop the others.
             std::thread::sleep(Duration::from_millis(20));
-            let _ = readers.drain_all(asm);
+            readers.drain_all(asm)?;
             asm.assemble(&mut row, session)?;
+            if st.success() && asm.published_all(i) {
+                continue;
+            }
             stop_all(procs);
-            let what = procs[i].describe_exit();
+            let mut what = procs[i].describe_exit();
+            if st.success() {
+                let last = asm.queue(i).last.map_or("none".to_string(), |l| format!("of step {l}"));
+                what += &format!(" before the end of the run (its last sample: {last})");
+            }
             let last = if asm.next == 0 { "no step completed".to_string() } else { format!("last completed step {}", asm.next - 1) };
             if i == 0 && st.code() == Some(plant::shell::EXIT_DIVERGED) {
                 return Ok(Stop::Diverged(format!("{what} ({last})")));
@@ -519,10 +603,12 @@ fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: 
             return Ok(Stop::Failed(format!("every component finished but only {} of {steps} steps arrived", asm.next)));
         }
         if last_progress.elapsed() > STALL_TIMEOUT {
-            let who = asm.missing().map_or_else(|| "a component".to_string(), |i| procs[i].describe_stall());
+            let missing = asm.missing();
+            let who = missing.map_or_else(|| "a component".to_string(), |i| procs[i].describe_stall());
+            let hint = if missing == Some(0) { " (a plant blocked publishing to a component that stopped reading its samples shows as this too)" } else { "" };
             stop_all(procs);
             let last = if asm.next == 0 { "no step completed".to_string() } else { format!("last completed step {}", asm.next - 1) };
-            return Ok(Stop::Failed(format!("{who} published no sample for step {} within {} s; {last}", asm.next, STALL_TIMEOUT.as_secs())));
+            return Ok(Stop::Failed(format!("{who} published no sample for step {} within {} s; {last}{hint}", asm.next, STALL_TIMEOUT.as_secs())));
         }
         std::thread::sleep(POLL);
     }

@@ -59,8 +59,8 @@ pub struct ReadSpec {
     /// How many steps this input may trail (0: exactly the step's sample).
     #[serde(default)]
     pub lag: u64,
-    /// Poll with this sleep (µs) instead of the run's wait strategy (an input off the critical
-    /// path); not part of the protocol, a hint for our components.
+    /// Poll with this sleep (µs) instead of the run's wait strategy: a hint that the input is off
+    /// the critical path (PROTOCOL.md §3), which a component may ignore.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sleep_us: Option<u32>,
     /// Named ranges [start, end) of the values (the plant's sample layout).

@@ -122,6 +122,9 @@ fn live<C: Component>(launch: &crate::Launch, cfg: &ComponentConfig) -> Result<(
     let bus = Bus::join(&launch.run, &cfg.name, wait).map_err(StepError::transport)?;
     let mut runner = Runner::new(cfg, &bus, comp).map_err(StepError::transport)?;
     ready_then_wait_for_go().map_err(StepError::transport)?;
+    // stdout was the handshake's; from here on what a component prints goes to stderr.
+    // SAFETY: dup2 of the process's own standard descriptors.
+    unsafe { libc::dup2(libc::STDERR_FILENO, libc::STDOUT_FILENO) };
     for k in 0..cfg.steps {
         runner.step(k)?;
     }

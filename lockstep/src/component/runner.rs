@@ -103,7 +103,8 @@ impl<C: Component> Runner<C> {
             Role::Plant => (self.take(k - 1, false)?, k as f64 * self.dt),
             _ => {
                 let taken = self.take(k, false)?;
-                let t = self.inputs.headers.first().map_or(k as f64 * self.dt, |h| h.sim_time);
+                // t_k as the first exact input carries it; k·dt with none.
+                let t = self.lags.iter().position(|&l| l == 0).map_or(k as f64 * self.dt, |i| self.inputs.headers[i].sim_time);
                 (taken, t)
             }
         };
