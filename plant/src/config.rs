@@ -33,6 +33,59 @@ pub struct PlantConfig {
     pub state_bound: f64,
 }
 
+#[derive(Deserialize)]
+#[allow(non_snake_case)]
+struct ProtocolModel {
+    A: Vec<Vec<f64>>,
+    B: Vec<Vec<f64>>,
+    C: Vec<Vec<f64>>,
+    D: Vec<Vec<f64>>,
+    E: Vec<Vec<f64>>,
+    x0: Vec<f64>,
+}
+
+#[derive(Deserialize)]
+struct ProtocolSignals {
+    disturbances: Vec<Signal>,
+    measurement_disturbances: Vec<Signal>,
+    inputs: Vec<Signal>,
+    state_bound: f64,
+}
+
+/// Rows as a matrix of `nrows` rows (an empty matrix keeps its rows, PROTOCOL.md §3).
+fn rows(r: &[Vec<f64>], nrows: usize) -> MatData {
+    let cols = r.first().map_or(0, Vec::len);
+    MatData { rows: nrows, cols, data: r.iter().flat_map(|row| row.iter().copied()).collect() }
+}
+
+impl PlantConfig {
+    /// The plant a component's configuration describes, from the protocol's public fields
+    /// alone — `model`, `signals`, `dt`, `steps` (PROTOCOL.md §3) — as any plant must read it.
+    pub fn from_protocol(cfg: &lockstep::component::ComponentConfig) -> Result<Self, String> {
+        let m: ProtocolModel = serde_json::from_value(cfg.model.clone()).map_err(|e| format!("model: {e}"))?;
+        let s: ProtocolSignals = serde_json::from_value(cfg.signals.clone()).map_err(|e| format!("signals: {e}"))?;
+        let (n, p) = (m.A.len(), m.C.len());
+        let ragged = [&m.A, &m.B, &m.C, &m.D, &m.E].iter().any(|x| x.iter().any(|r| r.len() != x[0].len()));
+        if ragged || [&m.B, &m.E].iter().any(|x| x.len() != n) || m.D.len() != p || m.A.iter().chain(&m.C).any(|r| r.len() != n) {
+            return Err("model: the matrices do not conform".into());
+        }
+        Ok(PlantConfig {
+            a: rows(&m.A, n),
+            b: rows(&m.B, n),
+            c: rows(&m.C, p),
+            e: rows(&m.E, n),
+            d: rows(&m.D, p),
+            x0: m.x0,
+            disturbances: s.disturbances,
+            measurement_disturbances: s.measurement_disturbances,
+            inputs: s.inputs,
+            dt: cfg.dt,
+            steps: cfg.steps,
+            state_bound: s.state_bound,
+        })
+    }
+}
+
 /// The plant of a run as the launcher plans it: its configuration (the built-in plant's
 /// `params`) and the shape of the ring around it, which places the processes on CPUs.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

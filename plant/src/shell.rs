@@ -1,5 +1,6 @@
 //! The built-in plant as a component of the kit (`lockstep::component`): the exact linear plant
-//! of [`crate::Plant`], its configuration ([`PlantConfig`]) arriving as the component's `params`.
+//! of [`crate::Plant`], built from the protocol's public fields alone
+//! ([`PlantConfig::from_protocol`]), as an external plant would be.
 
 use lockstep::component::{Component, ComponentConfig, Inputs, StepError};
 
@@ -20,7 +21,7 @@ pub struct PlantComponent {
 
 impl Component for PlantComponent {
     fn new(cfg: &ComponentConfig) -> Result<Self, String> {
-        let pc: PlantConfig = cfg.params()?;
+        let pc = PlantConfig::from_protocol(cfg)?;
         let plant = Plant::new(&pc)?;
         let l = plant.layout().l;
         Ok(PlantComponent { plant, controller: cfg.read_index("controller"), u: vec![0.0; l] })

@@ -15,7 +15,7 @@
 //! `params`: `coulomb` (τ_c, in the units of w, default 0.02), `stribeck_speed` (ω_s, rad/s,
 //! default 0.05), `substeps` (default 10).
 
-use examples::{DesignModel, Signals};
+use plant::PlantConfig;
 use lockstep::component::{self, Component, ComponentConfig, Inputs, StepError};
 use lockstep::PlantLayout;
 use lti::Mat;
@@ -35,9 +35,19 @@ impl Default for Params {
     }
 }
 
+/// The design model's matrices, read through the protocol (`PlantConfig::from_protocol`).
+struct Mats {
+    a: Mat,
+    b: Mat,
+    c: Mat,
+    d: Mat,
+    e: Mat,
+}
+
 struct FrictionMotor {
-    m: DesignModel,
-    s: Signals,
+    m: Mats,
+    /// The scenario's signals and state bound (its matrices are in `m`).
+    s: PlantConfig,
     p: Params,
     lay: PlantLayout,
     dt: f64,
@@ -55,7 +65,7 @@ impl FrictionMotor {
     /// ẋ at (t, x) with u held: A x + B u + E (w(t) + τ_f(ω)) — ω is x[1]; `held` is the
     /// piecewise-constant part of each w over this step.
     #[allow(clippy::too_many_arguments)]
-    fn f(m: &DesignModel, s: &Signals, p: &Params, t: f64, x: &[f64], u: &[f64], held: &[f64], out: &mut [f64]) {
+    fn f(m: &Mats, s: &PlantConfig, p: &Params, t: f64, x: &[f64], u: &[f64], held: &[f64], out: &mut [f64]) {
         let friction = p.coulomb * (x[1] / p.stribeck_speed).tanh();
         for (i, o) in out.iter_mut().enumerate() {
             let mut v = 0.0;
@@ -103,16 +113,17 @@ fn mul(m: &Mat, x: &[f64], i: usize) -> f64 {
 
 impl Component for FrictionMotor {
     fn new(cfg: &ComponentConfig) -> Result<Self, String> {
-        let (m, s) = (DesignModel::of(cfg)?, Signals::of(cfg)?);
+        let s = PlantConfig::from_protocol(cfg)?;
+        let m = Mats { a: (&s.a).into(), b: (&s.b).into(), c: (&s.c).into(), d: (&s.d).into(), e: (&s.e).into() };
         let p: Params = cfg.params()?;
-        let lay = m.layout();
+        let lay = PlantLayout { n: m.a.nrows(), p: m.c.nrows(), q: m.e.ncols(), r: m.d.ncols(), l: m.b.ncols() };
         if lay.n != 3 || lay.q < 1 {
             return Err(format!("this plant is x = [i, ω, θ] with the load torque as the first unknown input; the scenario has n = {}, q = {}", lay.n, lay.q));
         }
         if !(p.stribeck_speed > 0.0 && p.substeps > 0 && p.coulomb.is_finite()) {
             return Err("params: stribeck_speed must be > 0, substeps ≥ 1, coulomb finite".into());
         }
-        let x = m.x0.clone();
+        let x = s.x0.clone();
         let held = vec![0.0; lay.q];
         Ok(FrictionMotor { held, lay, dt: cfg.dt, controller: cfg.read_index("controller"), u: vec![0.0; lay.l], k: std::array::from_fn(|_| vec![0.0; 3]), tmp: vec![0.0; 3], x, m, s, p })
     }

@@ -95,7 +95,8 @@ pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> V
     let publishes = PublishSpec { service: "plant".into(), len: lay.len(), names: sample_names };
     let (program, params) = match &s.plant_process {
         Some(p) => (Program::External(p.clone()), p.params.clone()),
-        None => (Program::Builtin("plant"), serde_json::to_value(&cfg.plant.plant).expect("serialises")),
+        // The built-in plant reads what every plant reads: `model` and `signals`.
+        None => (Program::Builtin("plant"), json!({})),
     };
     let mut plant = base("plant", Role::Plant, publishes, reads, params);
     plant.signals = json!({

@@ -1,0 +1,195 @@
+//! The launcher's side of the samples: a queue per component, checked against the protocol
+//! (PROTOCOL.md §6) as it is assembled into the rows of the recording, in step order.
+
+use std::collections::VecDeque;
+
+use lockstep::{Header, Reader, WireHeader, PROTOCOL_VERSION};
+
+use super::super::envelope::Launchable;
+use super::super::session::Session;
+use crate::error::LaunchError;
+use recording::write::StepRow;
+
+/// The samples received from one component, in order. Their value buffers are recycled, so
+/// once the queue has been as deep as it gets, receiving allocates nothing.
+pub(super) struct Queue {
+    /// How messages name the component.
+    label: String,
+    /// Names of its values (1-based), for messages.
+    names: Vec<String>,
+    items: VecDeque<(WireHeader, Vec<f64>)>,
+    free: Vec<Vec<f64>>,
+    /// The highest step any of its samples carried.
+    pub(super) last: Option<u64>,
+}
+
+impl Queue {
+    pub(super) fn new(c: &Launchable) -> Self {
+        Queue { label: c.label.clone(), names: c.config.publishes.names.clone(), items: VecDeque::new(), free: Vec::new(), last: None }
+    }
+
+    pub(super) fn is_empty(&self) -> bool {
+        self.items.is_empty()
+    }
+
+    /// Moves every pending sample of `reader` in; returns how many there were.
+    pub(super) fn drain(&mut self, reader: &Reader) -> Result<usize, LaunchError> {
+        let (items, free, last) = (&mut self.items, &mut self.free, &mut self.last);
+        reader
+            .drain(|h, v| {
+                let mut buf = free.pop().unwrap_or_default();
+                buf.clear();
+                buf.extend_from_slice(v);
+                *last = Some(last.map_or(h.step, |l| l.max(h.step)));
+                items.push_back((*h, buf));
+            })
+            .map_err(|e| LaunchError::Component(format!("{}: {e}", self.label)))
+    }
+
+    /// Takes the sample of step `k` into `out`, checking it against the protocol (PROTOCOL.md
+    /// §6): the step, the protocol version, the number of values, and that each is finite.
+    pub(super) fn take(&mut self, k: u64, out: &mut [f64]) -> Result<Header, LaunchError> {
+        let (h, values) = self.items.pop_front().expect("non-empty");
+        let broken = |why: String| LaunchError::Component(format!("{} broke the protocol at step {k}: {why}", self.label));
+        if h.protocol != PROTOCOL_VERSION {
+            return Err(broken(format!("its sample says protocol version {}, the run speaks {PROTOCOL_VERSION}", h.protocol)));
+        }
+        if h.step != k {
+            return Err(broken(format!("its sample is of step {}", h.step)));
+        }
+        if values.len() != out.len() {
+            return Err(broken(format!("its sample has {} values, the run's configuration says {}", values.len(), out.len())));
+        }
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            let name = self.names.get(i).map_or(String::new(), |n| format!(" ({})", scenario::untrusted::quoted(n)));
+            return Err(broken(format!("value {}{name} is {}", i + 1, values[i])));
+        }
+        out.copy_from_slice(&values);
+        self.free.push(values);
+        Ok(Header::of(&h, 0))
+    }
+
+    /// Checks that the sample of step k was made from its input's sample k: it cannot have taken
+    /// its input (`taken_ns`) before that input was sent. A component that publishes without
+    /// reading would otherwise go unnoticed until its full subscriber buffer blocks the plant.
+    pub(super) fn made_after(&self, k: u64, own: &Header, input: &Header, input_label: &str) -> Result<(), LaunchError> {
+        if own.taken_ns < input.sent_ns {
+            return Err(LaunchError::Component(format!(
+                "{} broke the protocol at step {k}: it published the step before {input_label}'s sample {k} was sent (it does not read its input)",
+                self.label
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// Per-component queues of received samples, assembled into rows in step order.
+pub(super) struct Assembly {
+    pub(super) plant: Queue,
+    pub(super) observers: Vec<Queue>,
+    pub(super) controller: Option<Queue>,
+    pub(super) next: u64,
+    /// Steps K of the run: the plant's end sample (step K) is not a row.
+    pub(super) steps: u64,
+    /// Sample period: the recording's time is k·dt, whatever a plant's header says.
+    pub(super) dt: f64,
+    /// Index of the observer the controller reads.
+    pub(super) controller_observer: Option<usize>,
+}
+
+impl Assembly {
+    /// The component whose sample for the next step is missing, first in the order samples flow
+    /// within a step (plant, observers, controller): the others wait on it. Indices as the
+    /// launcher spawns them.
+    pub(super) fn missing(&self) -> Option<usize> {
+        if self.plant.is_empty() {
+            return Some(0);
+        }
+        if let Some(i) = self.observers.iter().position(|q| q.is_empty()) {
+            return Some(1 + i);
+        }
+        self.controller.as_ref().filter(|q| q.is_empty()).map(|_| 1 + self.observers.len())
+    }
+
+    /// Moves every complete step into the session.
+    pub(super) fn assemble(&mut self, row: &mut StepRow, session: &mut Session) -> Result<usize, LaunchError> {
+        let mut done = 0;
+        loop {
+            if self.next >= self.steps {
+                return Ok(done);
+            }
+            let ready = !self.plant.is_empty() && self.observers.iter().all(|q| !q.is_empty()) && self.controller.as_ref().is_none_or(|q| !q.is_empty());
+            if !ready {
+                return Ok(done);
+            }
+            let k = self.next;
+            row.plant_hdr = self.plant.take(k, &mut row.plant)?;
+            row.k = k;
+            row.t = k as f64 * self.dt;
+            for (i, q) in self.observers.iter_mut().enumerate() {
+                row.xhat_hdr[i] = q.take(k, &mut row.xhat[i])?;
+                q.made_after(k, &row.xhat_hdr[i], &row.plant_hdr, "the plant")?;
+            }
+            if let Some(q) = &mut self.controller {
+                row.u_hdr = q.take(k, &mut row.u)?;
+                if let Some(c) = self.controller_observer {
+                    q.made_after(k, &row.u_hdr, &row.xhat_hdr[c], &self.observers[c].label)?;
+                }
+            }
+            session.record(row)?;
+            self.next += 1;
+            done += 1;
+        }
+    }
+
+    /// The plant's end sample (step K), checked like every other, once every step was assembled.
+    pub(super) fn end(&mut self, row: &mut StepRow) -> Result<Option<Header>, LaunchError> {
+        if self.plant.is_empty() {
+            return Ok(None);
+        }
+        self.plant.take(self.steps, &mut row.plant).map(Some)
+    }
+
+    /// Whether component `i` (spawn order) has published its last sample: step K for the plant
+    /// (its end sample), K − 1 for the others.
+    pub(super) fn published_all(&self, i: usize) -> bool {
+        let nobs = self.observers.len();
+        let (q, last) = match i {
+            0 => (&self.plant, self.steps),
+            i if i <= nobs => (&self.observers[i - 1], self.steps.saturating_sub(1)),
+            _ => (self.controller.as_ref().expect("a controller"), self.steps.saturating_sub(1)),
+        };
+        q.last.is_some_and(|l| l >= last)
+    }
+
+    pub(super) fn queue(&self, i: usize) -> &Queue {
+        let nobs = self.observers.len();
+        match i {
+            0 => &self.plant,
+            i if i <= nobs => &self.observers[i - 1],
+            _ => self.controller.as_ref().expect("a controller"),
+        }
+    }
+}
+
+/// The launcher's recording subscribers, one per topic.
+pub(super) struct Readers<'a> {
+    pub(super) plant: &'a Reader,
+    pub(super) observers: &'a [Reader],
+    pub(super) controller: Option<&'a Reader>,
+}
+
+impl Readers<'_> {
+    /// Moves every pending sample into its queue; returns how many there were.
+    pub(super) fn drain_all(&self, asm: &mut Assembly) -> Result<usize, LaunchError> {
+        let mut got = asm.plant.drain(self.plant)?;
+        for (r, q) in self.observers.iter().zip(asm.observers.iter_mut()) {
+            got += q.drain(r)?;
+        }
+        if let (Some(r), Some(q)) = (self.controller, asm.controller.as_mut()) {
+            got += q.drain(r)?;
+        }
+        Ok(got)
+    }
+}
+

@@ -1,0 +1,199 @@
+//! `--mode processes`: one process per component, in lockstep over iceoryx2, supervised.
+//!
+//! The launcher creates the run's space and its own recording subscribers first, starts the
+//! components (each in its own process group, so a terminal's Ctrl-C reaches only the launcher),
+//! waits until every component reports `ready`, then says `go`. While the run goes it drains
+//! the recording subscribers and polls the children: a component that exits early or is killed
+//! stops the run within a poll interval, the others are killed, and the recording is closed.
+
+mod assembly;
+mod placement;
+mod proc;
+
+use std::io::Write;
+use std::path::Path;
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use lockstep::{cleanup_dead_runs, Bus, Reader, RunSpace, Wait};
+use scenario::Scenario;
+
+use self::assembly::{Assembly, Queue, Readers};
+use self::placement::placement;
+use self::proc::{spawn, stop_all, Proc};
+use super::configs::Configs;
+use super::envelope::envelopes;
+use super::session::Session;
+use super::{interrupt, Stop};
+use crate::error::LaunchError;
+use recording::write::StepRow;
+
+/// How long components may take to report ready.
+const READY_TIMEOUT: Duration = Duration::from_secs(20);
+/// How long the run may make no progress before it is declared stuck: shorter than a
+/// component's own inlet timeout (10 s), so the launcher names the stall first.
+const STALL_TIMEOUT: Duration = Duration::from_secs(5);
+/// Sleep between drains. The launcher shares the cores with the lockstep ring, and every
+/// wake-up takes a core from it for a moment: drain rarely, in large batches. At the fastest
+/// step rate measured (~250k steps/s) 5 ms is ~1300 samples, well inside the recorder's buffer.
+const POLL: Duration = Duration::from_millis(5);
+
+/// Runs the scenario across processes.
+pub fn run(s: &Scenario, cfg: &Configs, session: &mut Session, wait: Wait, pin: bool) -> Result<Stop, LaunchError> {
+    cleanup_dead_runs();
+    let space = RunSpace::create().map_err(|e| LaunchError::Component(e.to_string()))?;
+    let result = run_in(s, &space, cfg, session, wait, pin);
+    space.remove();
+    result
+}
+
+fn run_in(s: &Scenario, space: &RunSpace, cfg: &Configs, session: &mut Session, wait: Wait, pin: bool) -> Result<Stop, LaunchError> {
+    let ipc = |e: lockstep::LockstepError| LaunchError::Component(e.to_string());
+    let components = envelopes(s, cfg, space, wait);
+    for c in &components {
+        space.write_config(&c.file(), &to_json(&c.config)).map_err(ipc)?;
+    }
+
+    // The recorder's subscribers exist before any component can publish: they create every
+    // service of the run (PROTOCOL.md §4).
+    let bus = Bus::join(space, "launcher", Wait::Yield).map_err(ipc)?;
+    space.restrict_shm().map_err(ipc)?;
+    let readers: Vec<Reader> = components.iter().map(|c| bus.reader(&c.config.publishes.service)).collect::<Result<_, _>>().map_err(ipc)?;
+    let nobs = s.observers.len();
+
+    let (tx, rx) = mpsc::channel();
+    let mut procs: Vec<Proc> = Vec::new();
+    let (plant_cpu, observer_cpus, controller_cpu) = placement(cfg, pin);
+    let cpus: Vec<Option<usize>> = std::iter::once(plant_cpu).chain(observer_cpus).chain(s.controller.as_ref().map(|_| controller_cpu)).collect();
+    let workdir = s.path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let workdir = &std::path::absolute(workdir).unwrap_or_else(|_| workdir.to_path_buf());
+    let result = (|| {
+        for (i, (c, &cpu)) in components.iter().zip(&cpus).enumerate() {
+            procs.push(spawn(c, workdir, space, cpu, &tx, i)?);
+        }
+        handshake(&mut procs, &rx)?;
+        let r = Readers { plant: &readers[0], observers: &readers[1..1 + nobs], controller: readers.get(1 + nobs) };
+        let mut asm = Assembly {
+            plant: Queue::new(&components[0]),
+            observers: components[1..1 + nobs].iter().map(Queue::new).collect(),
+            controller: components.get(1 + nobs).map(Queue::new),
+            next: 0,
+            steps: s.steps,
+            dt: s.dt,
+            controller_observer: s.controller.as_ref().and_then(|c| s.observers.iter().position(|o| o.name == c.observer)),
+        };
+        supervise(cfg, session, &mut procs, &r, &mut asm)
+    })();
+    stop_all(&mut procs);
+    drop((readers, bus));
+    result
+}
+
+/// Waits for every component's `ready`, then tells them all `go`.
+fn handshake(procs: &mut [Proc], rx: &mpsc::Receiver<(usize, String)>) -> Result<(), LaunchError> {
+    let deadline = Instant::now() + READY_TIMEOUT;
+    let mut ready = vec![false; procs.len()];
+    while !ready.iter().all(|&r| r) {
+        if let Some(sig) = interrupt::received() {
+            return Err(LaunchError::Interrupted(format!("{sig} received while the components started")));
+        }
+        for p in procs.iter_mut() {
+            if p.status.is_none()
+                && let Ok(Some(st)) = p.child.try_wait()
+            {
+                p.status = Some(st);
+                // Give its stderr reader a moment to collect the message.
+                std::thread::sleep(Duration::from_millis(20));
+                return Err(LaunchError::Component(format!("{} before the run began", p.describe_exit())));
+            }
+        }
+        match rx.recv_timeout(Duration::from_millis(20)) {
+            Ok((i, line)) if line.trim() == "ready" => ready[i] = true,
+            Ok(_) | Err(mpsc::RecvTimeoutError::Timeout) => {}
+            Err(mpsc::RecvTimeoutError::Disconnected) => {}
+        }
+        if Instant::now() > deadline {
+            let slow: Vec<&str> = procs.iter().zip(&ready).filter(|(_, r)| !**r).map(|(p, _)| p.label.as_str()).collect();
+            return Err(LaunchError::Component(format!("{} did not report ready within {} s", slow.join(", "), READY_TIMEOUT.as_secs())));
+        }
+    }
+    for p in procs.iter_mut() {
+        let mut stdin = p.child.stdin.take().expect("piped");
+        stdin.write_all(b"go\n").and_then(|_| stdin.flush()).map_err(|e| LaunchError::Component(format!("{}: {e}", p.label)))?;
+    }
+    Ok(())
+}
+
+fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: &Readers, asm: &mut Assembly) -> Result<Stop, LaunchError> {
+    let steps = cfg.plant.plant.steps;
+    let mut row = StepRow::new(cfg.layout, readers.observers.len(), readers.controller.is_some());
+    let mut last_progress = Instant::now();
+    loop {
+        let got = readers.drain_all(asm)?;
+        if asm.assemble(&mut row, session)? > 0 {
+            last_progress = Instant::now();
+        }
+        if asm.next == steps {
+            // The plant's end sample (step K) closes the last step's timing; a plant that has
+            // exited without one ends the run all the same.
+            if let Some(h) = asm.end(&mut row)? {
+                session.close_last(&h)?;
+                return Ok(Stop::Completed);
+            }
+            if procs[0].status.is_some() {
+                return Ok(Stop::Completed);
+            }
+        }
+        if let Some(sig) = interrupt::received() {
+            return Ok(Stop::Interrupted(sig));
+        }
+        // A component that ended before the last step ends the run.
+        for i in 0..procs.len() {
+            if procs[i].status.is_some() {
+                continue;
+            }
+            let Ok(Some(st)) = procs[i].child.try_wait() else { continue };
+            procs[i].status = Some(st);
+            // Status 0 is the end of its part only when it published all of it; collect what it
+            // published before it went (its last samples may still be on their way).
+            readers.drain_all(asm)?;
+            asm.assemble(&mut row, session)?;
+            if st.success() && asm.published_all(i) {
+                continue;
+            }
+            std::thread::sleep(Duration::from_millis(20));
+            readers.drain_all(asm)?;
+            asm.assemble(&mut row, session)?;
+            if st.success() && asm.published_all(i) {
+                continue;
+            }
+            stop_all(procs);
+            let mut what = procs[i].describe_exit();
+            if st.success() {
+                let last = asm.queue(i).last.map_or("none".to_string(), |l| format!("of step {l}"));
+                what += &format!(" before the end of the run (its last sample: {last})");
+            }
+            let last = if asm.next == 0 { "no step completed".to_string() } else { format!("last completed step {}", asm.next - 1) };
+            if i == 0 && st.code() == Some(plant::shell::EXIT_DIVERGED) {
+                return Ok(Stop::Diverged(format!("{what} ({last})")));
+            }
+            return Ok(Stop::Failed(format!("{what}; {last}")));
+        }
+        if procs.iter().all(|p| p.status.is_some()) && got == 0 {
+            return Ok(Stop::Failed(format!("every component finished but only {} of {steps} steps arrived", asm.next)));
+        }
+        if last_progress.elapsed() > STALL_TIMEOUT {
+            let missing = asm.missing();
+            let who = missing.map_or_else(|| "a component".to_string(), |i| procs[i].describe_stall());
+            let hint = if missing == Some(0) { " (a plant blocked publishing to a component that stopped reading its samples shows as this too)" } else { "" };
+            stop_all(procs);
+            let last = if asm.next == 0 { "no step completed".to_string() } else { format!("last completed step {}", asm.next - 1) };
+            return Ok(Stop::Failed(format!("{who} published no sample for step {} within {} s; {last}{hint}", asm.next, STALL_TIMEOUT.as_secs())));
+        }
+        std::thread::sleep(POLL);
+    }
+}
+
+fn to_json<T: serde::Serialize>(v: &T) -> String {
+    serde_json::to_string(v).expect("configurations serialise")
+}
