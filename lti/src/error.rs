@@ -14,6 +14,12 @@ pub enum LtiError {
     /// A matrix that must be invertible is (numerically) singular.
     #[error("{0} is singular")]
     Singular(&'static str),
+    /// An argument is out of its domain (non-finite, not symmetric, not definite).
+    #[error("invalid input: {0}")]
+    InvalidInput(String),
+    /// A Riccati equation has no stabilising solution; the message names the cause.
+    #[error("no stabilising solution: {0}")]
+    NoStabilisingSolution(String),
     /// The requested pole set is not valid for this problem.
     #[error("invalid poles: {0}")]
     InvalidPoles(String),

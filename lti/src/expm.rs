@@ -52,6 +52,8 @@
 
 use nalgebra::DMatrix;
 
+use crate::dd::{two_prod, Dd};
+
 /// Unit roundoff of IEEE double precision, the u of the paper's θ_m.
 const U: f64 = 1.1102230246251565e-16;
 
@@ -201,83 +203,6 @@ fn pade(y: &DdMat, m: usize) -> DdMat {
     q.solve(p)
 }
 
-/// A double-double number hi + lo with |lo| ≤ ulp(hi)/2.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Dd {
-    hi: f64,
-    lo: f64,
-}
-
-impl From<f64> for Dd {
-    fn from(hi: f64) -> Self {
-        Dd { hi, lo: 0.0 }
-    }
-}
-
-/// a + b exactly (Knuth).
-fn two_sum(a: f64, b: f64) -> Dd {
-    let s = a + b;
-    let bb = s - a;
-    Dd { hi: s, lo: (a - (s - bb)) + (b - bb) }
-}
-
-/// a + b exactly, for |a| ≥ |b| (Dekker).
-fn quick_two_sum(a: f64, b: f64) -> Dd {
-    let s = a + b;
-    Dd { hi: s, lo: b - (s - a) }
-}
-
-/// a·b exactly: the fused multiply-add returns the rounding error of the product.
-fn two_prod(a: f64, b: f64) -> Dd {
-    let p = a * b;
-    Dd { hi: p, lo: a.mul_add(b, -p) }
-}
-
-impl Dd {
-    const ZERO: Dd = Dd { hi: 0.0, lo: 0.0 };
-
-    fn from_u128(x: u128) -> Dd {
-        let hi = x as f64;
-        // x − hi is exact in i128 and below 2⁵³ for the coefficients used here.
-        let lo = (x as i128 - hi as i128) as f64;
-        quick_two_sum(hi, lo)
-    }
-
-    fn add(self, o: Dd) -> Dd {
-        let s = two_sum(self.hi, o.hi);
-        let t = two_sum(self.lo, o.lo);
-        let u = quick_two_sum(s.hi, s.lo + t.hi);
-        quick_two_sum(u.hi, u.lo + t.lo)
-    }
-
-    fn neg(self) -> Dd {
-        Dd { hi: -self.hi, lo: -self.lo }
-    }
-
-    fn sub(self, o: Dd) -> Dd {
-        self.add(o.neg())
-    }
-
-    fn mul(self, o: Dd) -> Dd {
-        let p = two_prod(self.hi, o.hi);
-        quick_two_sum(p.hi, p.lo + (self.hi * o.lo + self.lo * o.hi))
-    }
-
-    fn div(self, o: Dd) -> Dd {
-        let q1 = self.hi / o.hi;
-        let r = self.sub(o.mul(Dd::from(q1)));
-        let q2 = r.hi / o.hi;
-        let r = r.sub(o.mul(Dd::from(q2)));
-        let q3 = r.hi / o.hi;
-        quick_two_sum(q1, q2).add(Dd::from(q3))
-    }
-
-    /// Rounded to the nearest double.
-    fn to_f64(self) -> f64 {
-        self.hi + self.lo
-    }
-}
-
 /// A square double-double matrix, row-major.
 #[derive(Debug, Clone)]
 struct DdMat {
@@ -389,18 +314,6 @@ mod tests {
         let q: f64 = b3.iter().enumerate().map(|(j, b)| b * (-x).powi(j as i32)).sum();
         let lead = 36.0 / (720.0 * 5040.0) * x.powi(7);
         assert!(((p / q - x.exp()) / lead - 1.0).abs() < 0.2, "{}", (p / q - x.exp()) / lead);
-    }
-
-    #[test]
-    fn double_double_products_are_exact() {
-        let (a, b) = (0.1f64, 3.0f64);
-        let p = two_prod(a, b);
-        // 0.1·3 = 0.30000000000000001665…: hi is the rounded product, lo what rounding dropped.
-        assert_eq!(p.hi, 0.30000000000000004);
-        assert_eq!(p.lo, -2.7755575615628914e-17);
-        let q = Dd::from(1.0).div(Dd::from(3.0));
-        let back = q.mul(Dd::from(3.0)).sub(Dd::from(1.0));
-        assert!(back.hi.abs() < 1e-31);
     }
 
     #[test]

@@ -5,11 +5,16 @@
 //! * [`staircase`] — controllable / observable splits, controllability and observability matrices;
 //! * [`zeros`] — invariant zeros that decide whether an unknown-input observer exists;
 //! * [`lyapunov`] — continuous and discrete Lyapunov equations (decay-rate certificates);
+//! * [`dare`] — the discrete algebraic Riccati equation (structure-preserving doubling) and the
+//!   steady-state Kalman filter;
 //! * [`place`] — eigenvalue assignment (Tits–Yang, KNV0, MATLAB-compatible, Ackermann);
 //! * [`model`], [`discretize`], [`expm`] — the plant model, its exact zero-order-hold sampling and
 //!   the matrix exponential behind it;
+//! * [`van_loan`] — the discrete covariance of continuous white process noise over a step;
 //! * [`signal`] — the known-input and disturbance signals of a scenario.
 
+pub mod dare;
+pub(crate) mod dd;
 pub mod discretize;
 pub mod eig;
 pub mod error;
@@ -24,13 +29,16 @@ pub mod poles;
 pub mod signal;
 pub mod staircase;
 pub mod subspace;
+pub mod van_loan;
 pub mod zeros;
 
+pub use dare::{solve_dare, steady_state_kalman, Dare, Kalman};
 pub use eig::C64;
 pub use error::{LtiError, Result};
 pub use nalgebra::DMatrix;
 pub use model::{Discrete, MatData, Model};
 pub use poles::{re_im, PoleSpec, Poles};
+pub use van_loan::{discrete_noise_covariance, process_noise_covariance};
 
 /// A real matrix.
 pub type Mat = nalgebra::DMatrix<f64>;
