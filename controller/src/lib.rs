@@ -22,8 +22,6 @@ pub struct ControllerConfig {
     pub references: Vec<Signal>,
     /// Sample period, s.
     pub dt: f64,
-    /// Number of steps.
-    pub steps: u64,
     /// The observer whose estimate is fed back.
     pub observer: String,
 }

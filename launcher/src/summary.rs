@@ -7,6 +7,7 @@ use lti::eig::sig;
 use serde::Serialize;
 
 use crate::plan::Plan;
+use recording::signals::figure;
 use recording::write::{Latency, Metrics, Percentiles};
 use crate::run::{Options, Stop};
 use scenario::Scenario;
@@ -231,9 +232,4 @@ impl Summary {
         }
         t
     }
-}
-
-/// A figure for the table: "—" where there is none (a run of fewer than 4 steps has no tail).
-pub fn figure(v: Option<f64>) -> String {
-    v.map_or_else(|| "—".to_string(), |v| format!("{v:.3e}"))
 }

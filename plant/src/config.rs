@@ -85,15 +85,3 @@ impl PlantConfig {
         })
     }
 }
-
-/// The plant of a run as the launcher plans it: its configuration (the built-in plant's
-/// `params`) and the shape of the ring around it, which places the processes on CPUs.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct PlantRun {
-    /// The plant itself.
-    pub plant: PlantConfig,
-    /// Per observer, whether it may trail the plant (a follower, see [`lockstep::FOLLOWER_LAG`]).
-    pub followers: Vec<bool>,
-    /// Whether a controller provides u (else u = the input signals).
-    pub controller: bool,
-}

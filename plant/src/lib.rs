@@ -5,5 +5,5 @@ mod config;
 mod plant;
 pub mod shell;
 
-pub use config::{PlantConfig, PlantRun};
+pub use config::PlantConfig;
 pub use plant::{Divergence, Plant};

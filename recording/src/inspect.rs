@@ -8,6 +8,7 @@ use serde::Serialize;
 
 use crate::write::{histogram, nan_max, Latency, Percentiles};
 use crate::read::Recording;
+use crate::signals::figure;
 use crate::tools::recorded_scenario;
 
 /// One entity.
@@ -111,15 +112,7 @@ pub fn inspect(file: &str, r: &Recording) -> Inspection {
                 .fold(0.0, nan_max),
         )
     };
-    let mut names: Vec<String> = r
-        .series
-        .keys()
-        .filter_map(|p| p.strip_prefix("/observer/").and_then(|rest| rest.split_once('/')).map(|(n, _)| n.to_string()))
-        .collect();
-    names.dedup();
-    let order: Vec<String> = scenario.as_ref().map(|s| s.observers.iter().map(|o| o.name.clone()).collect()).unwrap_or_default();
-    names.sort_by_key(|n| order.iter().position(|o| o == n).unwrap_or(usize::MAX));
-    let observers = names
+    let observers = crate::signals::observers_of(r.series.keys(), scenario.as_ref())
         .into_iter()
         .map(|n| ObserverFigures {
             tail_max_abs_error: tail_max(&format!("/observer/{n}/error/")),
@@ -178,7 +171,6 @@ impl Inspection {
         }
         t += &format!("  {:<14} {:>14} {:>14}\n", "observer", "tail max|e|", "tail max|r|");
         for o in &self.observers {
-            let figure = |v: Option<f64>| v.map_or_else(|| "—".to_string(), |v| format!("{v:.3e}"));
             t += &format!("  {:<14} {:>14} {:>14}\n", o.name, figure(o.tail_max_abs_error), figure(o.tail_max_abs_residual));
         }
         let p = &self.latency_ns.step;

@@ -168,11 +168,9 @@ pub fn figures(r: &Recording, selection: &PlotSelection) -> Result<Vec<(String, 
     let dt = s.map(|s| s.dt);
     let x_of = |k: i64| dt.map_or(k as f64, |dt| k as f64 * dt);
     let x_label = if dt.is_some() { "t [s]" } else { "step" };
-    let mut observers: Vec<String> = r.series.keys().filter_map(|p| p.strip_prefix("/observer/").and_then(|x| x.split_once('/')).map(|(n, _)| n.to_string())).collect();
-    observers.dedup();
-    // In the scenario's order where it is known: that order gives each observer its colour.
+    let observers = crate::signals::observers_of(r.series.keys(), s);
+    // The scenario's order gives each observer its colour.
     let order: Vec<String> = s.map(|s| s.observers.iter().map(|o| o.name.clone()).collect()).unwrap_or_default();
-    observers.sort_by_key(|n| order.iter().position(|o| o == n).unwrap_or(usize::MAX));
     let colours: Vec<String> = if order.is_empty() { observers.clone() } else { order };
     let width = (SIZE.0 as usize).saturating_sub(400);
     let mut out = Vec::new();

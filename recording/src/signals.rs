@@ -59,6 +59,23 @@ pub fn log_error(observer: &str) -> String {
 /// Where an error of exactly zero is drawn on a log axis (log10 of 0 has no value).
 pub const LOG_FLOOR: f64 = 1e-18;
 
+/// The observers a recording holds (from its `/observer/<name>/…` entities), in the scenario's
+/// order where it is known — the order that gives each observer its colour — else by name.
+pub fn observers_of<'a>(paths: impl IntoIterator<Item = &'a String>, s: Option<&Scenario>) -> Vec<String> {
+    let mut names: Vec<String> = paths.into_iter().filter_map(|p| p.strip_prefix("/observer/").and_then(|x| x.split_once('/')).map(|(n, _)| n.to_string())).collect();
+    names.sort();
+    names.dedup();
+    let order: Vec<&str> = s.map(|s| s.observers.iter().map(|o| o.name.as_str()).collect()).unwrap_or_default();
+    names.sort_by_key(|n| order.iter().position(|o| o == n).unwrap_or(usize::MAX));
+    names
+}
+
+/// A figure that may be missing, for tables: "—" where there is none (a run of fewer than 4
+/// steps has no tail).
+pub fn figure(v: Option<f64>) -> String {
+    v.map_or_else(|| "—".to_string(), |v| format!("{v:.3e}"))
+}
+
 /// log10 of a max |e|, zeros at the floor (NaN stays NaN: a diverged run shows as a gap).
 pub fn log10_floored(v: f64) -> f64 {
     if v.is_nan() { v } else { v.max(LOG_FLOOR).log10() }

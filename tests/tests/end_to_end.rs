@@ -74,11 +74,11 @@ fn bad_scenarios_are_refused_with_file_field_and_exit_2() {
         ("wrong-size", good.replace("C = [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]", "C = [[1.0, 0.0], [0.0, 1.0]]"), "plant.C"),
         ("missing-field", good.replace("x0 = [1.0, -1.0, 2.0]\n", ""), "x0"),
     ];
-    for (tag, text, field) in cases {
+    for (tag, body, field) in cases {
         let path = s.join(&format!("{tag}.toml"));
-        std::fs::write(&path, text).unwrap();
+        std::fs::write(&path, body).unwrap();
         let out = run(&s, &path, &[]);
-        let (_, err) = text_of(&out);
+        let (_, err) = text(&out);
         assert_eq!(out.status.code(), Some(2), "{tag}: {err}");
         assert_eq!(err.trim().lines().count(), 1, "{tag}: one line: {err}");
         assert!(err.contains(&format!("{tag}.toml")) && err.contains(field), "{tag}: {err}");
@@ -86,9 +86,6 @@ fn bad_scenarios_are_refused_with_file_field_and_exit_2() {
     }
 }
 
-fn text_of(o: &std::process::Output) -> (String, String) {
-    text(o)
-}
 
 #[test]
 fn default_command_runs_seed002_sine() {

@@ -85,22 +85,19 @@ fn a_command_that_does_not_exist_is_named() {
 #[test]
 fn an_external_rust_plant_reproduces_the_built_in_one_bit_for_bit() {
     let s = Scratch::new("external-linear");
-    let text = std::fs::read_to_string(scenario("seed002-sine")).unwrap();
-    let text = text.replacen("x0 = [1.0, -1.0, 2.0]\n", "x0 = [1.0, -1.0, 2.0]\n\n[plant.process]\ncommand = [\"linear_plant\"]\n", 1);
+    let body = std::fs::read_to_string(scenario("seed002-sine")).unwrap();
+    let body = body.replacen("x0 = [1.0, -1.0, 2.0]\n", "x0 = [1.0, -1.0, 2.0]\n\n[plant.process]\ncommand = [\"linear_plant\"]\n", 1);
     let path = s.join("seed002-sine.toml");
-    std::fs::write(&path, text).unwrap();
+    std::fs::write(&path, body).unwrap();
     let out = launcher(&s).arg("run").arg(&path).arg("--out").arg(s.join("ext")).output().unwrap();
-    assert!(out.status.success(), "{:?}", text_of(&out));
+    assert!(out.status.success(), "{:?}", text(&out));
     let out = launcher(&s).arg("run").arg(scenario("seed002-sine")).arg("--out").arg(s.join("builtin")).output().unwrap();
-    assert!(out.status.success(), "{:?}", text_of(&out));
+    assert!(out.status.success(), "{:?}", text(&out));
     let cmp = launcher(&s).arg("compare").arg(s.join("ext/seed002-sine.rrd")).arg(s.join("builtin/seed002-sine.rrd")).output().unwrap();
-    let (stdout, _) = text_of(&cmp);
+    let (stdout, _) = text(&cmp);
     assert!(cmp.status.success() && stdout.contains("bit for bit"), "{stdout}");
 }
 
-fn text_of(o: &std::process::Output) -> (String, String) {
-    text(o)
-}
 
 /// In-process mode cannot run someone else's process: refused before anything is written.
 #[test]

@@ -4,7 +4,7 @@
 use controller::ControllerConfig;
 use lockstep::PlantLayout;
 use observer::shell::ObserverRun;
-use plant::{PlantConfig, PlantRun};
+use plant::PlantConfig;
 
 use crate::plan::Plan;
 use scenario::Scenario;
@@ -12,8 +12,12 @@ use scenario::Scenario;
 /// Every component's configuration.
 #[derive(Debug, Clone)]
 pub struct Configs {
-    /// The plant's.
-    pub plant: PlantRun,
+    /// The plant's (the built-in plant reads the same from the protocol's fields).
+    pub plant: PlantConfig,
+    /// Per observer, whether it may trail the plant (a follower: off the ring's critical path).
+    pub followers: Vec<bool>,
+    /// Whether a controller, built in or external, closes the loop.
+    pub closed_loop: bool,
     /// (name, config) per observer; none for an external observer.
     pub observers: Vec<(String, Option<ObserverRun>)>,
     /// The built-in controller's (none without one, or for an external one).
@@ -37,8 +41,7 @@ pub fn is_follower(s: &Scenario, observer: &str) -> bool {
 pub fn configs(s: &Scenario, plan: &Plan) -> Configs {
     let m = &s.model;
     let layout = PlantLayout { n: m.n(), p: m.p(), q: m.e.ncols(), r: m.d.ncols(), l: m.l() };
-    let plant = PlantRun {
-        plant: PlantConfig {
+    let plant = PlantConfig {
             a: (&m.a).into(),
             b: (&m.b).into(),
             c: (&m.c).into(),
@@ -51,18 +54,16 @@ pub fn configs(s: &Scenario, plan: &Plan) -> Configs {
             dt: s.dt,
             steps: s.steps,
             state_bound: s.state_bound,
-        },
-        followers: s.observers.iter().map(|o| is_follower(s, &o.name)).collect(),
-        controller: s.controller.is_some(),
     };
+    let followers = s.observers.iter().map(|o| is_follower(s, &o.name)).collect();
     let observers = plan
         .observers
         .iter()
         .map(|(name, d)| (name.clone(), d.as_ref().map(|d| ObserverRun { observer: d.runtime.clone(), layout })))
         .collect();
     let controller = match (&s.controller, &plan.feedback) {
-        (Some(c), Some(fb)) => Some(ControllerConfig { g: (&fb.g).into(), n: (&fb.n).into(), references: s.inputs.clone(), dt: s.dt, steps: s.steps, observer: c.observer.clone() }),
+        (Some(c), Some(fb)) => Some(ControllerConfig { g: (&fb.g).into(), n: (&fb.n).into(), references: s.inputs.clone(), dt: s.dt, observer: c.observer.clone() }),
         _ => None,
     };
-    Configs { plant, observers, controller, layout }
+    Configs { plant, followers, closed_loop: s.controller.is_some(), observers, controller, layout }
 }

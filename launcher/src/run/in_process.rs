@@ -13,7 +13,7 @@ use recording::write::StepRow;
 
 /// Runs every step; returns how it ended.
 pub fn run(cfg: &Configs, session: &mut Session) -> Result<Stop, LaunchError> {
-    let mut plant = Plant::new(&cfg.plant.plant).map_err(LaunchError::Component)?;
+    let mut plant = Plant::new(&cfg.plant).map_err(LaunchError::Component)?;
     // External components were refused before the run (`run::run`): every observer is ours.
     let mut observers: Vec<ObserverState> = cfg.observers.iter().map(|(_, o)| o.as_ref().expect("built-in").observer.instantiate()).collect();
     let mut controller = cfg.controller.as_ref().map(Controller::new).transpose().map_err(LaunchError::Component)?;
@@ -21,7 +21,7 @@ pub fn run(cfg: &Configs, session: &mut Session) -> Result<Stop, LaunchError> {
     let lay = cfg.layout;
     let mut row = StepRow::new(lay, observers.len(), controller.is_some());
     let mut u = vec![0.0; lay.l];
-    for k in 0..cfg.plant.plant.steps {
+    for k in 0..cfg.plant.steps {
         if k % 1024 == 0
             && let Some(sig) = interrupt::received()
         {

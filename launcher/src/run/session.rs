@@ -9,7 +9,7 @@ use crate::error::LaunchError;
 use recording::write::Selection;
 use recording::palette;
 use recording::signals as sig;
-use recording::write::{blueprint, nan_max, Latency, Metrics, RrdSink, SeriesId, StepRow};
+use recording::write::{blueprint, Latency, Metrics, RrdSink, SeriesId, StepRow};
 use scenario::Scenario;
 
 /// Series of one observer.
@@ -234,8 +234,8 @@ impl Session {
             put(sink, &oc.xhat, &row.xhat[o]);
             put(sink, &oc.error, &self.metrics.error[o]);
             put(sink, &oc.residual, &self.metrics.residual[o]);
-            let max_abs = self.metrics.error[o].iter().fold(0.0, |m, e| nan_max(m, e.abs()));
-            sink.push(oc.log_error, sig::log10_floored(max_abs));
+            // max_i |e_i| of this step, as the figures took it.
+            sink.push(oc.log_error, sig::log10_floored(self.metrics.observers[o].final_abs_error));
         }
         // Latencies are recorded at the step they belong to: the step time and the
         // controller→plant hop of step k−1 complete with row k (in-process: step k itself).

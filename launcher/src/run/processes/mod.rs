@@ -125,7 +125,7 @@ fn handshake(procs: &mut [Proc], rx: &mpsc::Receiver<(usize, String)>) -> Result
 }
 
 fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: &Readers, asm: &mut Assembly) -> Result<Stop, LaunchError> {
-    let steps = cfg.plant.plant.steps;
+    let steps = cfg.plant.steps;
     let mut row = StepRow::new(cfg.layout, readers.observers.len(), readers.controller.is_some());
     let mut last_progress = Instant::now();
     loop {

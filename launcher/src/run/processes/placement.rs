@@ -40,8 +40,8 @@ pub(super) fn placement(cfg: &Configs, pin: bool) -> (Option<usize>, Vec<Option<
     if !pin || cpus.len() < 2 {
         return (None, vec![None; nobs], None);
     }
-    let ring_observers: Vec<bool> = cfg.plant.followers.iter().map(|f| !f).collect();
-    let ring = 1 + ring_observers.iter().filter(|&&r| r).count() + usize::from(cfg.plant.controller);
+    let ring_observers: Vec<bool> = cfg.followers.iter().map(|f| !f).collect();
+    let ring = 1 + ring_observers.iter().filter(|&&r| r).count() + usize::from(cfg.closed_loop);
     let mut next = 1;
     let mut cpu_for = |_: ()| {
         let c = if cpus.len() >= ring { cpus[next] } else { cpus[1 + (next - 1) % (cpus.len() - 1)] };
@@ -49,7 +49,7 @@ pub(super) fn placement(cfg: &Configs, pin: bool) -> (Option<usize>, Vec<Option<
         Some(c)
     };
     let observers = ring_observers.iter().map(|&r| if r { cpu_for(()) } else { None }).collect();
-    let controller = if cfg.plant.controller { cpu_for(()) } else { None };
+    let controller = if cfg.closed_loop { cpu_for(()) } else { None };
     (Some(cpus[0]), observers, controller)
 }
 
