@@ -55,7 +55,7 @@ pub fn report(s: &Scenario) -> DesignReport {
     let mut ok = true;
     let mut text = format!("{}: {}\n", s.name, scenario::untrusted::one_line(&s.description));
     let mut observers = Vec::new();
-    for o in &s.observers {
+    for o in s.observers.iter().filter(|o| o.member.is_none()) {
         text += &format!("\nobserver '{}' ({})\n", o.name, o.kind());
         let Some(spec) = &o.spec else {
             let p = o.process.as_ref().expect("an observer without a design is a process");
@@ -107,6 +107,9 @@ pub fn report(s: &Scenario) -> DesignReport {
             }
         }
     }
+    let (banks_text, diagnosers, banks_ok) = banks_report(s);
+    text += &banks_text;
+    ok &= banks_ok;
     let mut controller = Value::Null;
     let mut warnings = Vec::new();
     if ok {
@@ -154,9 +157,56 @@ pub fn report(s: &Scenario) -> DesignReport {
         "scenario": s.name,
         "observers": observers,
         "controller": controller,
+        "diagnosers": diagnosers,
         "warnings": warnings,
     });
     DesignReport { json, text, ok }
+}
+
+/// Each bank: its members (role, poles, threshold), and the structure matrix computed from the
+/// designs beside the one asked for.
+fn banks_report(s: &Scenario) -> (String, Vec<Value>, bool) {
+    let mut text = String::new();
+    let mut out = Vec::new();
+    if s.diagnosers.is_empty() {
+        return (text, out, true);
+    }
+    match crate::plan::banks(s) {
+        Ok(banks) => {
+            for b in &banks {
+                let d = &b.spec;
+                text += &format!("\ndiagnoser '{}' ({} scheme, {} faults, {} members)\n", d.name, d.scheme.name(), d.channels.name(), b.members.len());
+                let mut members = Vec::new();
+                for (i, m) in b.members.iter().enumerate() {
+                    let role = diagnosis::bank::role(d, &b.channels, i);
+                    text += &format!("  {} ({role}): {}, sampled poles {}, threshold {}\n", m.name, m.designed.report.kind, format_list(&m.designed.report.discrete_poles), sig(m.threshold));
+                    members.push(json!({
+                        "name": m.name, "role": role, "kind": m.designed.report.kind,
+                        "outputs": m.outputs.iter().map(|j| j + 1).collect::<Vec<_>>(),
+                        "poles": lti::re_im(&m.designed.report.poles),
+                        "discrete_poles": lti::re_im(&m.designed.report.discrete_poles),
+                        "threshold": m.threshold, "dof": m.dof,
+                        "residual_covariance": m.covariance.as_ref().map(rows),
+                        "sampled": sampled_json(&m.designed.runtime, s.dt),
+                    }));
+                }
+                text += &format!("  structure (rows: residuals, columns: {}):\n", b.channels.join(", "));
+                for (i, r) in b.structure.iter().enumerate() {
+                    text += &format!("    r{} {:?}\n", i + 1, r);
+                }
+                if d.structure.is_some() {
+                    text += "  equals the structure asked for\n";
+                }
+                out.push(json!({ "name": d.name, "scheme": d.scheme.name(), "faults": d.channels.name(), "channels": b.channels, "structure": b.structure, "members": members }));
+            }
+            (text, out, true)
+        }
+        Err(e) => {
+            text += &format!("\ndiagnoser: {}\n", e.error);
+            out.push(json!({ "error": e.error.to_string() }));
+            (text, out, false)
+        }
+    }
 }
 
 /// The sampled observer that actually runs, z_{k+1} = F z_k + G u_k + K y_k, x̂_k = P z_k + Q y_k

@@ -52,6 +52,9 @@ enum Command {
         /// path segment, `**` across segments); repeat for several.
         #[arg(long = "record", value_name = "GLOB")]
         record: Vec<String>,
+        /// The noise generator's seed (default: the scenario's `seed`).
+        #[arg(long)]
+        seed: Option<u64>,
     },
     /// Check the existence conditions and show the designs of a scenario.
     Design {
@@ -169,17 +172,21 @@ fn main() -> ExitCode {
         pin: "auto".into(),
         record_every: 1,
         record: Vec::new(),
+        seed: None,
     });
     match command {
-        Command::Run { scenario, out, mode, wait, force, allow_unstable, pin, record_every, record } => {
+        Command::Run { scenario, out, mode, wait, force, allow_unstable, pin, record_every, record, seed } => {
             let select = match recording::write::Selection::new(record_every, &record) {
                 Ok(x) => x,
                 Err(e) => return fail(&LaunchError::BadInput(e)),
             };
-            let s = match load(&scenario) {
+            let mut s = match load(&scenario) {
                 Ok(s) => s,
                 Err(e) => return fail(&e),
             };
+            if let Some(seed) = seed {
+                s.seed = seed;
+            }
             let p = match plan::plan(&s) {
                 Ok(p) => p,
                 Err(e) => return fail(&LaunchError::Scenario(e.error)),

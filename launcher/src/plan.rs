@@ -3,6 +3,7 @@
 
 use controller::design::{design as design_feedback, FeedbackDesign, FeedbackSpec};
 use lti::eig::{eigenvalues, format_list, sig, C64};
+use diagnosis::{design_bank, Bank};
 use observer::{design, Designed};
 
 use scenario::{Scenario, ScenarioError};
@@ -14,6 +15,8 @@ pub struct Plan {
     pub observers: Vec<(String, Option<Designed>)>,
     /// The state feedback, if any (not for an external controller).
     pub feedback: Option<FeedbackDesign>,
+    /// One bank per `[[diagnoser]]` (its members are among `observers`).
+    pub banks: Vec<Bank>,
     /// Things worth knowing that do not stop a run.
     pub warnings: Vec<String>,
 }
@@ -33,8 +36,13 @@ pub struct PlanError {
 #[allow(clippy::result_large_err)] // made once per command, never on a hot path
 pub fn plan(s: &Scenario) -> Result<Plan, PlanError> {
     let locate = |field: String, reason: String| scenario::locate_error(s, &field, reason);
+    let banks = banks(s)?;
     let mut observers = Vec::new();
     for (i, o) in s.observers.iter().enumerate() {
+        if let Some((d, j)) = o.member {
+            observers.push((o.name.clone(), Some(banks[d].members[j].designed.clone())));
+            continue;
+        }
         let Some(spec) = &o.spec else {
             observers.push((o.name.clone(), None));
             continue;
@@ -62,7 +70,26 @@ pub fn plan(s: &Scenario) -> Result<Plan, PlanError> {
         None => None,
     };
     let warnings = warnings(s, &observers, feedback.as_ref());
-    Ok(Plan { observers, feedback, warnings })
+    Ok(Plan { observers, feedback, banks, warnings })
+}
+
+/// Designs every `[[diagnoser]]` bank; a refusal names the diagnoser, the member and the
+/// condition that fails.
+#[allow(clippy::result_large_err)]
+pub fn banks(s: &Scenario) -> Result<Vec<Bank>, PlanError> {
+    let noise = s.noise.as_ref().map(|z| (&z.qd, &z.r));
+    s.diagnosers
+        .iter()
+        .enumerate()
+        .map(|(i, d)| {
+            design_bank(d, &s.model, &s.ff, s.dt, noise).map_err(|e| {
+                let field = if e.key.is_empty() { format!("diagnoser[{}]", i + 1) } else { format!("diagnoser[{}].{}", i + 1, e.key) };
+                let labels = diagnosis::bank::channel_labels(d.channels, &s.model, &s.ff);
+                let who = e.member.map_or(String::new(), |m| format!("member {} ({}): ", m + 1, diagnosis::bank::role(d, &labels, m)));
+                PlanError { error: scenario::locate_error(s, &field, format!("diagnoser '{}': {who}{}", d.name, e.reason)), conditions: vec![], observer: None }
+            })
+        })
+        .collect()
 }
 
 /// dt too coarse for the fastest pole, an unstable loop, and the like.

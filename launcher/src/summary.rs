@@ -89,6 +89,11 @@ pub struct Summary {
     pub expectations: Vec<Expectation>,
     /// Why the run stopped early, if it did.
     pub stopped: Option<String>,
+    /// Detection, isolation and false alarms (with a `[[diagnoser]]`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub diagnosis: Option<diagnosis::Diagnosis>,
+    /// The noise generator's seed.
+    pub seed: u64,
     /// The recording.
     pub recording: Option<String>,
     /// The recording's digest, entity → XXH64 (see `recording::digest`), also stored in the
@@ -100,7 +105,7 @@ pub struct Summary {
 impl Summary {
     /// Gathers the summary of a run.
     #[allow(clippy::too_many_arguments)]
-    pub fn new(s: &Scenario, plan: &Plan, opts: &Options, m: &Metrics, lat: &Latency, wall_s: f64, stop: &Stop, rrd: Option<&Path>) -> Self {
+    pub fn new(s: &Scenario, plan: &Plan, opts: &Options, m: &Metrics, lat: &Latency, wall_s: f64, stop: &Stop, rrd: Option<&Path>, diagnosis: Option<diagnosis::Diagnosis>) -> Self {
         let observers: Vec<ObserverSummary> = s
             .observers
             .iter()
@@ -141,6 +146,8 @@ impl Summary {
             latency_ns: LatencySummary { step: lat.step_percentiles(), hops: lat.hop_percentiles().into_iter().collect() },
             expectations: Vec::new(),
             stopped,
+            diagnosis,
+            seed: s.seed,
             recording: rrd.map(|p| p.display().to_string()),
             recording_digest: None,
         };
@@ -178,6 +185,18 @@ impl Summary {
                 _ => None,
             };
             add(format!("tail_error_ratio.{pair}"), limit, v);
+        }
+        let d = self.diagnosis.as_ref();
+        for (name, &limit) in &e.detection_delay {
+            let v = d.and_then(|d| d.faults.iter().find(|f| &f.name == name)).and_then(|f| f.delay);
+            add(format!("detection_delay.{name}"), limit, v);
+        }
+        if e.correct_isolation == Some(true) {
+            let wrong = d.map(|d| d.faults.iter().filter(|f| !f.correct).count() as f64);
+            add("faults_not_isolated_correctly".into(), 0.0, wrong);
+        }
+        if let Some(limit) = e.false_alarms {
+            add("false_alarms".into(), limit as f64, d.map(|d| d.false_alarms as f64));
         }
         out
     }
@@ -218,6 +237,20 @@ impl Summary {
             t += &format!("  step latency   p50 {}  p90 {}  p99 {}  p99.9 {}  max {}\n", us(p.p50), us(p.p90), us(p.p99), us(p.p999), us(p.max));
             for (hop, p) in &self.latency_ns.hops {
                 t += &format!("    {:<30} p50 {}  p99 {}  max {}\n", hop, us(p.p50), us(p.p99), us(p.max));
+            }
+        }
+        if let Some(d) = &self.diagnosis {
+            t += &format!("  diagnosis: {} false alarm(s) over {} s fault-free ({} step(s) in alarm)\n", d.false_alarms, sig(d.fault_free_time), d.false_alarm_steps);
+            for f in &d.faults {
+                let at = |v: Option<f64>| v.map_or_else(|| "—".to_string(), |v| format!("{v:.4} s"));
+                t += &format!(
+                    "    {:<20} start {:>9}  detected {:>11}  isolated as {:<16} {}\n",
+                    f.name,
+                    format!("{} s", f.start),
+                    at(f.detected_at),
+                    f.isolated_as.as_deref().unwrap_or("—"),
+                    if f.correct { "correct" } else { "WRONG" }
+                );
             }
         }
         for e in &self.expectations {

@@ -1,5 +1,5 @@
 //! Where each signal sits in the plant's sample:
-//! `[x (n) | y (p) | w (q) | v (r) | r (l) | u_{k−1} (l)]`.
+//! `[x (n) | y (p) | w (q) | v (r) | r (l) | u_{k−1} (l) | faults (2f)]`.
 //!
 //! The plant publishes the true state and the disturbances along with y so the recorder sees
 //! them; observers read only y and u_{k−1}.
@@ -21,12 +21,16 @@ pub struct PlantLayout {
     pub r: usize,
     /// Known inputs (columns of B).
     pub l: usize,
+    /// Injected faults, each published as (active, value) (0 without faults: the layout of a
+    /// plant that knows none, such as an external one, is unchanged).
+    #[serde(default)]
+    pub f: usize,
 }
 
 impl PlantLayout {
     /// Total number of values.
     pub fn len(&self) -> usize {
-        self.n + self.p + self.q + self.r + 2 * self.l
+        self.n + self.p + self.q + self.r + 2 * self.l + 2 * self.f
     }
 
     /// Never empty: a plant has at least one state.
@@ -67,5 +71,17 @@ impl PlantLayout {
     pub fn u_prev(&self) -> Range<usize> {
         let s = self.n + self.p + self.q + self.r + self.l;
         s..s + self.l
+    }
+
+    /// Fault i's (active, value) at t_k: 1 while it acts, and its magnitude then (0 otherwise).
+    pub fn fault(&self, i: usize) -> Range<usize> {
+        let s = self.n + self.p + self.q + self.r + 2 * self.l + 2 * i;
+        s..s + 2
+    }
+
+    /// Every fault's pair.
+    pub fn faults(&self) -> Range<usize> {
+        let s = self.n + self.p + self.q + self.r + 2 * self.l;
+        s..s + 2 * self.f
     }
 }

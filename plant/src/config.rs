@@ -2,6 +2,9 @@
 
 use lti::signal::Signal;
 use lti::MatData;
+
+use crate::fault::Fault;
+use crate::noise::Noise;
 use serde::{Deserialize, Serialize};
 
 /// The plant's model, signals and run length.
@@ -31,6 +34,12 @@ pub struct PlantConfig {
     pub steps: u64,
     /// A state whose magnitude exceeds this stops the run.
     pub state_bound: f64,
+    /// Fault distribution F_f, n×m (component faults act through its columns; may be empty).
+    pub ff: MatData,
+    /// Injected faults.
+    pub faults: Vec<Fault>,
+    /// Process and measurement noise, if any.
+    pub noise: Option<Noise>,
 }
 
 #[derive(Deserialize)]
@@ -42,6 +51,8 @@ struct ProtocolModel {
     D: Vec<Vec<f64>>,
     E: Vec<Vec<f64>>,
     x0: Vec<f64>,
+    #[serde(default)]
+    Ff: Vec<Vec<f64>>,
 }
 
 #[derive(Deserialize)]
@@ -50,6 +61,10 @@ struct ProtocolSignals {
     measurement_disturbances: Vec<Signal>,
     inputs: Vec<Signal>,
     state_bound: f64,
+    #[serde(default)]
+    faults: Vec<Fault>,
+    #[serde(default)]
+    noise: Option<Noise>,
 }
 
 /// Rows as a matrix of `nrows` rows (an empty matrix keeps its rows, PROTOCOL.md §3).
@@ -66,7 +81,8 @@ impl PlantConfig {
         let s: ProtocolSignals = serde_json::from_value(cfg.signals.clone()).map_err(|e| format!("signals: {e}"))?;
         let (n, p) = (m.A.len(), m.C.len());
         let ragged = [&m.A, &m.B, &m.C, &m.D, &m.E].iter().any(|x| x.iter().any(|r| r.len() != x[0].len()));
-        if ragged || [&m.B, &m.E].iter().any(|x| x.len() != n) || m.D.len() != p || m.A.iter().chain(&m.C).any(|r| r.len() != n) {
+        let ff_bad = !m.Ff.is_empty() && (m.Ff.len() != n || m.Ff.iter().any(|r| r.len() != m.Ff[0].len()));
+        if ragged || ff_bad || [&m.B, &m.E].iter().any(|x| x.len() != n) || m.D.len() != p || m.A.iter().chain(&m.C).any(|r| r.len() != n) {
             return Err("model: the matrices do not conform".into());
         }
         Ok(PlantConfig {
@@ -82,6 +98,9 @@ impl PlantConfig {
             dt: cfg.dt,
             steps: cfg.steps,
             state_bound: s.state_bound,
+            ff: rows(&m.Ff, n),
+            faults: s.faults,
+            noise: s.noise,
         })
     }
 }

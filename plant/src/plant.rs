@@ -26,6 +26,8 @@ use lti::signal::{locate, Signal, Switch};
 use nalgebra::{DMatrix, DVector};
 
 use crate::config::PlantConfig;
+use crate::fault::{Kind, Scheduled, Target};
+use crate::noise::{Gaussian, Stream, FAULT_BASE, MEASUREMENT, PROCESS};
 
 /// A stretch of a step with its transition matrices.
 #[derive(Debug, Clone)]
@@ -86,6 +88,15 @@ pub struct Plant {
     x_next: DVector<f64>,
     xi: DVector<f64>,
     out: Vec<f64>,
+    faults: Vec<Scheduled>,
+    /// Per fault acting through the state equation: (fault index, Γ₀ column, Γ₁ column).
+    state_faults: Vec<(usize, DVector<f64>, DVector<f64>)>,
+    /// Per fault: its noise stream (sensor noise bursts only).
+    bursts: Vec<Option<Stream>>,
+    process_noise: Option<Gaussian>,
+    measurement_noise: Option<Gaussian>,
+    /// The input applied over the step (the commanded one changed by actuator faults).
+    u_applied: Vec<f64>,
 }
 
 impl Plant {
@@ -137,7 +148,53 @@ impl Plant {
         };
         let full = piece(0.0, cfg.dt);
         let splits = split_steps(cfg, &piece);
-        let layout = PlantLayout { n, p, q, r, l };
+        let layout = PlantLayout { n, p, q, r, l, f: cfg.faults.len() };
+        let ff: DMatrix<f64> = (&cfg.ff).into();
+        for f in &cfg.faults {
+            let fits = match f.target {
+                Target::Actuator(i) => i < l,
+                Target::Sensor(j) => j < p,
+                Target::Component(j) => j < ff.ncols() && ff.nrows() == n,
+            };
+            if !fits {
+                return Err(format!("fault '{}': its target does not exist in this plant", f.name));
+            }
+        }
+        // [Γ₀ Γ₁] of a column f: exp([[A, f, 0], [0, 0, 1], [0, 0, 0]]·dt), see crate::fault.
+        let ramp_generator = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, 0.0, 0.0]);
+        let state_faults = cfg
+            .faults
+            .iter()
+            .enumerate()
+            .filter(|(_, f)| f.through_state())
+            .map(|(i, f)| {
+                let column = match f.target {
+                    Target::Actuator(j) => b.column(j).into_owned(),
+                    Target::Component(j) => ff.column(j).into_owned(),
+                    Target::Sensor(_) => unreachable!("sensor faults act at the sample"),
+                };
+                let mut g = DMatrix::<f64>::zeros(n, 2);
+                g.set_column(0, &column);
+                let (_, gamma) = exp_upper(&a, &g, &ramp_generator, cfg.dt);
+                (i, gamma.column(0).into_owned(), gamma.column(1).into_owned())
+            })
+            .collect();
+        let seed = cfg.noise.as_ref().map_or(0, |z| z.seed);
+        let bursts = cfg
+            .faults
+            .iter()
+            .enumerate()
+            .map(|(i, f)| (f.kind == Kind::Noise).then(|| Stream::new(seed, FAULT_BASE + i as u64)))
+            .collect();
+        let (process_noise, measurement_noise) = match &cfg.noise {
+            Some(z) => {
+                if (z.qd.rows, z.qd.cols) != (n, n) || (z.r.rows, z.r.cols) != (p, p) {
+                    return Err("plant configuration: the noise covariances do not conform".into());
+                }
+                (Gaussian::new(&z.qd, z.seed, PROCESS), Gaussian::new(&z.r, z.seed, MEASUREMENT))
+            }
+            None => (None, None),
+        };
         Ok(Self {
             dt: cfg.dt,
             bound: cfg.state_bound,
@@ -156,6 +213,12 @@ impl Plant {
             x_next: DVector::zeros(n),
             xi: DVector::zeros(m),
             out: vec![0.0; layout.len()],
+            faults: cfg.faults.iter().map(|f| Scheduled::new(f, cfg.dt)).collect(),
+            state_faults,
+            bursts,
+            process_noise,
+            measurement_noise,
+            u_applied: vec![0.0; l],
         })
     }
 
@@ -200,6 +263,28 @@ impl Plant {
         let y = &mut head[lay.y()];
         mul_into(y, &self.c, self.x.as_slice());
         mul_acc(y, &self.d, &tail[lay.v().start - lay.w().start..lay.v().end - lay.w().start]);
+        if let Some(g) = &mut self.measurement_noise {
+            g.add_to(y);
+        }
+        for (i, f) in self.faults.iter().enumerate() {
+            let (phi, _) = f.magnitude(k, dt);
+            let active = f.active(k);
+            if let (Target::Sensor(j), true) = (f.fault.target, active) {
+                match f.fault.kind {
+                    Kind::Stuck => y[j] = f.fault.value,
+                    Kind::Noise => y[j] += f.fault.value * self.bursts[i].as_mut().map_or(0.0, Stream::normal),
+                    _ => y[j] += phi,
+                }
+            }
+            let recorded = match f.fault.kind {
+                Kind::Additive | Kind::Bias | Kind::Drift => phi,
+                _ if active => f.fault.value,
+                _ => 0.0,
+            };
+            let at = lay.fault(i);
+            tail[at.start - lay.w().start] = if active { 1.0 } else { 0.0 };
+            tail[at.start + 1 - lay.w().start] = recorded;
+        }
         &self.out
     }
 
@@ -208,11 +293,21 @@ impl Plant {
         &self.out[self.layout.r()]
     }
 
-    /// x_k → x_{k+1} with u_k held over the step.
+    /// x_k → x_{k+1} with u_k held over the step (as commanded: actuator faults change what
+    /// acts on the plant, not what the observers are told).
     pub fn advance(&mut self, k: u64, u: &[f64]) -> Result<(), Divergence> {
         let t = self.time(k);
         let lay = self.layout;
         self.out[lay.u_prev()].copy_from_slice(u);
+        self.u_applied.copy_from_slice(u);
+        for f in self.faults.iter().filter(|f| f.active(k)) {
+            match (f.fault.target, f.fault.kind) {
+                (Target::Actuator(i), Kind::Stuck) => self.u_applied[i] = f.fault.value,
+                (Target::Actuator(i), Kind::Gain) => self.u_applied[i] *= 1.0 - f.fault.value,
+                _ => {}
+            }
+        }
+        let u = self.u_applied.as_slice();
         let pieces: &[Piece] = match self.splits.get(self.next_split) {
             Some((s, pieces)) if *s == k => {
                 self.next_split += 1;
@@ -233,6 +328,18 @@ impl Plant {
                 held.copy_from_slice(&piece.held);
             }
             integrate(piece, t, u, &self.sines, at_tk, &mut self.xi, &mut self.x, &mut self.x_next);
+        }
+        // Faults through the state equation, over the whole step (superposition: the split of
+        // a step at a disturbance's switching time does not concern them).
+        for (i, g0, g1) in &self.state_faults {
+            let (phi, slope) = self.faults[*i].magnitude(k, self.dt);
+            if phi != 0.0 || slope != 0.0 {
+                self.x.axpy(phi, g0, 1.0);
+                self.x.axpy(slope, g1, 1.0);
+            }
+        }
+        if let Some(g) = &mut self.process_noise {
+            g.add_to(self.x.as_mut_slice());
         }
         for (i, &v) in self.x.iter().enumerate() {
             if !v.is_finite() || v.abs() > self.bound {

@@ -125,3 +125,38 @@ pub fn control_name(s: &Scenario, k: usize) -> String {
         _ => format!("u{}", k + 1),
     }
 }
+
+/// `/fault/<name>/active`: 1 while the fault acts, 0 otherwise.
+pub fn fault_active(name: &str) -> String {
+    format!("/fault/{name}/active")
+}
+
+/// `/fault/<name>/value`: its magnitude while it acts (0 otherwise).
+pub fn fault_value(name: &str) -> String {
+    format!("/fault/{name}/value")
+}
+
+/// `/diagnoser/<d>/residual/<i+1>/<j+1>`: member i's residual on output j.
+pub fn member_residual(diagnoser: &str, i: usize, j: usize) -> String {
+    format!("/diagnoser/{diagnoser}/residual/{}/{}", i + 1, j + 1)
+}
+
+/// `/diagnosis/<d>/evaluation/<i+1>`: J_i, residual i's evaluation.
+pub fn evaluation(diagnoser: &str, i: usize) -> String {
+    format!("/diagnosis/{diagnoser}/evaluation/{}", i + 1)
+}
+
+/// `/diagnosis/<d>/threshold/<i+1>`: residual i's threshold.
+pub fn threshold(diagnoser: &str, i: usize) -> String {
+    format!("/diagnosis/{diagnoser}/threshold/{}", i + 1)
+}
+
+/// `/diagnosis/<d>/alarm/<i+1>`: 1 while residual i is in alarm.
+pub fn alarm(diagnoser: &str, i: usize) -> String {
+    format!("/diagnosis/{diagnoser}/alarm/{}", i + 1)
+}
+
+/// `/diagnosis/<d>/isolated`: the channel isolated (1-based), 0 without alarm, −1 unknown.
+pub fn isolated(diagnoser: &str) -> String {
+    format!("/diagnosis/{diagnoser}/isolated")
+}

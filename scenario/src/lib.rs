@@ -3,6 +3,7 @@
 //! Every problem is reported as one [`ScenarioError`]: file, line:column where known, the field
 //! (as a path such as `plant.A` or `observer[1].poles`), and the reason.
 
+mod fault_diagnosis;
 mod locate;
 mod raw;
 pub mod untrusted;
@@ -16,6 +17,7 @@ use lti::signal::Signal;
 use lti::{Mat, Model};
 use observer::Spec;
 
+pub use fault_diagnosis::NoiseSpec;
 pub use raw::RawExpect;
 pub use untrusted::{quoted, MAX_SCENARIO_BYTES};
 
@@ -58,6 +60,16 @@ pub struct Scenario {
     pub expect: RawExpect,
     /// The file's text (to locate fields in later messages).
     pub source: String,
+    /// The noise generator's seed.
+    pub seed: u64,
+    /// Process and measurement noise, if any.
+    pub noise: Option<NoiseSpec>,
+    /// Fault distribution F_f, n×m (m may be 0).
+    pub ff: Mat,
+    /// Injected faults.
+    pub faults: Vec<plant::Fault>,
+    /// Banks of residual generators.
+    pub diagnosers: Vec<diagnosis::DiagnoserSpec>,
 }
 
 /// A name and a unit ("" when unknown) per component of each signal, in order.
@@ -110,12 +122,19 @@ pub struct ObserverEntry {
     pub spec: Option<Spec>,
     /// The external observer, for `kind = "process"`.
     pub process: Option<ProcessSpec>,
+    /// (diagnoser, member), both 0-based, for a member of a `[[diagnoser]]` bank (designed with
+    /// the bank; neither spec nor process).
+    pub member: Option<(usize, usize)>,
 }
 
 impl ObserverEntry {
-    /// Its kind as the scenario writes it.
+    /// Its kind as the scenario writes it ("bank-member" for a diagnoser's member).
     pub fn kind(&self) -> &'static str {
-        self.spec.as_ref().map_or("process", Spec::kind)
+        match (&self.spec, self.member) {
+            (Some(s), _) => s.kind(),
+            (None, Some(_)) => "bank-member",
+            (None, None) => "process",
+        }
     }
 }
 

@@ -28,6 +28,63 @@ pub struct RawScenario {
     pub observer: Vec<RawObserver>,
     pub controller: Option<RawController>,
     pub expect: Option<RawExpect>,
+    /// The noise generator's seed (default 0; `--seed` overrides it).
+    pub seed: Option<u64>,
+    pub noise: Option<RawNoise>,
+    #[serde(default)]
+    pub fault: Vec<RawFault>,
+    #[serde(default)]
+    pub diagnoser: Vec<RawDiagnoser>,
+}
+
+/// `[noise]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawNoise {
+    /// Q_c: intensity of the continuous process noise ν in ẋ = … + Gν (k×k).
+    pub process: Option<Rows>,
+    /// G, n×k (default I).
+    #[serde(rename = "G")]
+    pub g: Option<Rows>,
+    /// Q_d: covariance of the process noise per step, n×n (instead of `process`).
+    pub process_discrete: Option<Rows>,
+    /// R: covariance of the measurement noise per sample, p×p.
+    pub measurement: Option<Rows>,
+}
+
+/// `[[fault]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawFault {
+    pub name: String,
+    pub target: String,
+    pub channel: i64,
+    pub kind: String,
+    pub value: f64,
+    pub profile: Option<String>,
+    pub start: Option<f64>,
+    pub end: Option<f64>,
+    pub intervals: Option<Vec<Vec<f64>>>,
+}
+
+/// `[[diagnoser]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawDiagnoser {
+    pub name: String,
+    pub scheme: String,
+    pub faults: String,
+    pub observer: Option<String>,
+    pub poles: Option<Vec<RawPole>>,
+    pub placement: Option<String>,
+    pub structure: Option<Vec<Vec<i64>>>,
+    pub evaluation: Option<String>,
+    pub window: Option<i64>,
+    pub forgetting: Option<f64>,
+    pub threshold: Option<f64>,
+    pub false_alarm: Option<f64>,
+    pub persistence: Option<i64>,
+    pub ignore_before: Option<f64>,
 }
 
 /// `[plant]`.
@@ -69,6 +126,9 @@ pub struct RawPlant {
     pub measurement_disturbance_units: Option<Vec<String>>,
     /// Who simulates the true plant, when not the built-in exact linear plant.
     pub process: Option<RawProcess>,
+    /// Fault distribution F_f (n×m): component faults act through its columns.
+    #[serde(rename = "Ff")]
+    pub ff: Option<Rows>,
 }
 
 /// An external component: its command and parameters (PROTOCOL.md §7).
@@ -136,4 +196,11 @@ pub struct RawExpect {
     /// Upper bound on tail error(uio) / tail error(reference): "uio/luenberger" = 1e-4.
     #[serde(default)]
     pub tail_error_ratio: BTreeMap<String, f64>,
+    /// Upper bound on each named fault's detection delay, s.
+    #[serde(default)]
+    pub detection_delay: BTreeMap<String, f64>,
+    /// Every injected fault correctly isolated.
+    pub correct_isolation: Option<bool>,
+    /// Upper bound on the false-alarm episodes.
+    pub false_alarms: Option<u64>,
 }

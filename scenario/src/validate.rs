@@ -16,12 +16,12 @@ use super::untrusted::quoted;
 use super::{ControllerEntry, Named, ObserverEntry, ProcessSpec, Scenario, ScenarioError, SignalNames};
 
 /// Observer kinds a scenario may name.
-pub const KINDS: [&str; 7] = ["luenberger", "chen-patton-uio", "das-ghosal", "das-ghosal-uio", "gi-full-order", "cumming", "hui-zak-uio"];
+pub const KINDS: [&str; 8] = ["luenberger", "chen-patton-uio", "das-ghosal", "das-ghosal-uio", "gi-full-order", "cumming", "hui-zak-uio", "kalman"];
 
 /// Field path and reason, before the location is looked up.
-type Bad = (String, String);
+pub(crate) type Bad = (String, String);
 
-fn bad(field: impl Into<String>, reason: impl Into<String>) -> Bad {
+pub(crate) fn bad(field: impl Into<String>, reason: impl Into<String>) -> Bad {
     (field.into(), reason.into())
 }
 
@@ -55,12 +55,12 @@ fn first_line(s: &str) -> &str {
     s.lines().next().unwrap_or(s).trim()
 }
 
-fn finite(field: &str, v: f64) -> Result<f64, Bad> {
+pub(crate) fn finite(field: &str, v: f64) -> Result<f64, Bad> {
     if v.is_finite() { Ok(v) } else { Err(bad(field, format!("{v} is not a finite number"))) }
 }
 
 /// A matrix from rows: not empty, not ragged, finite, and of the required shape.
-fn matrix(field: &str, rows: &Rows, shape: (Option<usize>, Option<usize>), why: &str) -> Result<Mat, Bad> {
+pub(crate) fn matrix(field: &str, rows: &Rows, shape: (Option<usize>, Option<usize>), why: &str) -> Result<Mat, Bad> {
     if rows.is_empty() || rows.iter().all(|r| r.is_empty()) {
         return Err(bad(field, "must not be empty"));
     }
@@ -124,7 +124,7 @@ fn names(prefix: &str, names: Option<&Vec<String>>, units: Option<&Vec<String>>,
         .collect())
 }
 
-fn poles(field: &str, raw: &[RawPole]) -> Result<Poles, Bad> {
+pub(crate) fn poles(field: &str, raw: &[RawPole]) -> Result<Poles, Bad> {
     let mut specs = Vec::new();
     for (i, p) in raw.iter().enumerate() {
         let f = format!("{field}[{}]", i + 1);
@@ -145,7 +145,7 @@ fn poles(field: &str, raw: &[RawPole]) -> Result<Poles, Bad> {
     Poles::new(specs).map_err(|e| bad(field, e.to_string()))
 }
 
-fn placement(field: &str, p: &Option<String>) -> Result<Method, Bad> {
+pub(crate) fn placement(field: &str, p: &Option<String>) -> Result<Method, Bad> {
     match p.as_deref() {
         None | Some("robust") | Some("yt") => Ok(Method::YangTits),
         Some("knv0") => Ok(Method::Knv0),
@@ -162,7 +162,7 @@ fn placement(field: &str, p: &Option<String>) -> Result<Method, Bad> {
 pub const MAX_NAME_CHARS: usize = 64;
 
 /// A name: 1 to [`MAX_NAME_CHARS`] ASCII letters, digits, '-' or '_'.
-fn check_name(field: &str, name: &str, why: &str) -> Result<(), Bad> {
+pub(crate) fn check_name(field: &str, name: &str, why: &str) -> Result<(), Bad> {
     if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_') {
         return Err(bad(field, format!("{} must be non-empty letters, digits, '-' or '_' ({why})", quoted(name))));
     }
@@ -241,7 +241,18 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
     let disturbances = signals("disturbance", &raw.disturbance, e.ncols(), "plant.E")?;
     let measurement_disturbances = signals("measurement_disturbance", &raw.measurement_disturbance, d.ncols(), "plant.D")?;
     let inputs = signals("input", &raw.input, b.ncols(), "plant.B")?;
+    let ff = match &p.ff {
+        Some(rows) => matrix("plant.Ff", rows, (Some(n), None), "n rows, one column per component fault")?,
+        None => Mat::zeros(n, 0),
+    };
     let model = Model { a, b, c, e, d };
+    let noise = super::fault_diagnosis::noise(&raw.noise, &model, dt)?;
+    let faults = super::fault_diagnosis::faults(&raw.fault, &model, &ff, dt)?;
+    if p.process.is_some() {
+        if let Some(what) = [(!raw.fault.is_empty(), "fault"), (raw.noise.is_some(), "noise")].iter().find(|w| w.0).map(|w| w.1) {
+            return Err(bad(what, "faults and noise are applied by the built-in plant: an external plant (plant.process) models its own"));
+        }
+    }
 
     // Observers.
     let mut seen = BTreeSet::new();
@@ -259,18 +270,39 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
                     return Err(bad(format!("{f}.{key}"), "a process observer takes no design keys (only command and params)"));
                 }
             }
-            ObserverEntry { name: o.name.clone(), spec: None, process: Some(process) }
+            ObserverEntry { name: o.name.clone(), spec: None, process: Some(process), member: None }
         } else {
             if o.command.is_some() || o.params.is_some() {
                 return Err(bad(format!("{f}.command"), format!("only kind = \"process\" takes command and params, not {}", quoted(&o.kind))));
             }
-            ObserverEntry { name: o.name.clone(), spec: Some(observer_spec(&f, o, &model)?), process: None }
+            ObserverEntry { name: o.name.clone(), spec: Some(observer_spec(&f, o, &model, noise.as_ref())?), process: None, member: None }
         });
+    }
+    let mut taken = seen.clone();
+    let diagnosers = super::fault_diagnosis::diagnosers(&raw.diagnoser, &model, &ff, noise.as_ref(), &mut taken)?;
+    // Each bank member runs as an observer of its own, after the scenario's observers.
+    for (di, d) in diagnosers.iter().enumerate() {
+        for j in 0..diagnosis::bank::channel_labels(d.channels, &model, &ff).len() {
+            observers.push(ObserverEntry { name: format!("{}-{}", d.name, j + 1), spec: None, process: None, member: Some((di, j)) });
+        }
     }
 
     let controller = raw.controller.as_ref().map(|c| controller_entry(c, &model, &seen)).transpose()?;
     let expect = raw.expect.unwrap_or_default();
     check_expect(&expect, &seen)?;
+    for (name, &v) in &expect.detection_delay {
+        let f = format!("expect.detection_delay.{name}");
+        if !faults.iter().any(|x| &x.name == name) {
+            return Err(bad(f, format!("no fault named {}", quoted(name))));
+        }
+        if !(v.is_finite() && v > 0.0) {
+            return Err(bad(f, format!("{v} must be a finite number > 0")));
+        }
+    }
+    let judged = !expect.detection_delay.is_empty() || expect.correct_isolation.is_some() || expect.false_alarms.is_some();
+    if judged && diagnosers.is_empty() {
+        return Err(bad("expect", "detection, isolation and false alarms are judged by a [[diagnoser]]; the scenario has none"));
+    }
     Ok(Scenario {
         path: Default::default(),
         name: raw.name,
@@ -290,10 +322,15 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
         plant_process: plant_process(&p.process)?,
         expect,
         source: String::new(),
+        seed: raw.seed.unwrap_or(0),
+        noise,
+        ff,
+        faults,
+        diagnosers,
     })
 }
 
-fn observer_spec(f: &str, o: &RawObserver, model: &Model) -> Result<Spec, Bad> {
+fn observer_spec(f: &str, o: &RawObserver, model: &Model, noise: Option<&super::NoiseSpec>) -> Result<Spec, Bad> {
     if !KINDS.contains(&o.kind.as_str()) {
         return Err(bad(format!("{f}.kind"), format!("{} is not an observer kind ({}, process)", quoted(&o.kind), KINDS.join(", "))));
     }
@@ -313,6 +350,13 @@ fn observer_spec(f: &str, o: &RawObserver, model: &Model) -> Result<Spec, Bad> {
     }
     if !matches!(o.kind.as_str(), "das-ghosal-uio" | "cumming") {
         refuse("H", o.h.is_some())?;
+    }
+    if o.kind == "kalman" {
+        for (key, given) in [("poles", o.poles.is_some()), ("placement", o.placement.is_some())] {
+            refuse(key, given)?;
+        }
+        let z = noise.ok_or_else(|| bad(format!("{f}.kind"), "a kalman observer needs [noise]: its covariances are the filter's"))?;
+        return Ok(Spec::Kalman { qd: z.qd.clone(), r: z.r.clone() });
     }
     Ok(match o.kind.as_str() {
         "luenberger" => Spec::Luenberger { poles: needs_poles()?, placement: method },

@@ -116,7 +116,7 @@ impl Component for FrictionMotor {
         let s = PlantConfig::from_protocol(cfg)?;
         let m = Mats { a: (&s.a).into(), b: (&s.b).into(), c: (&s.c).into(), d: (&s.d).into(), e: (&s.e).into() };
         let p: Params = cfg.params()?;
-        let lay = PlantLayout { n: m.a.nrows(), p: m.c.nrows(), q: m.e.ncols(), r: m.d.ncols(), l: m.b.ncols() };
+        let lay = PlantLayout { n: m.a.nrows(), p: m.c.nrows(), q: m.e.ncols(), r: m.d.ncols(), l: m.b.ncols(), f: 0 };
         if lay.n != 3 || lay.q < 1 {
             return Err(format!("this plant is x = [i, ω, θ] with the load torque as the first unknown input; the scenario has n = {}, q = {}", lay.n, lay.q));
         }

@@ -37,10 +37,22 @@ pub fn is_follower(s: &Scenario, observer: &str) -> bool {
     s.controller.as_ref().is_some_and(|c| c.observer != observer)
 }
 
+/// The plant's noise: the scenario's covariances and seed; a run with only noise-burst faults
+/// still needs the seed.
+pub fn noise(s: &Scenario) -> Option<plant::Noise> {
+    let bursts = s.faults.iter().any(|f| f.kind == plant::fault::Kind::Noise);
+    let (n, p) = (s.model.n(), s.model.p());
+    match &s.noise {
+        Some(z) => Some(plant::Noise { seed: s.seed, qd: (&z.qd).into(), r: (&z.r).into() }),
+        None if bursts => Some(plant::Noise { seed: s.seed, qd: (&lti::Mat::zeros(n, n)).into(), r: (&lti::Mat::zeros(p, p)).into() }),
+        None => None,
+    }
+}
+
 /// Builds the configurations.
 pub fn configs(s: &Scenario, plan: &Plan) -> Configs {
     let m = &s.model;
-    let layout = PlantLayout { n: m.n(), p: m.p(), q: m.e.ncols(), r: m.d.ncols(), l: m.l() };
+    let layout = PlantLayout { n: m.n(), p: m.p(), q: m.e.ncols(), r: m.d.ncols(), l: m.l(), f: s.faults.len() };
     let plant = PlantConfig {
             a: (&m.a).into(),
             b: (&m.b).into(),
@@ -54,6 +66,9 @@ pub fn configs(s: &Scenario, plan: &Plan) -> Configs {
             dt: s.dt,
             steps: s.steps,
             state_bound: s.state_bound,
+            ff: (&s.ff).into(),
+            faults: s.faults.clone(),
+            noise: noise(s),
     };
     let followers = s.observers.iter().map(|o| is_follower(s, &o.name)).collect();
     let observers = plan

@@ -50,8 +50,9 @@ fn rows(m: &lti::Mat) -> Vec<Vec<f64>> {
 
 /// The named ranges of the plant's sample (PROTOCOL.md §4).
 fn fields(l: PlantLayout) -> BTreeMap<String, [usize; 2]> {
-    [("x", l.x()), ("y", l.y()), ("w", l.w()), ("v", l.v()), ("r", l.r()), ("u_prev", l.u_prev())]
+    [("x", l.x()), ("y", l.y()), ("w", l.w()), ("v", l.v()), ("r", l.r()), ("u_prev", l.u_prev()), ("faults", l.faults())]
         .into_iter()
+        .filter(|(k, r)| *k != "faults" || !r.is_empty())
         .map(|(k, r)| (k.to_string(), [r.start, r.end]))
         .collect()
 }
@@ -71,7 +72,7 @@ pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> V
         steps: s.steps,
         publishes,
         reads,
-        model: json!({ "A": rows(&m.a), "B": rows(&m.b), "C": rows(&m.c), "D": rows(&m.d), "E": rows(&m.e), "x0": s.x0 }),
+        model: json!({ "A": rows(&m.a), "B": rows(&m.b), "C": rows(&m.c), "D": rows(&m.d), "E": rows(&m.e), "Ff": rows(&s.ff), "x0": s.x0 }),
         signals: Value::Null,
         params,
     };
@@ -88,10 +89,11 @@ pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> V
     if s.controller.is_some() {
         reads.push(ReadSpec { service: "controller".into(), len: lay.l, lag: 0, sleep_us: None, fields: BTreeMap::new() });
     }
-    let sample_names = [&s.names.state, &s.names.output, &s.names.disturbance, &s.names.measurement_disturbance, &s.names.input, &s.names.input]
+    let mut sample_names: Vec<String> = [&s.names.state, &s.names.output, &s.names.disturbance, &s.names.measurement_disturbance, &s.names.input, &s.names.input]
         .iter()
         .flat_map(|l| names(l))
         .collect();
+    sample_names.extend(s.faults.iter().flat_map(|f| [format!("{}.active", f.name), format!("{}.value", f.name)]));
     let publishes = PublishSpec { service: "plant".into(), len: lay.len(), names: sample_names };
     let (program, params) = match &s.plant_process {
         Some(p) => (Program::External(p.clone()), p.params.clone()),
@@ -104,6 +106,8 @@ pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> V
         "measurement_disturbances": s.measurement_disturbances,
         "inputs": s.inputs,
         "state_bound": s.state_bound,
+        "faults": s.faults,
+        "noise": cfg.plant.noise,
     });
     out.push(Launchable { label: "plant".into(), program, config: plant });
 

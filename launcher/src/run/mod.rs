@@ -148,7 +148,7 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
     let partial = rrd.as_ref().map(|p| p.with_extension("rrd.partial"));
     interrupt::install();
     let cfg = configs(s, plan);
-    let mut session = Session::new(s, cfg.layout, partial.as_deref(), &opts.select).inspect_err(|_| {
+    let mut session = Session::new(s, cfg.layout, &plan.banks, partial.as_deref(), &opts.select).inspect_err(|_| {
         // A recording that could not even be started is of no use to anyone.
         if let Some(p) = &partial {
             let _ = fs::remove_file(p);
@@ -171,7 +171,7 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
         Err(e) => Stop::Failed(e.to_string()),
     };
     let steps_done = session.steps;
-    let (mut metrics, latency, digest) = session.finish().map_err(|e| {
+    let (mut metrics, latency, digest, diagnosis) = session.finish().map_err(|e| {
         // Say why the run had stopped too, when the recording's failure is not the whole story.
         let why = match &stop {
             Stop::Completed => String::new(),
@@ -185,7 +185,7 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
     if let (Some(from), Some(to)) = (&partial, &rrd) {
         fs::rename(from, to).map_err(|e| LaunchError::Component(format!("{}: cannot rename the recording into place: {e}", to.display())))?;
     }
-    let mut summary = Summary::new(s, plan, opts, &metrics, &latency, wall, &stop, rrd.as_deref());
+    let mut summary = Summary::new(s, plan, opts, &metrics, &latency, wall, &stop, rrd.as_deref(), diagnosis);
     summary.recording_digest = digest;
     if let Some(path) = &summary_path {
         summary.write(path).map_err(LaunchError::Component)?;

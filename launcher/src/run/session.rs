@@ -6,6 +6,7 @@ use lockstep::PlantLayout;
 
 use super::progress::Progress;
 use crate::error::LaunchError;
+use diagnosis::{Bank, Diagnosis, FaultInfo, Judge, Monitor};
 use recording::write::Selection;
 use recording::palette;
 use recording::signals as sig;
@@ -33,7 +34,14 @@ struct Channels {
     v: Vec<SeriesId>,
     r: Vec<SeriesId>,
     u: Vec<SeriesId>,
-    observers: Vec<ObserverChannels>,
+    /// None for a bank member (recorded under `/diagnoser`).
+    observers: Vec<Option<ObserverChannels>>,
+    /// Per bank: per member, its residual's outputs.
+    members: Vec<Vec<Vec<SeriesId>>>,
+    /// Per bank: (evaluation, threshold, alarm) per member, and the isolation.
+    decisions: Vec<(Vec<[SeriesId; 3]>, SeriesId)>,
+    /// Per fault: (active, value).
+    faults: Vec<[SeriesId; 2]>,
     step_latency: SeriesId,
     /// One per hop; the last is controller→plant (late) when there is a controller.
     hops: Vec<SeriesId>,
@@ -58,6 +66,28 @@ pub struct Session {
     pub progress: Option<Progress>,
     /// The hops a row completes, reused from step to step (no allocation per step).
     hop_values: Vec<(usize, u64)>,
+    /// One per diagnoser bank: its decisions step by step.
+    monitors: Vec<Monitor>,
+    /// The diagnosis figures (with any bank).
+    judge: Option<Judge>,
+    /// Per bank, the false-alarm probability its χ² thresholds were asked for.
+    asked: Vec<Option<f64>>,
+}
+
+/// The faults of a scenario as the figures see them.
+fn fault_infos(s: &Scenario) -> Vec<FaultInfo> {
+    use plant::fault::Target;
+    s.faults
+        .iter()
+        .map(|f| {
+            let (channels, channel) = match f.target {
+                Target::Actuator(i) => (diagnosis::Channels::Actuator, i),
+                Target::Sensor(j) => (diagnosis::Channels::Sensor, j),
+                Target::Component(j) => (diagnosis::Channels::Component, j),
+            };
+            FaultInfo { name: f.name.clone(), channels, channel, start: f.profile.start() }
+        })
+        .collect()
 }
 
 /// A recording's digest: entity → 16 hex digits.
@@ -81,7 +111,16 @@ pub fn hop_entity(hop: &str) -> String {
 impl Session {
     /// Starts a session; with `rrd`, opens the recording there.
     /// `select` thins and filters what is written; the figures see every step.
-    pub fn new(s: &Scenario, layout: PlantLayout, rrd: Option<&Path>, select: &Selection) -> Result<Self, LaunchError> {
+    pub fn new(s: &Scenario, layout: PlantLayout, banks: &[Bank], rrd: Option<&Path>, select: &Selection) -> Result<Self, LaunchError> {
+        let monitors: Vec<Monitor> = banks
+            .iter()
+            .map(|b| {
+                let index = b.members.iter().map(|mb| s.observers.iter().position(|o| o.name == mb.name).expect("members are observers")).collect();
+                Monitor::new(b, index, &s.model.c, s.dt)
+            })
+            .collect();
+        let asked = banks.iter().map(|b| if let diagnosis::Threshold::FalseAlarm(a) = b.spec.threshold { Some(a) } else { None }).collect();
+        let judge = (!banks.is_empty()).then(|| Judge::new(fault_infos(s), &monitors, s.dt));
         let controller_observer = s.controller.as_ref().and_then(|c| s.observers.iter().position(|o| o.name == c.observer));
         let hops = hop_names(s);
         let sink = match rrd {
@@ -113,13 +152,45 @@ impl Session {
                     .iter()
                     .map(|o| {
                         let name = &o.name;
-                        ObserverChannels {
+                        o.member.is_none().then(|| ObserverChannels {
                             xhat: (0..layout.n).map(|i| series(signals, sig::estimate(name, i), format!("{} ({name})", names.state[i].name))).collect(),
                             error: (0..layout.n).map(|i| series(signals, sig::error(name, i), format!("e{} ({name})", i + 1))).collect(),
                             residual: (0..layout.p).map(|j| series(signals, sig::residual(name, j), format!("r{} ({name})", j + 1))).collect(),
                             log_error: series(signals, sig::log_error(name), format!("log10 max|e| ({name})")),
-                        }
+                        })
                     })
+                    .collect();
+                let members = banks
+                    .iter()
+                    .map(|b| {
+                        let d = &b.spec.name;
+                        b.members
+                            .iter()
+                            .enumerate()
+                            .map(|(i, mb)| mb.outputs.iter().map(|&j| series(signals, sig::member_residual(d, i, j), format!("r{} {} ({d})", i + 1, names.output[j].name))).collect())
+                            .collect()
+                    })
+                    .collect();
+                let decisions = banks
+                    .iter()
+                    .map(|b| {
+                        let d = &b.spec.name;
+                        let per = (0..b.members.len())
+                            .map(|i| {
+                                [
+                                    series(signals, sig::evaluation(d, i), format!("J{} ({d})", i + 1)),
+                                    series(signals, sig::threshold(d, i), format!("threshold {} ({d})", i + 1)),
+                                    series(signals, sig::alarm(d, i), format!("alarm {} ({d})", i + 1)),
+                                ]
+                            })
+                            .collect();
+                        (per, series(signals, sig::isolated(d), format!("isolated channel ({d})")))
+                    })
+                    .collect();
+                let faults = s
+                    .faults
+                    .iter()
+                    .map(|f| [series(signals, sig::fault_active(&f.name), format!("{} active", f.name)), series(signals, sig::fault_value(&f.name), format!("{} value", f.name))])
                     .collect();
                 let step_latency = series(hops_late, "/latency/step".into(), "step".into());
                 let late = s.controller.is_some();
@@ -131,7 +202,7 @@ impl Session {
                 for p in select.unmatched(paths.iter().map(String::as_str)) {
                     eprintln!("warning: --record {}: matches no signal of this run, so records nothing", scenario::quoted(&p));
                 }
-                Some((sink, Channels { signals, hops_now, hops_late, x, y, w, v, r, u, observers, step_latency, hops: hop_ids }))
+                Some((sink, Channels { signals, hops_now, hops_late, x, y, w, v, r, u, observers, members, decisions, faults, step_latency, hops: hop_ids }))
             }
             None => None,
         };
@@ -146,6 +217,9 @@ impl Session {
             dt: s.dt,
             progress: None,
             hop_values: Vec::with_capacity(s.observers.len() + 2),
+            monitors,
+            judge,
+            asked,
         })
     }
 
@@ -211,13 +285,19 @@ impl Session {
 
     fn push(&mut self, row: &StepRow, step_ns: Option<(u64, u64)>, hops: &[(usize, u64)]) -> Result<(), LaunchError> {
         self.metrics.push(row);
+        let lay = self.layout;
+        for m in &mut self.monitors {
+            m.step(row.k, &row.plant[lay.y()], &row.xhat);
+        }
+        if let Some(j) = &mut self.judge {
+            j.push(row.k, &self.monitors);
+        }
         self.steps += 1;
         if let Some(p) = &mut self.progress {
             p.tick(self.steps);
         }
         let Some((sink, ch)) = &mut self.sink else { return Ok(()) };
         let (k, t) = (row.k, row.t);
-        let lay = self.layout;
         sink.row(ch.signals, k, t);
         let put = |sink: &mut RrdSink, ids: &[SeriesId], vals: &[f64]| {
             for (&id, &v) in ids.iter().zip(vals) {
@@ -231,11 +311,27 @@ impl Session {
         put(sink, &ch.r, &row.plant[lay.r()]);
         put(sink, &ch.u, &row.u);
         for (o, oc) in ch.observers.iter().enumerate() {
+            let Some(oc) = oc else { continue };
             put(sink, &oc.xhat, &row.xhat[o]);
             put(sink, &oc.error, &self.metrics.error[o]);
             put(sink, &oc.residual, &self.metrics.residual[o]);
             // max_i |e_i| of this step, as the figures took it.
             sink.push(oc.log_error, sig::log10_floored(self.metrics.observers[o].final_abs_error));
+        }
+        for ((m, members), (decisions, isolated)) in self.monitors.iter().zip(&ch.members).zip(&ch.decisions) {
+            for (i, ids) in members.iter().enumerate() {
+                put(sink, ids, &m.residuals[i]);
+                let [e, th, al] = decisions[i];
+                sink.push(e, m.evals[i]);
+                sink.push(th, m.thresholds[i]);
+                sink.push(al, if m.alarms[i] { 1.0 } else { 0.0 });
+            }
+            sink.push(*isolated, m.isolation.code());
+        }
+        for (i, [active, value]) in ch.faults.iter().enumerate() {
+            let f = &row.plant[lay.fault(i)];
+            sink.push(*active, f[0]);
+            sink.push(*value, f[1]);
         }
         // Latencies are recorded at the step they belong to: the step time and the
         // controller→plant hop of step k−1 complete with row k (in-process: step k itself).
@@ -254,7 +350,7 @@ impl Session {
 
     /// Closes the recording (footer written); returns the figures and the recording's digest.
     /// Fails, naming the file, when the recording could not be written whole.
-    pub fn finish(self) -> Result<(Metrics, Latency, Option<Digest>), LaunchError> {
+    pub fn finish(self) -> Result<(Metrics, Latency, Option<Digest>, Option<Diagnosis>), LaunchError> {
         if let Some(p) = self.progress {
             p.finish();
         }
@@ -262,6 +358,7 @@ impl Session {
             Some((sink, _)) => Some(sink.finish(self.steps).map_err(LaunchError::Component)?),
             None => None,
         };
-        Ok((self.metrics, self.latency, digest))
+        let diagnosis = self.judge.map(|j| j.finish(&self.monitors, &self.asked));
+        Ok((self.metrics, self.latency, digest, diagnosis))
     }
 }

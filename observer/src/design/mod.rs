@@ -16,6 +16,7 @@ mod cumming;
 mod das_ghosal;
 mod gi_full_order;
 mod hui_zak;
+mod kalman;
 mod luenberger;
 
 use lti::eig::{eigenvalues, format_list, format_one};
@@ -44,6 +45,9 @@ pub enum Spec {
     Cumming { poles: Poles, placement: Method, h: Option<Mat> },
     /// Hui & Żak's projection unknown-input observer (seed 004).
     HuiZak { decay: f64, poles: Option<Poles>, placement: Method, path: Path },
+    /// The steady-state Kalman filter of the sampled plant for process-noise covariance Q_d
+    /// (per step, n×n) and measurement-noise covariance R (p×p).
+    Kalman { qd: Mat, r: Mat },
 }
 
 impl Spec {
@@ -57,6 +61,7 @@ impl Spec {
             Spec::GiFullOrder { .. } => "gi-full-order",
             Spec::Cumming { .. } => "cumming",
             Spec::HuiZak { .. } => "hui-zak-uio",
+            Spec::Kalman { .. } => "kalman",
         }
     }
 
@@ -319,5 +324,6 @@ pub fn design(model: &Model, spec: &Spec, dt: f64) -> Result<Designed, DesignErr
         Spec::GiFullOrder { poles, placement } => gi_full_order::design(model, poles, *placement, dt),
         Spec::Cumming { poles, placement, h } => cumming::design(model, poles, *placement, h.as_ref(), dt),
         Spec::HuiZak { decay, poles, placement, path } => hui_zak::design(model, *decay, poles.as_ref(), *placement, *path, dt),
+        Spec::Kalman { qd, r } => kalman::design(model, qd, r, dt),
     }
 }

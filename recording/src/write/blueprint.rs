@@ -25,6 +25,22 @@ fn state_title(i: usize, x: &Named) -> String {
     if x.name == format!("x{}", i + 1) { format!("x{}{}", i + 1, if x.unit.is_empty() { String::new() } else { format!(" [{}]", x.unit) }) } else { format!("x{}: {}", i + 1, x.with_unit()) }
 }
 
+/// Per bank: its residuals, their evaluations against the thresholds, the alarms and the
+/// isolated channel; and the injected faults for reference.
+fn diagnosis_views(s: &Scenario) -> Vec<ContainerLike> {
+    let mut views: Vec<ContainerLike> = Vec::new();
+    for d in &s.diagnosers {
+        let n = &d.name;
+        views.push(TimeSeriesView::new(format!("residuals ({n})")).with_contents([format!("/diagnoser/{n}/residual/**")]).into());
+        views.push(TimeSeriesView::new(format!("evaluations J and thresholds ({n})")).with_contents([format!("/diagnosis/{n}/evaluation/**"), format!("/diagnosis/{n}/threshold/**")]).into());
+        views.push(TimeSeriesView::new(format!("alarms, isolated channel ({n})")).with_contents([format!("/diagnosis/{n}/alarm/**"), signals::isolated(n)]).into());
+    }
+    if !s.faults.is_empty() {
+        views.push(TimeSeriesView::new("injected faults").with_contents(["/fault/**"]).into());
+    }
+    views
+}
+
 /// The blueprint for a scenario's recording.
 pub fn blueprint(s: &Scenario) -> Blueprint {
     let states: Vec<ContainerLike> = s
@@ -34,16 +50,17 @@ pub fn blueprint(s: &Scenario) -> Blueprint {
         .enumerate()
         .map(|(i, x)| {
             let mut contents = vec![signals::state(i)];
-            contents.extend(s.observers.iter().map(|o| signals::estimate(&o.name, i)));
+            contents.extend(s.observers.iter().filter(|o| o.member.is_none()).map(|o| signals::estimate(&o.name, i)));
             TimeSeriesView::new(state_title(i, x)).with_contents(contents).into()
         })
         .collect();
     let mut per_observer: Vec<ContainerLike> = Vec::new();
-    if !s.observers.is_empty() {
-        let logs: Vec<String> = s.observers.iter().map(|o| signals::log_error(&o.name)).collect();
+    let plain: Vec<_> = s.observers.iter().filter(|o| o.member.is_none()).collect();
+    if !plain.is_empty() {
+        let logs: Vec<String> = plain.iter().map(|o| signals::log_error(&o.name)).collect();
         per_observer.push(TimeSeriesView::new("log10 max|e|").with_contents(logs).into());
     }
-    for o in &s.observers {
+    for o in &plain {
         per_observer.push(TimeSeriesView::new(format!("error e = x − x̂ ({})", o.name)).with_contents([format!("/observer/{}/error/**", o.name)]).into());
         per_observer.push(TimeSeriesView::new(format!("residual r = y − Cx̂ ({})", o.name)).with_contents([format!("/observer/{}/residual/**", o.name)]).into());
     }
@@ -57,11 +74,15 @@ pub fn blueprint(s: &Scenario) -> Blueprint {
     plant_signals.push(TimeSeriesView::new(titled(inputs_title, &with_units(&n.input))).with_contents(["/input/**", "/controller/**"]).into());
     plant_signals.push(TimeSeriesView::new(titled("outputs", &with_units(&n.output))).with_contents(["/plant/y/**"]).into());
     plant_signals.push(TimeSeriesView::new("latency [ns]").with_contents(["/latency/**"]).into());
-    let root = Vertical::new([
+    let mut sections: Vec<ContainerLike> = vec![
         Grid::new(states).with_name("states and estimates").into(),
         Grid::new(per_observer).with_name("errors and residuals").into(),
-        Horizontal::new(plant_signals).with_name("signals").into(),
-    ]);
+    ];
+    if !s.diagnosers.is_empty() || !s.faults.is_empty() {
+        sections.push(Grid::new(diagnosis_views(s)).with_name("diagnosis").into());
+    }
+    sections.push(Horizontal::new(plant_signals).with_name("signals").into());
+    let root = Vertical::new(sections);
     Blueprint::new(root)
         .with_auto_views(false)
         .with_time_panel(TimePanel::new().with_timeline("sim_time").with_play_state(PlayState::Paused).with_state(PanelState::Collapsed))

@@ -1,0 +1,127 @@
+//! Decisions per step: alarms from evaluations and thresholds, isolation by the structure matrix.
+//!
+//! Residual i is in alarm once J_i has exceeded its threshold at `persistence` consecutive
+//! samples, and until it no longer does. The alarm pattern a ∈ {0, 1}^m is then matched against
+//! the columns of the structure matrix: channel j is isolated when a equals column j, and the
+//! fault is "unknown" when a matches no column (or several). Before `ignore_before` nothing is
+//! decided: the observers start from zero and their start-up transient is no fault.
+
+use lti::kernel::mul_into;
+use lti::Mat;
+
+use crate::bank::Bank;
+use crate::evaluate::Evaluator;
+
+/// The decision of one step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Isolation {
+    /// No alarm.
+    None,
+    /// The alarm pattern is channel j's signature (0-based).
+    Channel(usize),
+    /// Alarms that match no single channel.
+    Unknown,
+}
+
+impl Isolation {
+    /// As recorded: 0 none, j + 1 for channel j, −1 unknown.
+    pub fn code(self) -> f64 {
+        match self {
+            Isolation::None => 0.0,
+            Isolation::Channel(j) => (j + 1) as f64,
+            Isolation::Unknown => -1.0,
+        }
+    }
+}
+
+/// One bank's decision logic over a run.
+#[derive(Debug, Clone)]
+pub struct Monitor {
+    /// The diagnoser's name.
+    pub name: String,
+    /// Its channel class.
+    pub channels: crate::Channels,
+    /// Channel labels.
+    pub labels: Vec<String>,
+    /// The structure matrix.
+    pub structure: Vec<Vec<u8>>,
+    /// Index of each member's estimate among the run's observers.
+    observers: Vec<usize>,
+    outputs: Vec<Vec<usize>>,
+    evaluators: Vec<Evaluator>,
+    /// Per member.
+    pub thresholds: Vec<f64>,
+    persistence: u32,
+    /// The first step decided.
+    pub start_step: u64,
+    c: Mat,
+    full: Vec<f64>,
+    counts: Vec<u32>,
+    /// This step's residual per member (on its outputs).
+    pub residuals: Vec<Vec<f64>>,
+    /// This step's J per member.
+    pub evals: Vec<f64>,
+    /// J > threshold, per member, this step.
+    pub exceed: Vec<bool>,
+    /// Alarm per member, this step.
+    pub alarms: Vec<bool>,
+    /// This step's isolation.
+    pub isolation: Isolation,
+}
+
+impl Monitor {
+    /// For `bank`, whose member i's estimate is observer `observers[i]` of the run.
+    pub fn new(bank: &Bank, observers: Vec<usize>, c: &Mat, dt: f64) -> Self {
+        let m = bank.members.len();
+        let start_step = (bank.spec.ignore_before / dt - 1e-9).ceil().max(0.0) as u64;
+        Monitor {
+            name: bank.spec.name.clone(),
+            channels: bank.spec.channels,
+            labels: bank.channels.clone(),
+            structure: bank.structure.clone(),
+            observers,
+            outputs: bank.members.iter().map(|mb| mb.outputs.clone()).collect(),
+            evaluators: bank.members.iter().map(|mb| Evaluator::new(bank.spec.evaluation, mb.covariance.as_ref())).collect(),
+            thresholds: bank.members.iter().map(|mb| mb.threshold).collect(),
+            persistence: bank.spec.persistence.max(1),
+            start_step,
+            c: c.clone(),
+            full: vec![0.0; c.nrows()],
+            counts: vec![0; m],
+            residuals: bank.members.iter().map(|mb| vec![0.0; mb.outputs.len()]).collect(),
+            evals: vec![0.0; m],
+            exceed: vec![false; m],
+            alarms: vec![false; m],
+            isolation: Isolation::None,
+        }
+    }
+
+    /// Step k: residuals of the members' estimates against y_k, evaluations, alarms, isolation.
+    pub fn step(&mut self, k: u64, y: &[f64], xhat: &[Vec<f64>]) {
+        let deciding = k >= self.start_step;
+        for i in 0..self.observers.len() {
+            mul_into(&mut self.full, &self.c, &xhat[self.observers[i]]);
+            for (r, &j) in self.residuals[i].iter_mut().zip(&self.outputs[i]) {
+                *r = y[j] - self.full[j];
+            }
+            let j = self.evaluators[i].push(&self.residuals[i]);
+            self.evals[i] = j;
+            self.exceed[i] = j > self.thresholds[i];
+            self.counts[i] = if self.exceed[i] && deciding { self.counts[i].saturating_add(1) } else { 0 };
+            self.alarms[i] = self.counts[i] >= self.persistence;
+        }
+        self.isolation = self.isolate();
+    }
+
+    fn isolate(&self) -> Isolation {
+        if !self.alarms.iter().any(|&a| a) {
+            return Isolation::None;
+        }
+        let m = self.labels.len();
+        let matches: Vec<usize> = (0..m).filter(|&j| self.structure.iter().zip(&self.alarms).all(|(row, &a)| (row[j] == 1) == a)).collect();
+        match matches.as_slice() {
+            [j] => Isolation::Channel(*j),
+            _ => Isolation::Unknown,
+        }
+    }
+}

@@ -1,0 +1,208 @@
+//! The diagnosis figures of a run: when each injected fault was detected, what it was isolated
+//! as, and the false alarms.
+//!
+//! * A fault's window runs from its start to the next fault's start (or the end of the run). It
+//!   is detected at the first step of its window with an alarm of any bank, and isolated as the
+//!   first single channel a bank of its class names in its window; that is correct when it is
+//!   the fault's own channel.
+//! * Fault-free steps are those before the first fault starts (all of them in a run without
+//!   faults) from the bank's first decided step on. An alarm there is false; `false_alarms` counts
+//!   the episodes (an alarm switching on), `false_alarm_steps` the steps.
+//! * Per residual, the fraction of fault-free steps whose evaluation exceeds its threshold: for a
+//!   χ² threshold, the measured false-alarm probability against the one asked for.
+
+use serde::Serialize;
+
+use crate::decide::{Isolation, Monitor};
+use crate::spec::Channels;
+
+/// An injected fault, as the figures need it.
+#[derive(Debug, Clone)]
+pub struct FaultInfo {
+    /// Its name.
+    pub name: String,
+    /// The class of its target.
+    pub channels: Channels,
+    /// Its channel (0-based).
+    pub channel: usize,
+    /// When it first acts, s.
+    pub start: f64,
+}
+
+/// One fault's figures.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct FaultFigure {
+    /// Name.
+    pub name: String,
+    /// When it started, s.
+    pub start: f64,
+    /// The first alarm in its window, s.
+    pub detected_at: Option<f64>,
+    /// detected_at − start, s.
+    pub delay: Option<f64>,
+    /// The fault (or channel) the banks named.
+    pub isolated_as: Option<String>,
+    /// When the isolation was made, s.
+    pub isolated_at: Option<f64>,
+    /// Whether it named the fault's own channel.
+    pub correct: bool,
+}
+
+/// One residual's behaviour without faults.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct ResidualFigure {
+    /// `<diagnoser>-<i>`.
+    pub residual: String,
+    /// Its threshold.
+    pub threshold: f64,
+    /// The false-alarm probability asked for (χ² thresholds).
+    pub asked_false_alarm: Option<f64>,
+    /// Fault-free steps decided.
+    pub fault_free_steps: u64,
+    /// How many of them exceeded the threshold.
+    pub exceedances: u64,
+    /// exceedances / fault_free_steps.
+    pub exceedance_rate: Option<f64>,
+}
+
+/// The `diagnosis` of summary.json.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Diagnosis {
+    /// Alarm episodes while no fault acted.
+    pub false_alarms: u64,
+    /// Steps in alarm while no fault acted.
+    pub false_alarm_steps: u64,
+    /// Fault-free time decided, s.
+    pub fault_free_time: f64,
+    /// Per injected fault, in start order.
+    pub faults: Vec<FaultFigure>,
+    /// Per residual.
+    pub residuals: Vec<ResidualFigure>,
+}
+
+/// Accumulates the figures step by step.
+#[derive(Debug, Clone)]
+pub struct Judge {
+    dt: f64,
+    faults: Vec<FaultInfo>,
+    /// [start, end) step of each fault's window.
+    windows: Vec<(u64, u64)>,
+    first_fault: u64,
+    figures: Vec<FaultFigure>,
+    false_alarms: u64,
+    false_alarm_steps: u64,
+    fault_free_steps: u64,
+    was_alarm: bool,
+    /// Per monitor, per member: (fault-free steps, exceedances).
+    counts: Vec<Vec<(u64, u64)>>,
+}
+
+fn step_of(t: f64, dt: f64) -> u64 {
+    if t.is_finite() { (t / dt - 1e-9).ceil().max(0.0) as u64 } else { u64::MAX }
+}
+
+impl Judge {
+    /// For a run with these faults and monitors.
+    pub fn new(mut faults: Vec<FaultInfo>, monitors: &[Monitor], dt: f64) -> Self {
+        faults.sort_by(|a, b| a.start.total_cmp(&b.start));
+        let starts: Vec<u64> = faults.iter().map(|f| step_of(f.start, dt)).collect();
+        let windows = starts.iter().map(|&s| (s, starts.iter().copied().filter(|&t| t > s).min().unwrap_or(u64::MAX))).collect();
+        let figures = faults
+            .iter()
+            .map(|f| FaultFigure { name: f.name.clone(), start: f.start, detected_at: None, delay: None, isolated_as: None, isolated_at: None, correct: false })
+            .collect();
+        Judge {
+            dt,
+            first_fault: starts.first().copied().unwrap_or(u64::MAX),
+            faults,
+            windows,
+            figures,
+            false_alarms: 0,
+            false_alarm_steps: 0,
+            fault_free_steps: 0,
+            was_alarm: false,
+            counts: monitors.iter().map(|m| vec![(0, 0); m.thresholds.len()]).collect(),
+        }
+    }
+
+    /// Takes step k's decisions.
+    pub fn push(&mut self, k: u64, monitors: &[Monitor]) {
+        let t = k as f64 * self.dt;
+        let any = monitors.iter().any(|m| m.alarms.iter().any(|&a| a));
+        if k < self.first_fault {
+            let decided = monitors.iter().any(|m| k >= m.start_step);
+            if decided {
+                self.fault_free_steps += 1;
+            }
+            if any {
+                self.false_alarm_steps += 1;
+                if !self.was_alarm {
+                    self.false_alarms += 1;
+                }
+            }
+            for (m, counts) in monitors.iter().zip(&mut self.counts) {
+                if k >= m.start_step {
+                    for (c, &e) in counts.iter_mut().zip(&m.exceed) {
+                        c.0 += 1;
+                        c.1 += u64::from(e);
+                    }
+                }
+            }
+        }
+        self.was_alarm = any;
+        for (i, f) in self.faults.iter().enumerate() {
+            let (from, to) = self.windows[i];
+            if k < from || k >= to {
+                continue;
+            }
+            let fig = &mut self.figures[i];
+            if any && fig.detected_at.is_none() {
+                fig.detected_at = Some(t);
+                fig.delay = Some(t - f.start);
+            }
+            if fig.isolated_as.is_none() {
+                for m in monitors.iter().filter(|m| m.channels == f.channels) {
+                    if let Isolation::Channel(j) = m.isolation {
+                        // Name the fault on that channel: this one if it is, else another fault
+                        // of the run there, else the channel itself.
+                        let named = if j == f.channel {
+                            f.name.clone()
+                        } else {
+                            self.faults.iter().find(|g| g.channels == m.channels && g.channel == j).map_or_else(|| m.labels[j].clone(), |g| g.name.clone())
+                        };
+                        fig.isolated_as = Some(named);
+                        fig.isolated_at = Some(t);
+                        fig.correct = j == f.channel;
+                        break;
+                    }
+                }
+            }
+        }
+    }
+
+    /// The figures, with the thresholds asked for per monitor (χ² α, if any).
+    pub fn finish(self, monitors: &[Monitor], asked: &[Option<f64>]) -> Diagnosis {
+        let residuals = monitors
+            .iter()
+            .zip(&self.counts)
+            .zip(asked)
+            .flat_map(|((m, counts), &alpha)| {
+                counts.iter().enumerate().map(move |(i, &(steps, exc))| ResidualFigure {
+                    residual: format!("{}-{}", m.name, i + 1),
+                    threshold: m.thresholds[i],
+                    asked_false_alarm: alpha,
+                    fault_free_steps: steps,
+                    exceedances: exc,
+                    exceedance_rate: (steps > 0).then(|| exc as f64 / steps as f64),
+                })
+            })
+            .collect();
+        Diagnosis {
+            false_alarms: self.false_alarms,
+            false_alarm_steps: self.false_alarm_steps,
+            fault_free_time: self.fault_free_steps as f64 * self.dt,
+            faults: self.figures,
+            residuals,
+        }
+    }
+}

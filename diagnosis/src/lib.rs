@@ -1,0 +1,25 @@
+//! Fault diagnosis with banks of observers (Chen & Patton, "Robust Model-Based Fault Diagnosis
+//! for Dynamic Systems", 1999, ch. 3; Frank 1990): pure math, no I/O.
+//!
+//! * [`spec`] — what a `[[diagnoser]]` asks for: scheme, channels, member design, evaluation,
+//!   threshold, decision;
+//! * [`bank`] — the members' models and designs (each one a [`observer::LinearObserver`]), and
+//!   the bank's structure matrix computed from them ([`structure`]);
+//! * [`covariance`] — the stationary covariance of a member's residual under the noise;
+//! * [`evaluate`] — residual evaluation signals and thresholds;
+//! * [`decide`] — alarms and isolation per step ([`Monitor`]);
+//! * [`figures`] — detection times, isolation, false alarms of a run.
+
+pub mod bank;
+pub mod covariance;
+pub mod decide;
+pub mod evaluate;
+pub mod figures;
+pub mod spec;
+pub mod structure;
+
+pub use bank::{design_bank, Bank, Member};
+pub use decide::{Isolation, Monitor};
+pub use figures::{Diagnosis, FaultFigure, FaultInfo, Judge, ResidualFigure};
+pub use bank::BankError;
+pub use spec::{Channels, DiagnoserSpec, Evaluation, MemberKind, Scheme, Threshold};

@@ -1,0 +1,78 @@
+//! Which residual reacts to which fault, computed from the designs.
+//!
+//! A member (F, G, K, P, Q) on the sampled plant, with a fault entering the state through a
+//! column γ (x_{k+1} = Φx_k + γφ_k) or adding to output j (y_k = Cx_k + e_jφ_k), and residual
+//! r = S(y − Cx̂) on its outputs S, is the system (u and the initial state do not matter for a
+//! transfer)
+//!
+//! ```text
+//! [x; z]_{k+1} = [[Φ, 0], [KC, F]] [x; z]_k + B_f φ_k,      B_f = [γ; 0]  or  [0; K e_j]
+//! r_k = S[(I − CQ)C, −CP] [x; z]_k + D_f φ_k,                D_f = 0      or  S(I − CQ)e_j
+//! ```
+//!
+//! Its transfer from φ to r is identically zero iff every Markov parameter D_f, C_a A_a^k B_f
+//! (k < dim) is: the residual is then blind to the fault (for a UIO member, T γ = 0). Each is
+//! measured relative to ‖C_a‖‖A_a^k‖‖B_f‖, so that rounding is told from a response.
+
+use lti::Mat;
+use nalgebra::DVector;
+use observer::LinearObserver;
+
+/// How a fault enters the plant.
+#[derive(Debug, Clone)]
+pub enum FaultInput {
+    /// Through the state: the sampled column γ (for a fault held over the step).
+    State(DVector<f64>),
+    /// Added to output j.
+    Output(usize),
+}
+
+/// Relative size of a response below which it is rounding.
+pub const BLIND: f64 = 1e-9;
+
+/// The largest relative Markov parameter of the fault-to-residual transfer: ≈ ε for a residual
+/// blind to the fault, O(1e-3 … 1) for one that reacts.
+pub fn sensitivity(phi: &Mat, c: &Mat, obs: &LinearObserver, outputs: &[usize], input: &FaultInput) -> f64 {
+    let (n, p) = (phi.nrows(), c.nrows());
+    let f: Mat = (&obs.f).into();
+    let k: Mat = (&obs.k).into();
+    let pm: Mat = (&obs.p).into();
+    let q: Mat = (&obs.q).into();
+    let r = f.nrows();
+    let dim = n + r;
+    let mut a = Mat::zeros(dim, dim);
+    a.view_mut((0, 0), (n, n)).copy_from(phi);
+    a.view_mut((n, 0), (r, n)).copy_from(&(&k * c));
+    a.view_mut((n, n), (r, r)).copy_from(&f);
+    let s = Mat::from_fn(outputs.len(), p, |i, j| if outputs[i] == j { 1.0 } else { 0.0 });
+    let i_cq = Mat::identity(p, p) - c * &q;
+    let mut ca = Mat::zeros(outputs.len(), dim);
+    ca.view_mut((0, 0), (outputs.len(), n)).copy_from(&(&s * &i_cq * c));
+    ca.view_mut((0, n), (outputs.len(), r)).copy_from(&(-(&s * c * &pm)));
+    let mut b = DVector::zeros(dim);
+    let mut direct = 0.0;
+    match input {
+        FaultInput::State(g) => b.rows_mut(0, n).copy_from(g),
+        FaultInput::Output(j) => {
+            b.rows_mut(n, r).copy_from(&k.column(*j));
+            direct = (&s * i_cq.column(*j)).norm() / (s.norm() * i_cq.column(*j).norm()).max(f64::MIN_POSITIVE);
+        }
+    }
+    let (cn, bn) = (ca.norm(), b.norm());
+    let mut worst = direct;
+    let mut ak = Mat::identity(dim, dim);
+    for _ in 0..dim {
+        let h = &ca * &ak * &b;
+        let scale = cn * ak.norm() * bn;
+        if scale > 0.0 {
+            worst = worst.max(h.norm() / scale);
+        }
+        ak = &a * ak;
+    }
+    worst
+}
+
+/// Whether the residual reacts to the fault.
+pub fn reacts(phi: &Mat, c: &Mat, obs: &LinearObserver, outputs: &[usize], input: &FaultInput) -> bool {
+    sensitivity(phi, c, obs, outputs, input) > BLIND
+}

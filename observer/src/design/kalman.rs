@@ -1,0 +1,45 @@
+//! The steady-state discrete Kalman filter of the exact sampled plant (Kalman 1960; Anderson &
+//! Moore, "Optimal Filtering", 1979, ch. 4), the baseline a control engineer reaches for:
+//!
+//! ```text
+//! x_{k+1} = Φ x_k + B_d u_k + w_k,  y_k = C x_k + ν_k,   cov w = Q_d,  cov ν = R,
+//! P = ΦPΦᵀ − ΦPCᵀ(CPCᵀ + R)⁻¹CPΦᵀ + Q_d,       M = PCᵀ(CPCᵀ + R)⁻¹,
+//! x̂_{k|k} = x̂_{k|k−1} + M (y_k − C x̂_{k|k−1}),   x̂_{k+1|k} = Φ x̂_{k|k} + B_d u_k.
+//! ```
+//!
+//! With z_k = x̂_{k|k−1} this is the runtime form z_{k+1} = Φ(I − MC) z + B_d u + ΦM y,
+//! x̂_k = (I − MC) z + M y: the filtered estimate. The unknown inputs w(t) of the scenario are
+//! not modelled (they are what the unknown-input observers reject and the filter does not).
+//! There is no continuous design: the report's poles are ln(z)/dt of the filter's.
+
+use lti::{steady_state_kalman, Mat, Model, C64};
+
+use super::{eig, require_stable, Checks, Designed, DesignError, Domain, Report};
+use crate::runtime::LinearObserver;
+
+const KIND: &str = "kalman";
+
+pub(super) fn design(model: &Model, qd: &Mat, r: &Mat, dt: f64) -> Result<Designed, DesignError> {
+    let mut checks = Checks::sampled(KIND, dt);
+    let dm = model.discretize(dt);
+    let kf = steady_state_kalman(&dm.a, &dm.c, qd, r).map_err(|e| checks.error("DARE(Φᵀ, Cᵀ, Q_d, R) has a stabilising solution", e.to_string()))?;
+    let n = model.n();
+    let p_upd = Mat::identity(n, n) - &kf.gain * &dm.c;
+    let f = &dm.a * &p_upd;
+    let discrete = eig(&f);
+    require_stable(&mut checks, "Φ(I − MC) stable", &discrete, Domain::Discrete(dt))?;
+    let continuous: Vec<C64> = discrete.iter().map(|z| z.ln() / dt).collect();
+    let runtime = LinearObserver::new(&f, &dm.b, &kf.predictor_gain, &p_upd, &kf.gain);
+    Ok(Designed {
+        report: Report {
+            kind: KIND,
+            conditions: checks.into_list(),
+            matrices: vec![("M".into(), kf.gain.clone()), ("P".into(), kf.p.clone()), ("S".into(), kf.innovation.clone())],
+            poles: continuous,
+            discrete_poles: discrete,
+            fixed_modes: vec![],
+            notes: vec![format!("ρ(Φ(I − MC)) = {:.6}", kf.radius)],
+        },
+        runtime,
+    })
+}
