@@ -10,6 +10,7 @@ pub mod plan;
 pub mod run;
 pub mod shipped;
 pub mod summary;
+pub mod sweep;
 
 pub use error::LaunchError;
 pub use scenario::Scenario;

@@ -56,6 +56,30 @@ enum Command {
         #[arg(long)]
         seed: Option<u64>,
     },
+    /// Monte Carlo: run N noise realisations (seeds S, S+1, …) and write DIR/<name>.sweep.json
+    /// with detection delays, isolation accuracy, false-alarm rates and tail errors.
+    Sweep {
+        /// The scenario file, or the name of a shipped scenario (see `list`).
+        scenario: PathBuf,
+        /// Realisations.
+        #[arg(long, default_value_t = 100)]
+        runs: usize,
+        /// Worker threads (default: every core; processes mode runs one at a time).
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// The first seed (default: the scenario's `seed`).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Where the realisations run.
+        #[arg(long, value_parser = ["processes", "in-process"], default_value = "in-process")]
+        mode: String,
+        /// Output directory.
+        #[arg(long, default_value = "runs")]
+        out: PathBuf,
+        /// Run the K worst realisations again with a recording (DIR/<name>-seed<S>.rrd).
+        #[arg(long, value_name = "K", default_value_t = 0)]
+        keep_worst: usize,
+    },
     /// Check the existence conditions and show the designs of a scenario.
     Design {
         /// The scenario file, or the name of a shipped scenario (see `list`).
@@ -211,6 +235,33 @@ fn main() -> ExitCode {
                         Stop::Diverged(w) => fail(&LaunchError::Diverged(format!("{}: run stopped: {w}", s.name))),
                         Stop::Interrupted(sig) => fail(&LaunchError::Interrupted(format!("{}: run interrupted by {sig}; recording closed", s.name))),
                         Stop::Failed(w) => fail(&LaunchError::Component(format!("{}: {w}", s.name))),
+                    }
+                }
+                Err(e) => fail(&e),
+            }
+        }
+        Command::Sweep { scenario, runs, jobs, seed, mode, out, keep_worst } => {
+            let s = match load(&scenario) {
+                Ok(s) => s,
+                Err(e) => return fail(&e),
+            };
+            let p = match plan::plan(&s) {
+                Ok(p) => p,
+                Err(e) => return fail(&LaunchError::Scenario(e.error)),
+            };
+            let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+            let mode = if mode == "processes" { Mode::Processes } else { Mode::InProcess };
+            let opts = launcher::sweep::SweepOptions { runs, jobs, seed: seed.unwrap_or(s.seed), mode, out: out.clone(), keep_worst, wait: Wait::default_for_machine() };
+            run::interrupt::install();
+            match launcher::sweep::sweep(&s, &p, &opts) {
+                Ok(sw) => {
+                    print!("{}", sw.table());
+                    match sw.write(&out) {
+                        Ok(path) => {
+                            println!("sweep summary: {}", path.display());
+                            ExitCode::SUCCESS
+                        }
+                        Err(e) => fail(&LaunchError::Component(e)),
                     }
                 }
                 Err(e) => fail(&e),

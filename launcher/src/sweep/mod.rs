@@ -1,0 +1,319 @@
+//! `launcher sweep`: Monte Carlo over the noise. Realisation i runs the scenario with seed
+//! S + i (S = `--seed`, or the scenario's `seed`), without a recording; the figures of every
+//! realisation are gathered into distributions: detection delay, isolation accuracy,
+//! false-alarm rate per hour of fault-free simulated time, each residual's measured exceedance
+//! rate beside the false-alarm probability its χ² threshold was asked for, and each observer's
+//! tail error. Realisations are independent and gathered in seed order, so the result is the
+//! same whatever the number of jobs. The worst realisations can be run again with a recording
+//! (the same seed gives the same run, bit for bit).
+
+mod stats;
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::Instant;
+
+use serde::Serialize;
+
+pub use stats::{spread, Spread};
+
+use crate::error::LaunchError;
+use crate::plan::Plan;
+use crate::run::{self, Mode, Options, Stop};
+use crate::summary::Summary;
+use scenario::Scenario;
+
+/// How to sweep.
+#[derive(Debug, Clone)]
+pub struct SweepOptions {
+    /// Realisations.
+    pub runs: usize,
+    /// Worker threads (in-process mode).
+    pub jobs: usize,
+    /// The first seed.
+    pub seed: u64,
+    /// In-process (default) or processes (one realisation at a time).
+    pub mode: Mode,
+    /// Where the sweep summary (and kept recordings) go.
+    pub out: PathBuf,
+    /// Run the worst realisations again with a recording.
+    pub keep_worst: usize,
+    /// Wait strategy (processes mode).
+    pub wait: lockstep::Wait,
+}
+
+/// One fault over the sweep.
+#[derive(Debug, Clone, Serialize)]
+pub struct FaultSweep {
+    /// Its name.
+    pub name: String,
+    /// Realisations that detected it.
+    pub detected: usize,
+    /// Delays of those, s.
+    pub detection_delay: Option<Spread>,
+    /// Realisations that isolated it correctly.
+    pub isolated_correctly: usize,
+    /// isolated_correctly / runs.
+    pub isolation_accuracy: f64,
+}
+
+/// One residual over the sweep.
+#[derive(Debug, Clone, Serialize)]
+pub struct ResidualSweep {
+    /// `<diagnoser>-<i>`.
+    pub residual: String,
+    /// Its threshold.
+    pub threshold: f64,
+    /// The false-alarm probability per sample asked for (χ²).
+    pub asked_false_alarm: Option<f64>,
+    /// Fault-free samples decided, over all realisations.
+    pub fault_free_steps: u64,
+    /// How many exceeded the threshold.
+    pub exceedances: u64,
+    /// exceedances / fault_free_steps: the measured false-alarm probability per sample.
+    pub measured_false_alarm: Option<f64>,
+}
+
+/// The sweep's summary (`<name>.sweep.json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct SweepSummary {
+    /// Scenario name.
+    pub scenario: String,
+    /// Realisations.
+    pub runs: usize,
+    /// Seeds used: first and last.
+    pub seeds: [u64; 2],
+    /// Mode.
+    pub mode: String,
+    /// Jobs.
+    pub jobs: usize,
+    /// Wall-clock time, s.
+    pub wall_s: f64,
+    /// Realisations that stopped early (diverged, failed), by seed.
+    pub stopped: Vec<(u64, String)>,
+    /// Per fault.
+    pub faults: Vec<FaultSweep>,
+    /// Alarm episodes while no fault acted, over all realisations.
+    pub false_alarms: u64,
+    /// Realisations with at least one false alarm.
+    pub runs_with_false_alarms: usize,
+    /// Fault-free simulated time decided, over all realisations, s.
+    pub fault_free_time_s: f64,
+    /// false_alarms per hour of fault-free simulated time.
+    pub false_alarm_rate_per_hour: Option<f64>,
+    /// Per residual.
+    pub residuals: Vec<ResidualSweep>,
+    /// Per observer: its tail max |x − x̂| over the realisations.
+    pub tail_max_abs_error: Vec<(String, Option<Spread>)>,
+    /// The seeds of the realisations kept with a recording (worst first).
+    pub kept: Vec<u64>,
+}
+
+/// Runs realisation `seed`.
+fn one(s: &Scenario, plan: &Plan, seed: u64, opts: &SweepOptions, record: bool) -> Result<Summary, LaunchError> {
+    let mut s = s.clone();
+    s.seed = seed;
+    if record {
+        s.name = format!("{}-seed{seed}", s.name);
+    }
+    let o = Options {
+        out: opts.out.clone(),
+        mode: opts.mode,
+        wait: opts.wait,
+        force: true,
+        allow_unstable: false,
+        record,
+        pin: false,
+        select: recording::write::Selection::default(),
+        progress: false,
+    };
+    let outcome = run::run(&s, plan, &o)?;
+    if let Stop::Interrupted(sig) = outcome.stop {
+        return Err(LaunchError::Interrupted(format!("{}: sweep interrupted by {sig}", s.name)));
+    }
+    Ok(outcome.summary)
+}
+
+/// How bad a realisation went: wrong isolations, then false alarms, then the longest delay.
+fn badness(s: &Summary) -> (usize, u64, u64) {
+    let Some(d) = &s.diagnosis else { return (0, 0, 0) };
+    let wrong = d.faults.iter().filter(|f| !f.correct).count();
+    let delay = d.faults.iter().map(|f| f.delay.map_or(u64::MAX, |x| (x * 1e9) as u64)).max().unwrap_or(0);
+    (wrong, d.false_alarms, delay)
+}
+
+/// Runs the sweep.
+pub fn sweep(s: &Scenario, plan: &Plan, opts: &SweepOptions) -> Result<SweepSummary, LaunchError> {
+    if opts.runs == 0 {
+        return Err(LaunchError::BadInput("--runs must be at least 1".into()));
+    }
+    std::fs::create_dir_all(&opts.out).map_err(|e| LaunchError::BadInput(format!("{}: cannot create the output directory: {e}", opts.out.display())))?;
+    let jobs = if opts.mode == Mode::Processes { 1 } else { opts.jobs.clamp(1, opts.runs) };
+    let start = Instant::now();
+    let next = AtomicUsize::new(0);
+    let results: Mutex<Vec<Option<Result<Summary, LaunchError>>>> = Mutex::new((0..opts.runs).map(|_| None).collect());
+    let bar = progress_bar(opts.runs);
+    std::thread::scope(|scope| {
+        for _ in 0..jobs {
+            scope.spawn(|| loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                if i >= opts.runs || run::interrupt::received().is_some() {
+                    break;
+                }
+                let r = one(s, plan, opts.seed.wrapping_add(i as u64), opts, false);
+                let failed = r.is_err();
+                results.lock().expect("no worker panics")[i] = Some(r);
+                if let Some(b) = &bar {
+                    b.inc(1);
+                }
+                if failed {
+                    next.store(opts.runs, Ordering::Relaxed);
+                }
+            });
+        }
+    });
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    if let Some(sig) = run::interrupt::received() {
+        return Err(LaunchError::Interrupted(format!("{}: sweep interrupted by {sig}", s.name)));
+    }
+    let mut summaries = Vec::with_capacity(opts.runs);
+    for r in results.into_inner().expect("no worker panics").into_iter().flatten() {
+        summaries.push(r?);
+    }
+    let mut out = gather(s, opts, jobs, &summaries);
+    out.wall_s = start.elapsed().as_secs_f64();
+    // The worst realisations, again, with their recordings.
+    let mut order: Vec<usize> = (0..summaries.len()).collect();
+    order.sort_by_key(|&i| std::cmp::Reverse(badness(&summaries[i])));
+    for &i in order.iter().take(opts.keep_worst) {
+        let seed = opts.seed.wrapping_add(i as u64);
+        one(s, plan, seed, opts, true)?;
+        out.kept.push(seed);
+    }
+    Ok(out)
+}
+
+fn progress_bar(total: usize) -> Option<indicatif::ProgressBar> {
+    use std::io::IsTerminal;
+    std::io::stderr().is_terminal().then(|| {
+        let b = indicatif::ProgressBar::new(total as u64);
+        if let Ok(style) = indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} realisations, {eta} left") {
+            b.set_style(style);
+        }
+        b
+    })
+}
+
+/// The distributions over the realisations' summaries, in seed order.
+pub fn gather(s: &Scenario, opts: &SweepOptions, jobs: usize, runs: &[Summary]) -> SweepSummary {
+    let stopped = runs.iter().enumerate().filter_map(|(i, r)| r.stopped.clone().map(|w| (opts.seed.wrapping_add(i as u64), w))).collect();
+    let diag: Vec<&diagnosis::Diagnosis> = runs.iter().filter_map(|r| r.diagnosis.as_ref()).collect();
+    let faults = s
+        .faults
+        .iter()
+        .map(|f| {
+            let figs: Vec<&diagnosis::FaultFigure> = diag.iter().filter_map(|d| d.faults.iter().find(|x| x.name == f.name)).collect();
+            let delays: Vec<f64> = figs.iter().filter_map(|x| x.delay).collect();
+            let correct = figs.iter().filter(|x| x.correct).count();
+            FaultSweep { name: f.name.clone(), detected: delays.len(), detection_delay: spread(&delays), isolated_correctly: correct, isolation_accuracy: correct as f64 / runs.len() as f64 }
+        })
+        .collect();
+    let false_alarms: u64 = diag.iter().map(|d| d.false_alarms).sum();
+    let fault_free: f64 = diag.iter().map(|d| d.fault_free_time).sum();
+    let mut residuals: Vec<ResidualSweep> = Vec::new();
+    for d in &diag {
+        for r in &d.residuals {
+            match residuals.iter_mut().find(|x| x.residual == r.residual) {
+                Some(x) => {
+                    x.fault_free_steps += r.fault_free_steps;
+                    x.exceedances += r.exceedances;
+                }
+                None => residuals.push(ResidualSweep {
+                    residual: r.residual.clone(),
+                    threshold: r.threshold,
+                    asked_false_alarm: r.asked_false_alarm,
+                    fault_free_steps: r.fault_free_steps,
+                    exceedances: r.exceedances,
+                    measured_false_alarm: None,
+                }),
+            }
+        }
+    }
+    for x in &mut residuals {
+        x.measured_false_alarm = (x.fault_free_steps > 0).then(|| x.exceedances as f64 / x.fault_free_steps as f64);
+    }
+    let tail = s
+        .observers
+        .iter()
+        .map(|o| {
+            let v: Vec<f64> = runs.iter().filter_map(|r| r.observers.iter().find(|x| x.name == o.name).and_then(|x| x.tail_max_abs_error)).collect();
+            (o.name.clone(), spread(&v))
+        })
+        .collect();
+    SweepSummary {
+        scenario: s.name.clone(),
+        runs: runs.len(),
+        seeds: [opts.seed, opts.seed.wrapping_add(runs.len().saturating_sub(1) as u64)],
+        mode: opts.mode.name().into(),
+        jobs,
+        wall_s: 0.0,
+        stopped,
+        faults,
+        false_alarms,
+        runs_with_false_alarms: diag.iter().filter(|d| d.false_alarms > 0).count(),
+        fault_free_time_s: fault_free,
+        false_alarm_rate_per_hour: (fault_free > 0.0).then(|| false_alarms as f64 / fault_free * 3600.0),
+        residuals,
+        tail_max_abs_error: tail,
+        kept: Vec::new(),
+    }
+}
+
+impl SweepSummary {
+    /// Writes `<out>/<name>.sweep.json` (atomically).
+    pub fn write(&self, out: &Path) -> Result<PathBuf, String> {
+        let path = out.join(format!("{}.sweep.json", self.scenario));
+        let tmp = path.with_extension("json.tmp");
+        let text = serde_json::to_string_pretty(self).expect("serialises");
+        std::fs::write(&tmp, text + "\n").and_then(|_| std::fs::rename(&tmp, &path)).map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+        Ok(path)
+    }
+
+    /// The table printed after a sweep.
+    pub fn table(&self) -> String {
+        let f = |s: &Option<Spread>| s.as_ref().map_or_else(|| "—".to_string(), |s| format!("{:.4} / {:.4} / {:.4} / {:.4}", s.min, s.median, s.p95, s.max));
+        let mut t = format!("{} sweep: {} realisations (seeds {}–{}), {}, {} job(s), {:.1} s wall\n", self.scenario, self.runs, self.seeds[0], self.seeds[1], self.mode, self.jobs, self.wall_s);
+        for x in &self.faults {
+            t += &format!(
+                "  fault {:<18} detected {}/{}  delay min/median/p95/max {} s  isolated correctly {:.1} %\n",
+                x.name,
+                x.detected,
+                self.runs,
+                f(&x.detection_delay),
+                100.0 * x.isolation_accuracy
+            );
+        }
+        t += &format!(
+            "  false alarms: {} over {:.1} s fault-free ({} per hour; {} realisation(s) with one)\n",
+            self.false_alarms,
+            self.fault_free_time_s,
+            self.false_alarm_rate_per_hour.map_or_else(|| "—".to_string(), |r| format!("{r:.3}")),
+            self.runs_with_false_alarms
+        );
+        for r in &self.residuals {
+            let asked = r.asked_false_alarm.map_or_else(|| "—".to_string(), |a| format!("{a:.1e}"));
+            let measured = r.measured_false_alarm.map_or_else(|| "—".to_string(), |m| format!("{m:.3e}"));
+            t += &format!("  residual {:<12} P(J > threshold) asked {asked}, measured {measured} ({} of {} fault-free samples)\n", r.residual, r.exceedances, r.fault_free_steps);
+        }
+        for (name, s) in &self.tail_max_abs_error {
+            t += &format!("  observer {:<12} tail max|e| min/median/p95/max {}\n", name, f(s));
+        }
+        for (seed, why) in &self.stopped {
+            t += &format!("  seed {seed} stopped: {why}\n");
+        }
+        t
+    }
+}
