@@ -22,6 +22,8 @@ pub fn threshold_for(spec: &DiagnoserSpec, cov: Option<&Mat>) -> Result<(f64, us
     let dof = cov.map_or(0, |c| whitening(c).nrows());
     match spec.threshold {
         Threshold::Fixed(t) => Ok((t, dof)),
+        // Not known until the fault-free realisations have run: nothing exceeds it meanwhile.
+        Threshold::Calibrated { .. } => Ok((f64::INFINITY, dof)),
         Threshold::FalseAlarm(alpha) => {
             if spec.evaluation != Evaluation::Chi2 {
                 return Err("a false-alarm probability sets a χ² threshold: it needs evaluation = \"chi2\"".into());

@@ -63,6 +63,8 @@ pub struct ResidualFigure {
     pub exceedances: u64,
     /// exceedances / fault_free_steps.
     pub exceedance_rate: Option<f64>,
+    /// The largest evaluation J on those steps (what a calibrated threshold is made from).
+    pub max_fault_free_evaluation: Option<f64>,
 }
 
 /// The `diagnosis` of summary.json.
@@ -95,6 +97,8 @@ pub struct Judge {
     was_alarm: bool,
     /// Per monitor, per member: (fault-free steps, exceedances).
     counts: Vec<Vec<(u64, u64)>>,
+    /// Per monitor, per member: the largest J on fault-free decided steps.
+    max_eval: Vec<Vec<f64>>,
 }
 
 fn step_of(t: f64, dt: f64) -> u64 {
@@ -122,6 +126,7 @@ impl Judge {
             fault_free_steps: 0,
             was_alarm: false,
             counts: monitors.iter().map(|m| vec![(0, 0); m.thresholds.len()]).collect(),
+            max_eval: monitors.iter().map(|m| vec![f64::NEG_INFINITY; m.thresholds.len()]).collect(),
         }
     }
 
@@ -140,11 +145,12 @@ impl Judge {
                     self.false_alarms += 1;
                 }
             }
-            for (m, counts) in monitors.iter().zip(&mut self.counts) {
+            for ((m, counts), max) in monitors.iter().zip(&mut self.counts).zip(&mut self.max_eval) {
                 if k >= m.start_step {
-                    for (c, &e) in counts.iter_mut().zip(&m.exceed) {
+                    for ((c, &e), (top, &j)) in counts.iter_mut().zip(&m.exceed).zip(max.iter_mut().zip(&m.evals)) {
                         c.0 += 1;
                         c.1 += u64::from(e);
+                        *top = top.max(j);
                     }
                 }
             }
@@ -184,9 +190,9 @@ impl Judge {
     pub fn finish(self, monitors: &[Monitor], asked: &[Option<f64>]) -> Diagnosis {
         let residuals = monitors
             .iter()
-            .zip(&self.counts)
+            .zip(self.counts.iter().zip(&self.max_eval))
             .zip(asked)
-            .flat_map(|((m, counts), &alpha)| {
+            .flat_map(|((m, (counts, max)), &alpha)| {
                 counts.iter().enumerate().map(move |(i, &(steps, exc))| ResidualFigure {
                     residual: format!("{}-{}", m.name, i + 1),
                     threshold: m.thresholds[i],
@@ -194,6 +200,7 @@ impl Judge {
                     fault_free_steps: steps,
                     exceedances: exc,
                     exceedance_rate: (steps > 0).then(|| exc as f64 / steps as f64),
+                    max_fault_free_evaluation: (steps > 0).then_some(max[i]),
                 })
             })
             .collect();

@@ -77,6 +77,9 @@ pub enum Threshold {
     Fixed(f64),
     /// The χ²(p_i) quantile 1 − α: a fault-free sample exceeds it with probability α.
     FalseAlarm(f64),
+    /// `margin` × the largest evaluation of `runs` fault-free realisations (set by the launcher
+    /// before the run; see `launcher/src/calibrate.rs`).
+    Calibrated { runs: usize, margin: f64 },
 }
 
 /// One `[[diagnoser]]`.

@@ -179,7 +179,11 @@ fn banks_report(s: &Scenario) -> (String, Vec<Value>, bool) {
                 let mut members = Vec::new();
                 for (i, m) in b.members.iter().enumerate() {
                     let role = diagnosis::bank::role(d, &b.channels, i);
-                    text += &format!("  {} ({role}): {}, sampled poles {}, threshold {}\n", m.name, m.designed.report.kind, format_list(&m.designed.report.discrete_poles), sig(m.threshold));
+                    let threshold = match d.threshold {
+                        diagnosis::Threshold::Calibrated { runs, margin } => format!("{margin} × the largest J of {runs} fault-free realisation(s), set when run"),
+                        _ => sig(m.threshold),
+                    };
+                    text += &format!("  {} ({role}): {}, sampled poles {}, threshold {threshold}\n", m.name, m.designed.report.kind, format_list(&m.designed.report.discrete_poles));
                     members.push(json!({
                         "name": m.name, "role": role, "kind": m.designed.report.kind,
                         "outputs": m.outputs.iter().map(|j| j + 1).collect::<Vec<_>>(),

@@ -3,6 +3,7 @@
 //! Rerun `.rrd` with a summary of how each observer did.
 
 pub mod bench;
+pub mod calibrate;
 pub mod design_report;
 pub mod error;
 pub mod output;

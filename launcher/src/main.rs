@@ -211,10 +211,13 @@ fn main() -> ExitCode {
             if let Some(seed) = seed {
                 s.seed = seed;
             }
-            let p = match plan::plan(&s) {
+            let mut p = match plan::plan(&s) {
                 Ok(p) => p,
                 Err(e) => return fail(&LaunchError::Scenario(e.error)),
             };
+            if let Err(e) = launcher::calibrate::calibrate(&s, &mut p) {
+                return fail(&e);
+            }
             for w in &p.warnings {
                 eprintln!("warning: {w}");
             }
@@ -245,10 +248,16 @@ fn main() -> ExitCode {
                 Ok(s) => s,
                 Err(e) => return fail(&e),
             };
-            let p = match plan::plan(&s) {
+            let mut p = match plan::plan(&s) {
                 Ok(p) => p,
                 Err(e) => return fail(&LaunchError::Scenario(e.error)),
             };
+            // One calibration for every realisation, from the first seed.
+            let mut first = s.clone();
+            first.seed = seed.unwrap_or(s.seed);
+            if let Err(e) = launcher::calibrate::calibrate(&first, &mut p) {
+                return fail(&e);
+            }
             let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
             let mode = if mode == "processes" { Mode::Processes } else { Mode::InProcess };
             let opts = launcher::sweep::SweepOptions { runs, jobs, seed: seed.unwrap_or(s.seed), mode, out: out.clone(), keep_worst, wait: Wait::default_for_machine() };

@@ -29,6 +29,9 @@ fn sinusoidal_disturbance_matches_scipy() {
         dt: 1e-3,
         steps: 1000,
         state_bound: 1e9,
+        ff: lti::MatData { rows: 0, cols: 0, data: vec![] },
+        faults: vec![],
+        noise: None,
     };
     let mut plant = Plant::new(&cfg).unwrap();
     let u = [0.5, -0.2];
@@ -83,6 +86,9 @@ fn divergence_names_the_state_and_step() {
         dt: 1e-2,
         steps: 100,
         state_bound: 1e6,
+        ff: lti::MatData { rows: 0, cols: 0, data: vec![] },
+        faults: vec![],
+        noise: None,
     };
     let mut plant = Plant::new(&cfg).unwrap();
     let mut k = 0;
@@ -114,6 +120,9 @@ fn scalar(w: Signal, steps: u64) -> PlantConfig {
         dt: 1e-3,
         steps,
         state_bound: 1e9,
+        ff: lti::MatData { rows: 0, cols: 0, data: vec![] },
+        faults: vec![],
+        noise: None,
     }
 }
 

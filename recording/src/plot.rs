@@ -135,6 +135,23 @@ fn views(r: &Recording, s: Option<&Scenario>, observers: &[String]) -> Vec<View>
     out.push(View { file: "inputs.png".into(), title: "known inputs r and controller output u".into(), y_label: common_unit("r, u", &units), scale: Scale::Linear, series });
     let (series, units) = group(&["/plant/y"]);
     out.push(View { file: "outputs.png".into(), title: "measured outputs y".into(), y_label: common_unit("y", &units), scale: Scale::Linear, series });
+    // Diagnosis: per bank its evaluations against their thresholds and its decisions, then the
+    // injected faults (legends as recorded).
+    let recorded = |prefix: &str| -> Vec<(String, String)> {
+        r.series.keys().filter(|p| p.starts_with(prefix)).map(|p| (r.names.get(p).cloned().unwrap_or_else(|| p.clone()), p.clone())).collect()
+    };
+    let mut banks: Vec<&str> = r.series.keys().filter_map(|p| p.strip_prefix("/diagnosis/").and_then(|x| x.split_once('/')).map(|(d, _)| d)).collect();
+    banks.dedup();
+    for d in banks {
+        let series = [recorded(&format!("/diagnosis/{d}/evaluation/")), recorded(&format!("/diagnosis/{d}/threshold/"))].concat();
+        out.push(View { file: format!("diagnosis_{}.png", sanitize(d)), title: format!("residual evaluations J and thresholds ({d})"), y_label: "J".into(), scale: Scale::Linear, series });
+        let series = [recorded(&format!("/diagnosis/{d}/alarm/")), recorded(&format!("/diagnosis/{d}/isolated"))].concat();
+        out.push(View { file: format!("alarms_{}.png", sanitize(d)), title: format!("alarms and isolated channel ({d}; 0 none, −1 unknown)"), y_label: "alarm, channel".into(), scale: Scale::Linear, series });
+    }
+    let faults: Vec<(String, String)> = recorded("/fault/").into_iter().filter(|(_, p)| p.ends_with("/value")).collect();
+    if !faults.is_empty() {
+        out.push(View { file: "faults.png".into(), title: "injected faults (magnitude while active)".into(), y_label: "fault".into(), scale: Scale::Linear, series: faults });
+    }
     let latency = r.series.keys().filter(|p| p.starts_with("/latency/")).map(|p| (r.names.get(p).cloned().unwrap_or_else(|| p.trim_start_matches("/latency/").to_string()), p.clone())).collect();
     out.push(View { file: "latency.png".into(), title: "lockstep latency, log scale".into(), y_label: "latency [µs]".into(), scale: Scale::Log, series: latency });
     out

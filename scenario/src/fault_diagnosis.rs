@@ -276,7 +276,25 @@ pub(crate) fn diagnosers(raw: &[RawDiagnoser], model: &Model, ff: &Mat, noise: O
         if d.forgetting.is_some() && !matches!(evaluation, Evaluation::Forgetting { .. }) {
             return Err(bad(at("forgetting"), "only evaluation = \"forgetting\" takes forgetting"));
         }
+        let given = [d.threshold.is_some(), d.false_alarm.is_some(), d.calibrate.is_some()].iter().filter(|&&g| g).count();
+        if given > 1 {
+            return Err(bad(at("threshold"), "give one of threshold, false_alarm and calibrate"));
+        }
         let threshold = match (d.threshold, d.false_alarm) {
+            _ if d.calibrate.is_some() => {
+                let c = d.calibrate.as_ref().expect("given");
+                if c.runs < 1 {
+                    return Err(bad(at("calibrate.runs"), format!("{} must be a whole number of realisations ≥ 1", c.runs)));
+                }
+                let margin = finite(&at("calibrate.margin"), c.margin.unwrap_or(1.2))?;
+                if margin < 1.0 {
+                    return Err(bad(at("calibrate.margin"), format!("{margin} must be ≥ 1 (the threshold is margin × the largest fault-free J)")));
+                }
+                if noise.is_none() {
+                    return Err(bad(at("calibrate"), "calibration runs fault-free noisy realisations: the scenario has no [noise]"));
+                }
+                Threshold::Calibrated { runs: c.runs as usize, margin }
+            }
             (Some(t), None) => {
                 let t = finite(&at("threshold"), t)?;
                 if t <= 0.0 {
@@ -298,7 +316,7 @@ pub(crate) fn diagnosers(raw: &[RawDiagnoser], model: &Model, ff: &Mat, noise: O
                 Threshold::FalseAlarm(a)
             }
             (Some(_), Some(_)) => return Err(bad(at("false_alarm"), "give threshold or false_alarm, not both")),
-            (None, None) => return Err(bad(at("threshold"), "a diagnoser needs threshold = value or false_alarm = probability")),
+            (None, None) => return Err(bad(at("threshold"), "a diagnoser needs threshold = value, false_alarm = probability or calibrate = { runs = N }")),
         };
         let persistence = d.persistence.unwrap_or(1);
         if persistence < 1 {

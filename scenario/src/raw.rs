@@ -67,6 +67,14 @@ pub struct RawFault {
     pub intervals: Option<Vec<Vec<f64>>>,
 }
 
+/// `calibrate = { runs, margin }` of a `[[diagnoser]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawCalibrate {
+    pub runs: i64,
+    pub margin: Option<f64>,
+}
+
 /// `[[diagnoser]]`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -83,6 +91,7 @@ pub struct RawDiagnoser {
     pub forgetting: Option<f64>,
     pub threshold: Option<f64>,
     pub false_alarm: Option<f64>,
+    pub calibrate: Option<RawCalibrate>,
     pub persistence: Option<i64>,
     pub ignore_before: Option<f64>,
 }

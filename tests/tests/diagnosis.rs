@@ -198,3 +198,31 @@ fn a_sweep_is_the_same_whatever_the_jobs() {
     }
 }
 
+
+/// A calibrated threshold is margin × the largest evaluation of the fault-free realisations with
+/// seeds 2³² + S + r: checked against those realisations run one by one with their own seeds.
+#[test]
+fn a_calibrated_threshold_is_the_margin_times_the_fault_free_maximum() {
+    let s = Scratch::new("calibrate");
+    let cal = edited(&s, "seed002-fault-free", "false_alarm = 1e-3", "calibrate = { runs = 3, margin = 1.5 }");
+    let out = run(&s, &cal, &["--mode", "in-process"]);
+    assert!(out.status.success(), "{:?}", text(&out));
+    let got = summary(&s, "seed002-fault-free");
+    let thresholds: Vec<f64> = got["diagnosis"]["residuals"].as_array().unwrap().iter().map(|r| r["threshold"].as_f64().unwrap()).collect();
+    // The same scenario with a fixed threshold reports each realisation's largest J.
+    let fixed = edited(&s, "seed002-fault-free", "false_alarm = 1e-3", "threshold = 1e9");
+    let mut top = vec![f64::NEG_INFINITY; thresholds.len()];
+    for r in 0..3u64 {
+        let t = Scratch::new("calibrate-one");
+        let out = run(&t, &fixed, &["--mode", "in-process", "--seed", &((1u64 << 32) + 7 + r).to_string()]);
+        assert!(out.status.success(), "{:?}", text(&out));
+        let one = summary(&t, "seed002-fault-free");
+        for (m, res) in top.iter_mut().zip(one["diagnosis"]["residuals"].as_array().unwrap()) {
+            *m = m.max(res["max_fault_free_evaluation"].as_f64().unwrap());
+        }
+    }
+    assert_eq!(thresholds.len(), 2);
+    for (t, m) in thresholds.iter().zip(&top) {
+        assert_eq!(*t, 1.5 * m, "threshold {t} against 1.5 × {m}");
+    }
+}
