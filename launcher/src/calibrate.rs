@@ -47,13 +47,13 @@ pub fn calibrate(s: &Scenario, plan: &mut Plan) -> Result<(), LaunchError> {
         }
         let figures = o.summary.diagnosis.map(|d| d.residuals).unwrap_or_default();
         let mut at = 0;
-        for (b, bank) in plan.banks.iter().enumerate() {
-            for j in 0..bank.members.len() {
-                let runs = wanted.iter().find(|w| w.0 == b).map_or(0, |w| w.1);
+        for (b, tops) in top.iter_mut().enumerate() {
+            let runs = wanted.iter().find(|w| w.0 == b).map_or(0, |w| w.1);
+            for t in tops.iter_mut() {
                 if r < runs
                     && let Some(v) = figures.get(at).and_then(|f| f.max_fault_free_evaluation)
                 {
-                    top[b][j] = top[b][j].max(v);
+                    *t = t.max(v);
                 }
                 at += 1;
             }

@@ -248,10 +248,10 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
     let model = Model { a, b, c, e, d };
     let noise = super::fault_diagnosis::noise(&raw.noise, &model, dt)?;
     let faults = super::fault_diagnosis::faults(&raw.fault, &model, &ff, dt)?;
-    if p.process.is_some() {
-        if let Some(what) = [(!raw.fault.is_empty(), "fault"), (raw.noise.is_some(), "noise")].iter().find(|w| w.0).map(|w| w.1) {
-            return Err(bad(what, "faults and noise are applied by the built-in plant: an external plant (plant.process) models its own"));
-        }
+    if p.process.is_some()
+        && let Some(what) = [(!raw.fault.is_empty(), "fault"), (raw.noise.is_some(), "noise")].iter().find(|w| w.0).map(|w| w.1)
+    {
+        return Err(bad(what, "faults and noise are applied by the built-in plant: an external plant (plant.process) models its own"));
     }
 
     // Observers.
