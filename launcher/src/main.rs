@@ -109,6 +109,20 @@ enum Command {
         /// Place the lockstep ring's processes on CPUs (auto) or not (off).
         #[arg(long, value_parser = ["auto", "off"], default_value = "auto")]
         pin: String,
+        /// Repetitions (each: the floor, then every configuration); ratios are given as medians.
+        #[arg(long, default_value_t = 1)]
+        repeat: usize,
+    },
+    /// One node of the benchmark's floor ring (started by `launcher bench`).
+    #[command(hide = true)]
+    FloorNode {
+        run: String,
+        index: usize,
+        steps: u64,
+        len_plant: usize,
+        len_observer: usize,
+        len_controller: usize,
+        wait: Wait,
     },
     /// List the shipped scenarios.
     List {
@@ -289,7 +303,13 @@ fn main() -> ExitCode {
             }
             if r.ok { ExitCode::SUCCESS } else { ExitCode::from(EXIT_BAD_INPUT as u8) }
         }
-        Command::Bench { steps, json, wait, mode, recording, pin } => {
+        Command::FloorNode { run, index, steps, len_plant, len_observer, len_controller, wait } => {
+            match launcher::bench::floor::node(&run, index.min(2), steps, [len_plant, len_observer, len_controller], wait) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => fail(&LaunchError::Component(format!("floor node {index}: {e}"))),
+            }
+        }
+        Command::Bench { steps, json, wait, mode, recording, pin, repeat } => {
             let wait = wait.unwrap_or_else(Wait::default_for_machine);
             let modes: Vec<Mode> = match mode.as_deref() {
                 Some("processes") => vec![Mode::Processes],
@@ -301,10 +321,10 @@ fn main() -> ExitCode {
                 Some(_) => vec![false],
                 None => vec![false, true],
             };
-            match launcher::bench::bench(&shipped::dir().join("seed002-sine.toml"), steps, wait, pin == "auto", &modes, &rec) {
+            match launcher::bench::bench(&shipped::dir().join("seed002-sine.toml"), steps, wait, pin == "auto", &modes, &rec, repeat) {
                 Ok(runs) => {
                     if json {
-                        println!("{}", serde_json::to_string_pretty(&serde_json::json!({ "runs": runs })).expect("serialises"));
+                        println!("{}", serde_json::to_string_pretty(&serde_json::json!({ "runs": runs, "ratios": launcher::bench::ratios(&runs).into_iter().map(|(n, v)| (n, serde_json::json!({"min": v.0, "median": v.1, "max": v.2, "repetitions": v.3}))).collect::<serde_json::Map<_, _>>() })).expect("serialises"));
                     } else {
                         print!("{}", launcher::bench::table(&runs, wait));
                     }

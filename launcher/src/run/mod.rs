@@ -18,6 +18,7 @@ use lockstep::Wait;
 pub use configs::{configs, Configs};
 pub use envelope::{envelopes, Launchable, Program};
 pub use session::{hop_entity, hop_names, Session};
+pub(crate) use processes::placement::{allowed_cpus, pin_self};
 
 use crate::error::LaunchError;
 use crate::plan::Plan;

@@ -7,7 +7,7 @@
 //! stops the run within a poll interval, the others are killed, and the recording is closed.
 
 mod assembly;
-mod placement;
+pub(crate) mod placement;
 mod proc;
 
 use std::io::Write;

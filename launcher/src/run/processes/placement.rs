@@ -3,7 +3,7 @@
 use super::super::configs::Configs;
 
 /// The CPUs this process may run on.
-fn allowed_cpus() -> Vec<usize> {
+pub(crate) fn allowed_cpus() -> Vec<usize> {
     // SAFETY: sched_getaffinity fills the set we own.
     unsafe {
         let mut set: libc::cpu_set_t = std::mem::zeroed();
@@ -16,7 +16,7 @@ fn allowed_cpus() -> Vec<usize> {
 
 /// Restricts the calling process to one CPU (best effort: a refusal leaves it where it is).
 /// Called in the child between fork and exec, so the component starts where it will run.
-pub(super) fn pin_self(cpu: usize) {
+pub(crate) fn pin_self(cpu: usize) {
     // SAFETY: the set is initialised before use; sched_setaffinity is a plain system call
     // (async-signal-safe) and only reads it.
     unsafe {

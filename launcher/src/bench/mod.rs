@@ -1,0 +1,140 @@
+//! `launcher bench`: the seed-002 closed loop (plant, two observers, controller) for N steps,
+//! in one process and across processes, with and without recording — and, in the same session,
+//! its floor: a bare ring of three processes over the same transport ([`floor`]), against which
+//! the multi-process figures are given as ratios. Every repetition runs the floor and then each
+//! configuration, so that the machine's drift falls on both sides of a ratio alike.
+
+pub mod floor;
+
+use std::path::Path;
+
+use lockstep::Wait;
+use serde::Serialize;
+
+use crate::error::LaunchError;
+use crate::plan::plan;
+use recording::write::Percentiles;
+use crate::run::{run, Mode, Options, Stop};
+use scenario::Scenario;
+
+/// One benchmark run.
+#[derive(Debug, Clone, Serialize)]
+pub struct BenchRun {
+    /// "processes" or "in-process".
+    pub mode: String,
+    /// Whether the .rrd was written.
+    pub recording: bool,
+    /// Steps run.
+    pub steps: u64,
+    /// Steps per second of wall time.
+    pub steps_per_s: f64,
+    /// Full-step latency, ns.
+    pub step_ns: Percentiles,
+}
+
+/// Runs the benchmark on `scenario` (seed002-sine) for `steps` steps, `repeat` times over.
+pub fn bench(scenario: &Path, steps: u64, wait: Wait, pin: bool, modes: &[Mode], recording: &[bool], repeat: usize) -> Result<Vec<BenchRun>, LaunchError> {
+    let mut s = Scenario::load(scenario)?;
+    s.steps = steps;
+    s.duration = steps as f64 * s.dt;
+    s.expect = Default::default();
+    let p = plan(&s).map_err(|e| LaunchError::Scenario(e.error))?;
+    let tmp = std::env::temp_dir().join(format!("uio-bench-{}", std::process::id()));
+    let lay = crate::run::configs(&s, &p).layout;
+    let mut out = Vec::new();
+    for _ in 0..repeat.max(1) {
+    if modes.contains(&Mode::Processes) {
+        let f = floor::floor(steps, [lay.len(), lay.n, lay.l], wait, pin)?;
+        out.push(BenchRun { mode: "floor".into(), recording: false, steps, steps_per_s: f.steps_per_s, step_ns: f.inner.step_ns });
+    }
+    for &mode in modes {
+        for &record in recording {
+            let opts = Options { out: tmp.clone(), mode, wait, force: true, allow_unstable: false, record, pin, select: Default::default(), progress: false };
+            let o = run(&s, &p, &opts)?;
+            if o.stop != Stop::Completed {
+                return Err(LaunchError::Component(format!("benchmark run stopped: {:?}", o.stop)));
+            }
+            out.push(BenchRun {
+                mode: mode.name().into(),
+                recording: record,
+                steps: o.summary.steps,
+                steps_per_s: o.summary.steps_per_s,
+                step_ns: o.summary.latency_ns.step,
+            });
+        }
+    }
+    }
+    let _ = std::fs::remove_dir_all(&tmp);
+    Ok(out)
+}
+
+/// The printed table.
+pub fn table(runs: &[BenchRun], wait: Wait) -> String {
+    let mut t = format!("seed002 closed loop (plant, 2 observers, controller), wait = {wait}; floor: bare 3-process ring, same transport and payloads\n");
+    t += &format!("{:<12} {:<10} {:>10} {:>14} {:>9} {:>9} {:>9} {:>9} {:>9}\n", "mode", "recording", "steps", "steps/s", "p50 µs", "p90 µs", "p99 µs", "p99.9 µs", "max µs");
+    for r in runs {
+        let us = |ns: u64| format!("{:.2}", ns as f64 / 1000.0);
+        t += &format!(
+            "{:<12} {:<10} {:>10} {:>14.0} {:>9} {:>9} {:>9} {:>9} {:>9}\n",
+            r.mode,
+            r.recording,
+            r.steps,
+            r.steps_per_s,
+            us(r.step_ns.p50),
+            us(r.step_ns.p90),
+            us(r.step_ns.p99),
+            us(r.step_ns.p999),
+            us(r.step_ns.max)
+        );
+    }
+    for (name, v) in ratios(runs) {
+        t += &format!("{name}: median {:.3} [{:.3} – {:.3}] over {} repetition(s)\n", v.1, v.0, v.2, v.3);
+    }
+    t
+}
+
+/// Ratios per repetition (a repetition starts at each floor run, or is the whole list without
+/// one), as (name, (min, median, max, count)).
+pub fn ratios(runs: &[BenchRun]) -> Vec<(String, (f64, f64, f64, usize))> {
+    let mut reps: Vec<&[BenchRun]> = Vec::new();
+    let starts: Vec<usize> = runs.iter().enumerate().filter(|(_, r)| r.mode == "floor").map(|(i, _)| i).collect();
+    if starts.is_empty() {
+        reps.push(runs);
+    } else {
+        for (j, &s) in starts.iter().enumerate() {
+            reps.push(&runs[s..starts.get(j + 1).copied().unwrap_or(runs.len())]);
+        }
+    }
+    let mut named: Vec<(String, Vec<f64>)> = Vec::new();
+    let mut add = |name: String, v: f64| match named.iter_mut().find(|(n, _)| *n == name) {
+        Some((_, list)) => list.push(v),
+        None => named.push((name, vec![v])),
+    };
+    for rep in reps {
+        let get = |m: &str, rec: bool| rep.iter().find(|r| r.mode == m && r.recording == rec);
+        if let Some(f) = get("floor", false) {
+            for rec in [false, true] {
+                if let Some(p) = get("processes", rec) {
+                    let what = if rec { "recording" } else { "no recording" };
+                    add(format!("processes ({what}) / floor, steps/s"), p.steps_per_s / f.steps_per_s);
+                    add(format!("processes ({what}) / floor, step p50"), p.step_ns.p50 as f64 / f.step_ns.p50.max(1) as f64);
+                }
+            }
+        }
+        if let (Some(p), Some(i)) = (get("processes", false), get("in-process", false)) {
+            add("processes / in-process, steps/s (no recording)".into(), p.steps_per_s / i.steps_per_s);
+        }
+        for m in ["in-process", "processes"] {
+            if let (Some(a), Some(b)) = (get(m, true), get(m, false)) {
+                add(format!("{m}: share of steps/s recording costs"), 1.0 - a.steps_per_s / b.steps_per_s);
+            }
+        }
+    }
+    named
+        .into_iter()
+        .map(|(n, mut v)| {
+            v.sort_by(f64::total_cmp);
+            (n, (v[0], v[(v.len() - 1) / 2], v[v.len() - 1], v.len()))
+        })
+        .collect()
+}
