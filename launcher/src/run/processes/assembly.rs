@@ -33,10 +33,10 @@ impl Queue {
     }
 
     /// Moves every pending sample of `reader` in; returns how many there were.
-    pub(super) fn drain(&mut self, reader: &Reader) -> Result<usize, LaunchError> {
+    pub(super) fn drain(&mut self, reader: &Reader, max: usize) -> Result<usize, LaunchError> {
         let (items, free, last) = (&mut self.items, &mut self.free, &mut self.last);
         reader
-            .drain(|h, v| {
+            .drain_up_to(max, |h, v| {
                 let mut buf = free.pop().unwrap_or_default();
                 buf.clear();
                 buf.extend_from_slice(v);
@@ -182,12 +182,17 @@ pub(super) struct Readers<'a> {
 impl Readers<'_> {
     /// Moves every pending sample into its queue; returns how many there were.
     pub(super) fn drain_all(&self, asm: &mut Assembly) -> Result<usize, LaunchError> {
-        let mut got = asm.plant.drain(self.plant)?;
+        self.drain_up_to(asm, usize::MAX)
+    }
+
+    /// At most `max` samples of each service.
+    pub(super) fn drain_up_to(&self, asm: &mut Assembly, max: usize) -> Result<usize, LaunchError> {
+        let mut got = asm.plant.drain(self.plant, max)?;
         for (r, q) in self.observers.iter().zip(asm.observers.iter_mut()) {
-            got += q.drain(r)?;
+            got += q.drain(r, max)?;
         }
         if let (Some(r), Some(q)) = (self.controller, asm.controller.as_mut()) {
-            got += q.drain(r)?;
+            got += q.drain(r, max)?;
         }
         Ok(got)
     }

@@ -37,6 +37,8 @@ const STALL_TIMEOUT: Duration = Duration::from_secs(5);
 /// wake-up takes a core from it for a moment: drain rarely, in large batches. At the fastest
 /// step rate measured (~250k steps/s) 5 ms is ~1300 samples, well inside the recorder's buffer.
 const POLL: Duration = Duration::from_millis(5);
+/// Samples per service taken between yields of the core.
+const CHUNK: usize = 16;
 
 /// Runs the scenario across processes.
 pub fn run(s: &Scenario, cfg: &Configs, session: &mut Session, wait: Wait, pin: bool) -> Result<Stop, LaunchError> {
@@ -129,9 +131,20 @@ fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: 
     let mut row = StepRow::new(cfg.layout, readers.observers.len(), readers.controller.is_some());
     let mut last_progress = Instant::now();
     loop {
-        let got = readers.drain_all(asm)?;
-        if asm.assemble(&mut row, session)? > 0 {
-            last_progress = Instant::now();
+        // In chunks, yielding the core between them: the ring's processes, spinning on it, get
+        // it back within a chunk's work (tens of µs) instead of after the whole batch.
+        let mut got = 0;
+        loop {
+            let chunk = readers.drain_up_to(asm, CHUNK)?;
+            got += chunk;
+            let made = asm.assemble(&mut row, session)?;
+            if made > 0 {
+                last_progress = Instant::now();
+            }
+            if chunk == 0 && made == 0 {
+                break;
+            }
+            std::thread::yield_now();
         }
         if asm.next == steps {
             // The plant's end sample (step K) closes the last step's timing; a plant that has
