@@ -36,6 +36,7 @@ pub fn calibrate(s: &Scenario, plan: &mut Plan) -> Result<(), LaunchError> {
         pin: false,
         select: recording::write::Selection::default(),
         progress: false,
+        realtime: None,
     };
     let mut top: Vec<Vec<f64>> = plan.banks.iter().map(|b| vec![f64::NEG_INFINITY; b.members.len()]).collect();
     for r in 0..most {

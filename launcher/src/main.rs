@@ -55,6 +55,13 @@ enum Command {
         /// The noise generator's seed (default: the scenario's `seed`).
         #[arg(long)]
         seed: Option<u64>,
+        /// Pace the run in real time: step k starts at k·dt/X of wall time (waits sleep: the
+        /// default wait becomes `block`); steps that end late are counted and recorded.
+        #[arg(long)]
+        realtime: bool,
+        /// X for --realtime: 2 runs twice as fast as real time, 0.5 half as fast.
+        #[arg(long, value_name = "X", requires = "realtime")]
+        speed: Option<f64>,
     },
     /// Monte Carlo: run N noise realisations (seeds S, S+1, …) and write DIR/<name>.sweep.json
     /// with detection delays, isolation accuracy, false-alarm rates and tail errors.
@@ -211,9 +218,18 @@ fn main() -> ExitCode {
         record_every: 1,
         record: Vec::new(),
         seed: None,
+        realtime: false,
+        speed: None,
     });
     match command {
-        Command::Run { scenario, out, mode, wait, force, allow_unstable, pin, record_every, record, seed } => {
+        Command::Run { scenario, out, mode, wait, force, allow_unstable, pin, record_every, record, seed, realtime, speed } => {
+            let speed = speed.unwrap_or(1.0);
+            if !(speed.is_finite() && speed > 0.0) {
+                return fail(&LaunchError::BadInput(format!("--speed {speed}: must be a finite number > 0")));
+            }
+            let realtime = realtime.then_some(speed);
+            // A paced run sleeps while it waits, unless told otherwise.
+            let wait = wait.or(realtime.map(|_| Wait::Block));
             let select = match recording::write::Selection::new(record_every, &record) {
                 Ok(x) => x,
                 Err(e) => return fail(&LaunchError::BadInput(e)),
@@ -236,7 +252,7 @@ fn main() -> ExitCode {
                 eprintln!("warning: {w}");
             }
             let mode = if mode == "in-process" { Mode::InProcess } else { Mode::Processes };
-            let opts = Options { out, mode, wait: wait.unwrap_or_else(Wait::default_for_machine), force, allow_unstable, record: true, pin: pin == "auto", select, progress: true };
+            let opts = Options { out, mode, wait: wait.unwrap_or_else(Wait::default_for_machine), force, allow_unstable, record: true, pin: pin == "auto", select, progress: true, realtime };
             match run::run(&s, &p, &opts) {
                 Ok(o) => {
                     print!("{}", o.summary.table());

@@ -94,6 +94,9 @@ pub struct Summary {
     pub diagnosis: Option<diagnosis::Diagnosis>,
     /// The noise generator's seed.
     pub seed: u64,
+    /// How a paced run (`--realtime`) kept its schedule.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub realtime: Option<crate::run::RealtimeFigures>,
     /// The recording.
     pub recording: Option<String>,
     /// The recording's digest, entity → XXH64 (see `recording::digest`), also stored in the
@@ -148,6 +151,7 @@ impl Summary {
             stopped,
             diagnosis,
             seed: s.seed,
+            realtime: None,
             recording: rrd.map(|p| p.display().to_string()),
             recording_digest: None,
         };
@@ -238,6 +242,15 @@ impl Summary {
             for (hop, p) in &self.latency_ns.hops {
                 t += &format!("    {:<30} p50 {}  p99 {}  max {}\n", hop, us(p.p50), us(p.p99), us(p.max));
             }
+        }
+        if let Some(r) = &self.realtime {
+            let off = 100.0 * (r.paced_wall_s / r.scheduled_s.max(1e-12) - 1.0);
+            t += &format!("  real time: {} s paced for {} s scheduled ({off:+.2} %), step period {} s\n", sig(r.paced_wall_s), sig(r.scheduled_s), sig(r.period_s));
+            t += &if r.overruns == 0 {
+                "  every step ended by its deadline\n".to_string()
+            } else {
+                format!("  cannot keep up: {} of {} steps ended after their deadline (latest by {:.1} µs)\n", r.overruns, r.steps, r.max_lateness_us)
+            };
         }
         if let Some(d) = &self.diagnosis {
             t += &format!("  diagnosis: {} false alarm(s) over {} s fault-free ({} step(s) in alarm)\n", d.false_alarms, sig(d.fault_free_time), d.false_alarm_steps);

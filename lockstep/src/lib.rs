@@ -39,12 +39,12 @@ pub mod settings;
 pub mod service;
 mod wait;
 
-pub use clock::now_ns;
+pub use clock::{now_ns, sleep_until_ns, tight_timers};
 pub use error::LockstepError;
 pub use handshake::{die_with_parent, parse_launch, ready_then_wait_for_go, Launch, EXIT_USAGE};
 pub use layout::PlantLayout;
 pub use quiet::quiet_iceoryx2;
 pub use port::{Bus, Inlet, Outlet, Reader, FOLLOWER_LAG, RECORDER_BUFFER};
-pub use run::{cleanup_dead_runs, RunSpace, RUNS_DIR_ENV};
+pub use run::{cleanup_dead_runs, iox2_root, RunSpace, RUNS_DIR_ENV};
 pub use sample::{Header, WireHeader, PROTOCOL_VERSION};
 pub use wait::Wait;

@@ -21,6 +21,22 @@ pub const RUNS_DIR_ENV: &str = "UIO_RUNS_DIR";
 
 const SHM_DIR: &str = "/dev/shm";
 
+/// Where a run's iceoryx2 root goes when `<run dir>/iox2/` is too long: iceoryx2 names the
+/// unix sockets of its event services (the `block`, `waitset` and `spin-then-block` waits)
+/// after the root, and a socket's path holds at most 108 bytes.
+const SHORT_ROOTS: &str = "/tmp/uio-iox2";
+
+/// The longest root that leaves room for iceoryx2's socket names (measured: a 62-byte root
+/// fails, a 57-byte one works).
+const MAX_ROOT: usize = 56;
+
+/// The iceoryx2 root of run `id` in `dir`: `<dir>/iox2/`, or `/tmp/uio-iox2/<id>/` when that is
+/// too long (a deep `UIO_RUNS_DIR`). A function of the two, so every process finds the same.
+pub fn iox2_root(dir: &Path, id: &str) -> PathBuf {
+    let inside = dir.join("iox2");
+    if inside.as_os_str().len() < MAX_ROOT { inside } else { Path::new(SHORT_ROOTS).join(id) }
+}
+
 /// A run's identity and its iceoryx2 configuration.
 #[derive(Debug, Clone)]
 pub struct RunSpace {
@@ -61,6 +77,10 @@ impl RunSpace {
         writeln!(f, "{}", std::process::id()).map_err(|e| io("cannot write", &tmp, e))?;
         fs::set_permissions(tmp.join("owner.pid"), fs::Permissions::from_mode(0o600)).map_err(|e| io("cannot chmod", &tmp, e))?;
         let dir = base.join(&id);
+        let root = iox2_root(&dir, &id);
+        if !root.starts_with(&dir) {
+            fs::DirBuilder::new().recursive(true).mode(0o700).create(&root).map_err(|e| io("cannot create", &root, e))?;
+        }
         fs::rename(&tmp, &dir).map_err(|e| io("cannot create", &dir, e))?;
         Self::at(id, dir)
     }
@@ -81,7 +101,7 @@ impl RunSpace {
         // The built-in defaults, not a config file: runs must not depend on what /etc holds.
         let mut config = Config::default();
         config.global.prefix = FileName::new(format!("uio{id}_").as_bytes()).map_err(LockstepError::ipc)?;
-        let root = format!("{}/", dir.join("iox2").display());
+        let root = format!("{}/", iox2_root(&dir, &id).display());
         config.global.set_root_path(&IoxPath::new(root.as_bytes()).map_err(LockstepError::ipc)?);
         Ok(Self { id, dir, config })
     }
@@ -99,6 +119,11 @@ impl RunSpace {
     /// The run directory.
     pub fn dir(&self) -> &Path {
         &self.dir
+    }
+
+    /// The iceoryx2 root path (see [`iox2_root`]).
+    pub fn iox2_root(&self) -> PathBuf {
+        iox2_root(&self.dir, &self.id)
     }
 
     /// The iceoryx2 configuration with this run's prefix and root.
@@ -147,6 +172,7 @@ impl RunSpace {
             let _ = fs::remove_file(f);
         }
         let _ = fs::remove_dir_all(&self.dir);
+        let _ = fs::remove_dir_all(Path::new(SHORT_ROOTS).join(&self.id));
     }
 }
 
@@ -185,7 +211,17 @@ pub fn cleanup_dead_runs() -> usize {
                     let _ = fs::remove_file(f);
                 }
                 let _ = fs::remove_dir_all(entry.path());
+                let _ = fs::remove_dir_all(Path::new(SHORT_ROOTS).join(&id));
                 cleaned += 1;
+            }
+        }
+    }
+    // Short iceoryx2 roots are named after their run id, <launcher pid>x…: the owner is in the name.
+    if let Ok(entries) = fs::read_dir(SHORT_ROOTS) {
+        for entry in entries.flatten() {
+            let pid = entry.file_name().to_string_lossy().split('x').next().and_then(|p| p.parse::<i32>().ok());
+            if pid.is_some_and(|p| !alive(p)) {
+                let _ = fs::remove_dir_all(entry.path());
             }
         }
     }

@@ -24,6 +24,7 @@ in `setup` → `<name>: setup: <exception>`, exit 3 (`Diverged` from a plant's s
 from __future__ import annotations
 
 import os
+import time
 import sys
 import traceback
 from typing import Any, Callable, List, Optional
@@ -56,6 +57,11 @@ class Stepper:
         self.state = state
         self.with_state = with_state
         self.timeout_s = timeout_s
+        #: Real-time pacing of a plant (`pace_s`, PROTOCOL.md §5): sample k goes out no earlier
+        #: than t0 + k·pace, t0 when sample 0 did.
+        pace = config.raw.get("pace_s") if config.role == "plant" else None
+        self.pace_ns = int(round(float(pace) * 1e9)) if pace else None
+        self.t0 = 0
         #: The latest values of every input, in `reads` order (what the step function gets).
         self.inputs = [np.zeros(r.len) for r in config.reads]
         #: The header of every input's latest sample.
@@ -140,7 +146,21 @@ class Stepper:
             exact = [h for h, lag in zip(self.headers, self.lags) if lag == 0]
             sim_time = exact[0].sim_time if exact and exact[0] is not None else k * dt
         out = self.call(k)
+        self.pace(k)
         self._transport(k, self.outlet.send, k, sim_time, taken, out)
+
+    def pace(self, k: int) -> None:
+        """A paced plant waits until t0 + k·pace before it publishes sample k."""
+        if self.pace_ns is None:
+            return
+        if k == 0:
+            self.t0 = now_ns()
+            return
+        while True:
+            left = self.t0 + k * self.pace_ns - now_ns()
+            if left <= 0:
+                return
+            time.sleep(left * 1e-9)
 
     def finish(self) -> None:
         """After step K − 1: the plant's end sample K, once every input has delivered K − 1."""
@@ -149,6 +169,7 @@ class Stepper:
         k = self.config.steps
         taken = 0 if k == 0 else self._transport(k, self.take, k - 1, True)
         out = self.call(k)
+        self.pace(k)
         self._transport(k, self.outlet.send, k, k * self.config.dt, taken, out)
 
     def run(self) -> None:

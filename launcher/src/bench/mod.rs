@@ -49,7 +49,7 @@ pub fn bench(scenario: &Path, steps: u64, wait: Wait, pin: bool, modes: &[Mode],
     }
     for &mode in modes {
         for &record in recording {
-            let opts = Options { out: tmp.clone(), mode, wait, force: true, allow_unstable: false, record, pin, select: Default::default(), progress: false };
+            let opts = Options { out: tmp.clone(), mode, wait, force: true, allow_unstable: false, record, pin, select: Default::default(), progress: false, realtime: None };
             let o = run(&s, &p, &opts)?;
             if o.stop != Stop::Completed {
                 return Err(LaunchError::Component(format!("benchmark run stopped: {:?}", o.stop)));

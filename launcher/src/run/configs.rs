@@ -24,6 +24,8 @@ pub struct Configs {
     pub controller: Option<ControllerConfig>,
     /// The plant sample layout.
     pub layout: PlantLayout,
+    /// Real-time pacing period, s (dt / speed), with `--realtime`.
+    pub pace_s: Option<f64>,
 }
 
 /// How long a follower sleeps between batches. Each wake-up takes a core from the ring while
@@ -80,5 +82,5 @@ pub fn configs(s: &Scenario, plan: &Plan) -> Configs {
         (Some(c), Some(fb)) => Some(ControllerConfig { g: (&fb.g).into(), n: (&fb.n).into(), references: s.inputs.clone(), dt: s.dt, observer: c.observer.clone() }),
         _ => None,
     };
-    Configs { plant, followers, closed_loop: s.controller.is_some(), observers, controller, layout }
+    Configs { plant, followers, closed_loop: s.controller.is_some(), observers, controller, layout, pace_s: None }
 }

@@ -66,7 +66,7 @@ pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> V
         run: space.id().to_string(),
         name: name.to_string(),
         role,
-        iceoryx2: Iceoryx2Place { prefix: format!("uio{}_", space.id()), root: format!("{}/", space.dir().join("iox2").display()) },
+        iceoryx2: Iceoryx2Place { prefix: format!("uio{}_", space.id()), root: format!("{}/", space.iox2_root().display()) },
         wait: wait.to_string(),
         dt: s.dt,
         steps: s.steps,
@@ -75,6 +75,7 @@ pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> V
         model: json!({ "A": rows(&m.a), "B": rows(&m.b), "C": rows(&m.c), "D": rows(&m.d), "E": rows(&m.e), "Ff": rows(&s.ff), "x0": s.x0 }),
         signals: Value::Null,
         params,
+        pace_s: None,
     };
     let plant_read = |sleep_us| ReadSpec { service: "plant".into(), len: lay.len(), lag: 0, sleep_us, fields: fields(lay) };
     let estimate = |name: &str| PublishSpec { service: format!("observer/{name}"), len: lay.n, names: names(&s.names.state) };
@@ -101,6 +102,7 @@ pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> V
         None => (Program::Builtin("plant"), json!({})),
     };
     let mut plant = base("plant", Role::Plant, publishes, reads, params);
+    plant.pace_s = cfg.pace_s;
     plant.signals = json!({
         "disturbances": s.disturbances,
         "measurement_disturbances": s.measurement_disturbances,

@@ -21,7 +21,18 @@ pub fn run(cfg: &Configs, session: &mut Session) -> Result<Stop, LaunchError> {
     let lay = cfg.layout;
     let mut row = StepRow::new(lay, observers.len(), controller.is_some());
     let mut u = vec![0.0; lay.l];
+    // Real-time pacing: step k starts at t₀ + k·period.
+    let pace = cfg.pace_s.map(|p| (p * 1e9).round() as u64);
+    let mut t0 = 0;
+    if pace.is_some() {
+        lockstep::tight_timers();
+        t0 = now_ns();
+        session.pace_start(t0);
+    }
     for k in 0..cfg.plant.steps {
+        if let Some(p) = pace {
+            lockstep::sleep_until_ns(t0 + k * p);
+        }
         if k % 1024 == 0
             && let Some(sig) = interrupt::received()
         {
@@ -47,6 +58,9 @@ pub fn run(cfg: &Configs, session: &mut Session) -> Result<Stop, LaunchError> {
         let diverged = plant.advance(k, &u);
         let step_ns = if timed { Some(now_ns() - start) } else { None };
         session.record_in_process(&row, step_ns)?;
+        if pace.is_some() {
+            session.step_ended(k, now_ns())?;
+        }
         if let Err(d) = diverged {
             return Ok(Stop::Diverged(d.to_string()));
         }

@@ -17,7 +17,7 @@ use lockstep::Wait;
 
 pub use configs::{configs, Configs};
 pub use envelope::{envelopes, Launchable, Program};
-pub use session::{hop_entity, hop_names, Session};
+pub use session::{hop_entity, hop_names, RealtimeFigures, Session};
 pub(crate) use processes::placement::{allowed_cpus, pin_self};
 
 use crate::error::LaunchError;
@@ -65,6 +65,8 @@ pub struct Options {
     pub select: recording::write::Selection,
     /// Show a progress bar on a terminal (not in benchmarks: it would disturb their timing).
     pub progress: bool,
+    /// Real-time pacing at this speed (`--realtime --speed X`): step k starts at k·dt/X.
+    pub realtime: Option<f64>,
 }
 
 /// How a run ended.
@@ -148,8 +150,9 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
     // (`<name>.rrd.partial`, without footer) does not stand in the next run's way.
     let partial = rrd.as_ref().map(|p| p.with_extension("rrd.partial"));
     interrupt::install();
-    let cfg = configs(s, plan);
-    let mut session = Session::new(s, cfg.layout, &plan.banks, partial.as_deref(), &opts.select).inspect_err(|_| {
+    let mut cfg = configs(s, plan);
+    cfg.pace_s = opts.realtime.map(|x| s.dt / x);
+    let mut session = Session::new(s, cfg.layout, &plan.banks, partial.as_deref(), &opts.select, cfg.pace_s).inspect_err(|_| {
         // A recording that could not even be started is of no use to anyone.
         if let Some(p) = &partial {
             let _ = fs::remove_file(p);
@@ -172,7 +175,7 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
         Err(e) => Stop::Failed(e.to_string()),
     };
     let steps_done = session.steps;
-    let (mut metrics, latency, digest, diagnosis) = session.finish().map_err(|e| {
+    let (mut metrics, latency, digest, diagnosis, realtime) = session.finish().map_err(|e| {
         // Say why the run had stopped too, when the recording's failure is not the whole story.
         let why = match &stop {
             Stop::Completed => String::new(),
@@ -187,6 +190,7 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
         fs::rename(from, to).map_err(|e| LaunchError::Component(format!("{}: cannot rename the recording into place: {e}", to.display())))?;
     }
     let mut summary = Summary::new(s, plan, opts, &metrics, &latency, wall, &stop, rrd.as_deref(), diagnosis);
+    summary.realtime = realtime;
     summary.recording_digest = digest;
     if let Some(path) = &summary_path {
         summary.write(path).map_err(LaunchError::Component)?;

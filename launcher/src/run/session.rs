@@ -72,6 +72,38 @@ pub struct Session {
     judge: Option<Judge>,
     /// Per bank, the false-alarm probability its χ² thresholds were asked for.
     asked: Vec<Option<f64>>,
+    /// Real-time pacing, with `--realtime`.
+    pace: Option<Pace>,
+    /// `/latency/overrun`'s group and series (paced runs).
+    overrun: Option<(usize, SeriesId)>,
+}
+
+/// How a paced run kept its schedule: step k is due to end at t₀ + (k + 1)·period.
+#[derive(Debug, Clone, Copy)]
+struct Pace {
+    period_ns: u64,
+    t0: Option<u64>,
+    steps: u64,
+    overruns: u64,
+    max_late_ns: u64,
+    last_end: u64,
+}
+
+/// A paced run's figures (summary.json → `realtime`).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct RealtimeFigures {
+    /// Wall time per step, s (dt / speed).
+    pub period_s: f64,
+    /// Steps whose end was timed.
+    pub steps: u64,
+    /// Steps that ended after their deadline t₀ + (k + 1)·period.
+    pub overruns: u64,
+    /// The latest a step ended past its deadline, µs.
+    pub max_lateness_us: f64,
+    /// From sample 0 to the end of the last step, s.
+    pub paced_wall_s: f64,
+    /// steps × period, s.
+    pub scheduled_s: f64,
 }
 
 /// The faults of a scenario as the figures see them.
@@ -111,7 +143,9 @@ pub fn hop_entity(hop: &str) -> String {
 impl Session {
     /// Starts a session; with `rrd`, opens the recording there.
     /// `select` thins and filters what is written; the figures see every step.
-    pub fn new(s: &Scenario, layout: PlantLayout, banks: &[Bank], rrd: Option<&Path>, select: &Selection) -> Result<Self, LaunchError> {
+    pub fn new(s: &Scenario, layout: PlantLayout, banks: &[Bank], rrd: Option<&Path>, select: &Selection, pace_s: Option<f64>) -> Result<Self, LaunchError> {
+        let pace = pace_s.map(|p| Pace { period_ns: (p * 1e9).round() as u64, t0: None, steps: 0, overruns: 0, max_late_ns: 0, last_end: 0 });
+        let mut overrun = None;
         let monitors: Vec<Monitor> = banks
             .iter()
             .map(|b| {
@@ -128,6 +162,7 @@ impl Session {
                 let mut sink = RrdSink::create(path, &s.name, blueprint(s), &s.source).map_err(LaunchError::BadInput)?;
                 sink.select(select.clone());
                 let (signals, hops_now, hops_late) = (sink.group(), sink.group(), sink.group());
+                let overrun_group = pace.is_some().then(|| sink.group());
                 let names = &s.names;
                 let observer_names: Vec<String> = s.observers.iter().map(|o| o.name.clone()).collect();
                 let mut paths: Vec<String> = Vec::new();
@@ -193,6 +228,9 @@ impl Session {
                     .map(|f| [series(signals, sig::fault_active(&f.name), format!("{} active", f.name)), series(signals, sig::fault_value(&f.name), format!("{} value", f.name))])
                     .collect();
                 let step_latency = series(hops_late, "/latency/step".into(), "step".into());
+                if let Some(g) = overrun_group {
+                    overrun = Some((g, series(g, "/latency/overrun".into(), "overrun".into())));
+                }
                 let late = s.controller.is_some();
                 let hop_ids = hops
                     .iter()
@@ -220,6 +258,8 @@ impl Session {
             monitors,
             judge,
             asked,
+            pace,
+            overrun,
         })
     }
 
@@ -243,6 +283,14 @@ impl Session {
                 hop_values.push((nobs + 1, row.plant_hdr.taken_ns.saturating_sub(ctrl_sent)));
             }
         }
+        if row.k == 0
+            && let Some(p) = &mut self.pace
+        {
+            p.t0 = Some(row.plant_hdr.sent_ns);
+        }
+        if row.k > 0 {
+            self.step_ended(row.k - 1, row.plant_hdr.taken_ns)?;
+        }
         self.prev = Some((row.plant_hdr.sent_ns, row.u_hdr.sent_ns));
         for &(i, ns) in &hop_values {
             self.latency.hop(i, ns);
@@ -259,6 +307,7 @@ impl Session {
     /// after the run, carrying when the plant had u_{K−1}): its step time and controller→plant hop.
     pub fn close_last(&mut self, end: &lockstep::Header) -> Result<(), LaunchError> {
         let Some((plant_sent, ctrl_sent)) = self.prev.take() else { return Ok(()) };
+        self.step_ended(end.step.saturating_sub(1), end.taken_ns)?;
         let step_ns = end.taken_ns.saturating_sub(plant_sent);
         self.latency.step(step_ns);
         let late = self.controller_observer.map(|_| (self.metrics.observers.len() + 1, end.taken_ns.saturating_sub(ctrl_sent)));
@@ -273,6 +322,32 @@ impl Session {
             sink.push(ch.hops[i], ns as f64);
         }
         sink.flush_full().map_err(LaunchError::Component)
+    }
+
+    /// Step k of a paced run ended at `end_ns` (CLOCK_MONOTONIC): late if after its deadline
+    /// t₀ + (k + 1)·period. In-process, the loop sets t₀ with [`Session::pace_start`].
+    pub fn step_ended(&mut self, k: u64, end_ns: u64) -> Result<(), LaunchError> {
+        let Some(p) = &mut self.pace else { return Ok(()) };
+        let Some(t0) = p.t0 else { return Ok(()) };
+        let late = end_ns.saturating_sub(t0 + (k + 1) * p.period_ns);
+        p.steps += 1;
+        p.last_end = p.last_end.max(end_ns);
+        if late > 0 {
+            p.overruns += 1;
+            p.max_late_ns = p.max_late_ns.max(late);
+        }
+        if let (Some((sink, _)), Some((g, id))) = (&mut self.sink, self.overrun) {
+            sink.row(g, k, k as f64 * self.dt);
+            sink.push(id, late as f64);
+        }
+        Ok(())
+    }
+
+    /// When sample 0 went out in a paced in-process run.
+    pub fn pace_start(&mut self, t0: u64) {
+        if let Some(p) = &mut self.pace {
+            p.t0 = Some(t0);
+        }
     }
 
     /// Records one step of the in-process loop, with its step time when it was measured.
@@ -350,7 +425,7 @@ impl Session {
 
     /// Closes the recording (footer written); returns the figures and the recording's digest.
     /// Fails, naming the file, when the recording could not be written whole.
-    pub fn finish(self) -> Result<(Metrics, Latency, Option<Digest>, Option<Diagnosis>), LaunchError> {
+    pub fn finish(self) -> Result<(Metrics, Latency, Option<Digest>, Option<Diagnosis>, Option<RealtimeFigures>), LaunchError> {
         if let Some(p) = self.progress {
             p.finish();
         }
@@ -359,6 +434,14 @@ impl Session {
             None => None,
         };
         let diagnosis = self.judge.map(|j| j.finish(&self.monitors, &self.asked));
-        Ok((self.metrics, self.latency, digest, diagnosis))
+        let realtime = self.pace.map(|p| RealtimeFigures {
+            period_s: p.period_ns as f64 * 1e-9,
+            steps: p.steps,
+            overruns: p.overruns,
+            max_lateness_us: p.max_late_ns as f64 / 1000.0,
+            paced_wall_s: p.t0.map_or(0.0, |t0| p.last_end.saturating_sub(t0) as f64 * 1e-9),
+            scheduled_s: p.steps as f64 * p.period_ns as f64 * 1e-9,
+        });
+        Ok((self.metrics, self.latency, digest, diagnosis, realtime))
     }
 }

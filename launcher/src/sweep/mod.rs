@@ -127,6 +127,7 @@ fn one(s: &Scenario, plan: &Plan, seed: u64, opts: &SweepOptions, record: bool) 
         pin: false,
         select: recording::write::Selection::default(),
         progress: false,
+        realtime: None,
     };
     let outcome = run::run(&s, plan, &o)?;
     if let Stop::Interrupted(sig) = outcome.stop {

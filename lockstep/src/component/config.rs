@@ -100,6 +100,10 @@ pub struct ComponentConfig {
     /// The component's own parameters.
     #[serde(default)]
     pub params: serde_json::Value,
+    /// Real-time pacing (the plant's, with `--realtime`): sample k is published no earlier than
+    /// t₀ + k·pace_s, t₀ when sample 0 was (PROTOCOL.md §5).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pace_s: Option<f64>,
 }
 
 impl ComponentConfig {

@@ -1,7 +1,7 @@
 //! The loop around a component's step function: ports, the step order of PROTOCOL.md §5, and
 //! the end sample. Everything is allocated in [`Runner::new`]; a step allocates nothing.
 
-use crate::clock::now_ns;
+use crate::clock::{now_ns, sleep_until_ns, tight_timers};
 use crate::error::LockstepError;
 use crate::port::{Bus, Inlet, Outlet};
 use crate::sample::Header;
@@ -62,6 +62,9 @@ pub struct Runner<C: Component> {
     done: Vec<u64>,
     inputs: Inputs,
     out: Vec<f64>,
+    /// The plant's pacing period, ns, and when its sample 0 went out.
+    pace_ns: Option<u64>,
+    t0: u64,
 }
 
 impl<C: Component> Runner<C> {
@@ -87,7 +90,23 @@ impl<C: Component> Runner<C> {
             done: vec![0; cfg.reads.len()],
             inputs: Inputs::new(cfg.reads.iter().map(|r| r.len)),
             out: vec![0.0; cfg.publishes.len],
+            pace_ns: cfg.pace_s.filter(|p| cfg.role == Role::Plant && p.is_finite() && *p > 0.0).map(|p| {
+                tight_timers();
+                (p * 1e9).round() as u64
+            }),
+            t0: 0,
         })
+    }
+
+    /// A paced plant waits for t₀ + k·pace before it publishes sample k (t₀: sample 0).
+    fn pace(&mut self, k: u64) {
+        if let Some(p) = self.pace_ns {
+            if k == 0 {
+                self.t0 = now_ns();
+            } else {
+                sleep_until_ns(self.t0 + k * p);
+            }
+        }
     }
 
     /// The component.
@@ -109,6 +128,7 @@ impl<C: Component> Runner<C> {
             }
         };
         self.comp.step(k, &self.inputs, &mut self.out)?;
+        self.pace(k);
         self.outlet.send(k, sim_time, taken_ns, &self.out).map_err(StepError::transport)?;
         Ok(())
     }
@@ -122,6 +142,7 @@ impl<C: Component> Runner<C> {
         let k = self.steps;
         let taken_ns = if k == 0 { 0 } else { self.take(k - 1, true)? };
         self.comp.step(k, &self.inputs, &mut self.out)?;
+        self.pace(k);
         self.outlet.send(k, k as f64 * self.dt, taken_ns, &self.out).map_err(StepError::transport)?;
         Ok(())
     }

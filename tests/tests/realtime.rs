@@ -1,0 +1,88 @@
+//! Issue 13, item 5: `--realtime [--speed X]` paces a run — step k starts at k·dt/X of wall
+//! time — with waits that sleep, and counts and records the steps that end late.
+
+use std::time::{Duration, Instant};
+
+use tests::*;
+
+/// utime + stime of a process, in clock ticks (/proc/<pid>/stat fields 14 and 15).
+fn cpu_ticks(pid: i32) -> Option<u64> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    let rest = stat.rsplit_once(')')?.1;
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    Some(f.get(11)?.parse::<u64>().ok()? + f.get(12)?.parse::<u64>().ok()?)
+}
+
+#[test]
+fn a_paced_run_keeps_wall_time_and_its_processes_idle() {
+    let s = Scratch::new("realtime");
+    let path = variant(&s, "seed002-sine", 3.0, false);
+    let child = launcher(&s).arg("run").arg(&path).arg("--out").arg(s.join("out")).arg("--realtime").stdout(std::process::Stdio::piped()).stderr(std::process::Stdio::piped()).spawn().unwrap();
+    let pid = child.id();
+    let names = ["plant", "uio", "luenberger", "controller"];
+    wait_running(pid, &names);
+    // CPU use of every component over one second in the middle of the run.
+    let pids: Vec<i32> = names.iter().map(|n| component_pid(pid, n).unwrap()).collect();
+    let before: Vec<u64> = pids.iter().map(|&p| cpu_ticks(p).unwrap()).collect();
+    let t = Instant::now();
+    std::thread::sleep(Duration::from_secs(1));
+    let after: Vec<Option<u64>> = pids.iter().map(|&p| cpu_ticks(p)).collect();
+    let secs = t.elapsed().as_secs_f64();
+    // SAFETY: sysconf has no preconditions.
+    let hz = unsafe { libc::sysconf(libc::_SC_CLK_TCK) } as f64;
+    for ((name, b), a) in names.iter().zip(&before).zip(&after) {
+        let share = (a.expect("still running") - b) as f64 / hz / secs;
+        assert!(share < 0.10, "{name} used {:.0} % of a core in a paced run", 100.0 * share);
+    }
+    let out = child.wait_with_output().unwrap();
+    assert!(out.status.success(), "{:?}", text(&out));
+    assert_clean(&s, pid);
+    let sum = summary(&s, "seed002-sine");
+    let rt = &sum["realtime"];
+    let (paced, scheduled) = (rt["paced_wall_s"].as_f64().unwrap(), rt["scheduled_s"].as_f64().unwrap());
+    assert!((scheduled - 3.0).abs() < 1e-9, "{rt}");
+    assert!((paced / scheduled - 1.0).abs() < 0.01, "paced {paced} s for {scheduled} s");
+    assert_eq!(rt["steps"], 3000);
+    let rec = read(&s.join("out").join("seed002-sine.rrd")).unwrap();
+    let overrun = &rec.series["/latency/overrun"];
+    assert_eq!(overrun.values.len(), 3000);
+    let late = overrun.values.iter().filter(|&&v| v > 0.0).count() as u64;
+    assert_eq!(rt["overruns"], late, "the summary counts what the recording shows");
+}
+
+#[test]
+fn speed_scales_the_pace_and_an_impossible_pace_is_reported() {
+    // Four times real time, in-process: 2 s of simulated time in 0.5 s.
+    let s = Scratch::new("realtime-speed");
+    let path = variant(&s, "seed002-sine", 2.0, false);
+    let out = run(&s, &path, &["--mode", "in-process", "--realtime", "--speed", "4"]);
+    assert!(out.status.success(), "{:?}", text(&out));
+    let rt = &summary(&s, "seed002-sine")["realtime"];
+    let paced = rt["paced_wall_s"].as_f64().unwrap();
+    assert!((paced / 0.5 - 1.0).abs() < 0.01, "{rt}");
+    // A million times real time at dt = 1 ms is a step per ns: no step can keep up, and the
+    // summary says so.
+    let t = Scratch::new("realtime-too-fast");
+    let out = run(&t, &path, &["--mode", "in-process", "--realtime", "--speed", "1e6", "--force"]);
+    assert!(out.status.success(), "{:?}", text(&out));
+    let (stdout, _) = text(&out);
+    assert!(stdout.contains("cannot keep up"), "{stdout}");
+    let rt = &summary(&t, "seed002-sine")["realtime"];
+    assert!(rt["overruns"].as_u64().unwrap() > 1000, "{rt}");
+    for bad in ["0", "-1", "nan", "inf"] {
+        let out = run(&t, &path, &["--mode", "in-process", "--realtime", "--speed", bad, "--force"]);
+        assert_eq!(out.status.code(), Some(2), "--speed {bad}: {:?}", text(&out));
+    }
+}
+
+/// A Python plant (the Python kit) paces itself from the same `pace_s` as the Rust kit.
+#[test]
+fn a_python_plant_is_paced_too() {
+    let s = Scratch::new("realtime-python");
+    // 10 s of simulated time at five times real time.
+    let out = run(&s, &scenario("cartpole-python-plant"), &["--realtime", "--speed", "5"]);
+    assert!(out.status.success(), "{:?}", text(&out));
+    let rt = &summary(&s, "cartpole-python-plant")["realtime"];
+    let (paced, scheduled) = (rt["paced_wall_s"].as_f64().unwrap(), rt["scheduled_s"].as_f64().unwrap());
+    assert!((scheduled - 2.0).abs() < 1e-9 && (paced / scheduled - 1.0).abs() < 0.01, "{rt}");
+}
