@@ -86,7 +86,12 @@ pub fn floor(steps: u64, lens: [usize; 3], wait: Wait, pin: bool) -> Result<Floo
             if pin && cpus.len() >= 2 {
                 let cpu = if i == 0 { cpus[0] } else { cpus[1 + (i - 1) % (cpus.len() - 1)] };
                 // SAFETY: the closure only calls sched_setaffinity (async-signal-safe).
-                unsafe { c.pre_exec(move || Ok(crate::run::pin_self(cpu))) };
+                unsafe {
+                    c.pre_exec(move || {
+                        crate::run::pin_self(cpu);
+                        Ok(())
+                    })
+                };
             }
             children.push(c.spawn().map_err(|x| fail(format!("{}: {x}", exe.display())))?);
         }

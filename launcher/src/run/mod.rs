@@ -17,7 +17,7 @@ use lockstep::Wait;
 
 pub use configs::{configs, Configs};
 pub use envelope::{envelopes, Launchable, Program};
-pub use session::{hop_entity, hop_names, RealtimeFigures, Session};
+pub use session::{hop_entity, hop_names, Finished, RealtimeFigures, Session};
 pub(crate) use processes::placement::{allowed_cpus, pin_self};
 
 use crate::error::LaunchError;
@@ -175,7 +175,7 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
         Err(e) => Stop::Failed(e.to_string()),
     };
     let steps_done = session.steps;
-    let (mut metrics, latency, digest, diagnosis, realtime) = session.finish().map_err(|e| {
+    let Finished { mut metrics, latency, digest, diagnosis, realtime } = session.finish().map_err(|e| {
         // Say why the run had stopped too, when the recording's failure is not the whole story.
         let why = match &stop {
             Stop::Completed => String::new(),

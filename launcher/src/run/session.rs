@@ -89,6 +89,20 @@ struct Pace {
     last_end: u64,
 }
 
+/// What a session leaves when it is closed.
+pub struct Finished {
+    /// The figures of merit.
+    pub metrics: Metrics,
+    /// The latency histograms.
+    pub latency: Latency,
+    /// The recording's digest, if one was written.
+    pub digest: Option<Digest>,
+    /// Detection, isolation and false alarms (with a diagnoser).
+    pub diagnosis: Option<Diagnosis>,
+    /// How a paced run kept its schedule.
+    pub realtime: Option<RealtimeFigures>,
+}
+
 /// A paced run's figures (summary.json → `realtime`).
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct RealtimeFigures {
@@ -423,9 +437,9 @@ impl Session {
         sink.flush_full().map_err(LaunchError::Component)
     }
 
-    /// Closes the recording (footer written); returns the figures and the recording's digest.
+    /// Closes the recording (footer written); returns what the run leaves ([`Finished`]).
     /// Fails, naming the file, when the recording could not be written whole.
-    pub fn finish(self) -> Result<(Metrics, Latency, Option<Digest>, Option<Diagnosis>, Option<RealtimeFigures>), LaunchError> {
+    pub fn finish(self) -> Result<Finished, LaunchError> {
         if let Some(p) = self.progress {
             p.finish();
         }
@@ -442,6 +456,6 @@ impl Session {
             paced_wall_s: p.t0.map_or(0.0, |t0| p.last_end.saturating_sub(t0) as f64 * 1e-9),
             scheduled_s: p.steps as f64 * p.period_ns as f64 * 1e-9,
         });
-        Ok((self.metrics, self.latency, digest, diagnosis, realtime))
+        Ok(Finished { metrics: self.metrics, latency: self.latency, digest, diagnosis, realtime })
     }
 }
