@@ -226,3 +226,28 @@ fn a_calibrated_threshold_is_the_margin_times_the_fault_free_maximum() {
         assert_eq!(*t, 1.5 * m, "threshold {t} against 1.5 × {m}");
     }
 }
+
+/// `--keep-worst K` runs the K worst realisations again with their recordings — the same runs,
+/// bit for bit, as `launcher run --seed` gives; `--runs 0` is bad input.
+#[test]
+fn a_sweep_keeps_its_worst_realisations_as_recordings() {
+    let name = "seed003-sensor-faults";
+    let s = Scratch::new("keep-worst");
+    let out = launcher(&s).arg("sweep").arg(scenario(name)).args(["--runs", "6", "--keep-worst", "2", "--out"]).arg(s.join("out")).output().unwrap();
+    assert!(out.status.success(), "{:?}", text(&out));
+    let sw: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(s.join("out").join(format!("{name}.sweep.json"))).unwrap()).unwrap();
+    let kept: Vec<u64> = sw["kept"].as_array().unwrap().iter().map(|v| v.as_u64().unwrap()).collect();
+    assert_eq!(kept.len(), 2, "{sw}");
+    let seed = kept[0];
+    let swept = read(&s.join("out").join(format!("{name}-seed{seed}.rrd"))).unwrap();
+    let t = Scratch::new("keep-worst-one");
+    let one = run(&t, &scenario(name), &["--mode", "in-process", "--seed", &seed.to_string()]);
+    assert!(one.status.success(), "{:?}", text(&one));
+    let alone = read(&t.join("out").join(format!("{name}.rrd"))).unwrap();
+    for ((ka, a), (kb, b)) in trajectories(&swept).iter().zip(trajectories(&alone)) {
+        assert_eq!(ka, &kb);
+        assert!(a.values.iter().zip(&b.values).all(|(x, y)| x.to_bits() == y.to_bits()), "{ka} differs");
+    }
+    let bad = launcher(&s).arg("sweep").arg(scenario(name)).args(["--runs", "0", "--out"]).arg(s.join("out")).output().unwrap();
+    assert_eq!(bad.status.code(), Some(2), "{:?}", text(&bad));
+}
