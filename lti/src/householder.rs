@@ -19,44 +19,71 @@ pub struct FullQr<T: ComplexField> {
 
 /// Householder QR of `a` (m×n) with the full m×m Q.
 pub fn full_qr<T: ComplexField<RealField = f64>>(a: &DMatrix<T>) -> FullQr<T> {
+    let m = a.nrows();
+    let (r, vs) = reflectors(a);
+    FullQr { q: q_columns(&vs, m, 0..m), r }
+}
+
+/// Columns `cols` of the Q of `a`'s Householder QR (the same bits as [`full_qr`]'s Q there:
+/// each column of Q is transformed by the reflectors on its own), at O(m·k) per column
+/// instead of the O(m²·k) of the whole Q — for a basis of the complement of `a`'s columns.
+pub fn qr_q_columns<T: ComplexField<RealField = f64>>(a: &DMatrix<T>, cols: std::ops::Range<usize>) -> DMatrix<T> {
+    let m = a.nrows();
+    let (_, vs) = reflectors(a);
+    q_columns(&vs, m, cols)
+}
+
+/// R and the reflectors (v, τ) of `a` (`xGEQRF`). The loops walk the column-major storage
+/// directly (column j of an m-row matrix is `[j·m, (j + 1)·m)`); each element sees the same operations in the same order as the textbook loops.
+fn reflectors<T: ComplexField<RealField = f64>>(a: &DMatrix<T>) -> (DMatrix<T>, Vec<(Vec<T>, T)>) {
     let (m, n) = a.shape();
     let k = m.min(n);
     let mut r = a.clone();
     let mut vs: Vec<(Vec<T>, T)> = Vec::with_capacity(k);
     for i in 0..k {
-        let (v, tau, beta) = reflector(&r.view((i, i), (m - i, 1)).iter().cloned().collect::<Vec<_>>());
+        let (v, tau, beta) = reflector(&r.as_slice()[i * m + i..(i + 1) * m]);
         // Apply Hᴴ = I − conj(τ) v vᴴ to the trailing columns (xLARF with conj(tau), as xGEQRF).
+        let tau_c = tau.clone().conjugate();
         for j in i + 1..n {
+            let col = &mut r.as_mut_slice()[j * m + i..(j + 1) * m];
             let mut w = T::zero();
-            for (p, vp) in v.iter().enumerate() {
-                w += vp.clone().conjugate() * r[(i + p, j)].clone();
+            for (vp, x) in v.iter().zip(col.iter()) {
+                w += vp.clone().conjugate() * x.clone();
             }
-            let s = tau.clone().conjugate() * w;
-            for (p, vp) in v.iter().enumerate() {
-                r[(i + p, j)] -= vp.clone() * s.clone();
+            let s = tau_c.clone() * w;
+            for (vp, x) in v.iter().zip(col.iter_mut()) {
+                *x -= vp.clone() * s.clone();
             }
         }
-        r[(i, i)] = beta;
-        for p in 1..m - i {
-            r[(i + p, i)] = T::zero();
+        let col = &mut r.as_mut_slice()[i * m + i..(i + 1) * m];
+        col[0] = beta;
+        for x in col.iter_mut().skip(1) {
+            *x = T::zero();
         }
         vs.push((v, tau));
     }
-    // Q = H₁ ⋯ H_k applied to I, accumulated backwards as xUNGQR does.
-    let mut q = DMatrix::<T>::identity(m, m);
-    for (i, (v, tau)) in vs.iter().enumerate().rev() {
-        for j in 0..m {
+    (r, vs)
+}
+
+/// Columns `cols` of Q = H₁ ⋯ H_k, each accumulated backwards from the identity's as xUNGQR does.
+fn q_columns<T: ComplexField<RealField = f64>>(vs: &[(Vec<T>, T)], m: usize, cols: std::ops::Range<usize>) -> DMatrix<T> {
+    let mut q = DMatrix::<T>::zeros(m, cols.len());
+    for (c, j) in cols.enumerate() {
+        let col = &mut q.as_mut_slice()[c * m..(c + 1) * m];
+        col[j] = T::one();
+        for (i, (v, tau)) in vs.iter().enumerate().rev() {
+            let part = &mut col[i..m];
             let mut w = T::zero();
-            for (p, vp) in v.iter().enumerate() {
-                w += vp.clone().conjugate() * q[(i + p, j)].clone();
+            for (vp, x) in v.iter().zip(part.iter()) {
+                w += vp.clone().conjugate() * x.clone();
             }
             let s = tau.clone() * w;
-            for (p, vp) in v.iter().enumerate() {
-                q[(i + p, j)] -= vp.clone() * s.clone();
+            for (vp, x) in v.iter().zip(part.iter_mut()) {
+                *x -= vp.clone() * s.clone();
             }
         }
     }
-    FullQr { q, r }
+    q
 }
 
 /// `xLARFG`: the reflector that maps `col = (α, x)` to (β, 0). Returns (v with v₀ = 1, τ, β).

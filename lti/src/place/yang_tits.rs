@@ -21,7 +21,7 @@ use nalgebra::{DMatrix, DVector};
 use super::eigenstructure::{abs_det, Eigenstructure};
 use super::knv0::converged;
 use crate::eig::C64;
-use crate::householder::full_qr;
+use crate::householder::qr_q_columns;
 
 /// Runs Tits–Yang sweeps from X until |det X| settles (scipy's rule), at most `max` sweeps.
 /// The poles in `es` must be ordered real first, then complex pairs.
@@ -110,7 +110,7 @@ fn schedule(es: &Eigenstructure) -> Vec<Update> {
 fn knv_column(es: &Eigenstructure, x: &mut DMatrix<C64>, i: usize) {
     let n = x.nrows();
     let others = x.clone().remove_column(i);
-    let y = full_qr(&others).q.column(n - 1).into_owned();
+    let y = qr_q_columns(&others, n - 1..n).column(0).into_owned();
     if let Some(v) = es.project(i, &y) {
         es.set(x, i, &v);
     }
@@ -122,8 +122,7 @@ fn knv_column(es: &Eigenstructure, x: &mut DMatrix<C64>, i: usize) {
 /// conjugation and have a real basis: orthonormalise the real and imaginary parts.
 fn complement(x: &DMatrix<C64>, i: usize, j: usize) -> (DVector<f64>, DVector<f64>) {
     let n = x.nrows();
-    let q = full_qr(&x.clone().remove_columns_at(&[i, j])).q;
-    let q2 = q.columns(n - 2, 2);
+    let q2 = qr_q_columns(&x.clone().remove_columns_at(&[i, j]), n - 2..n);
     let mut parts = DMatrix::<f64>::zeros(n, 4);
     for c in 0..2 {
         parts.set_column(2 * c, &q2.column(c).map(|e| e.re));
