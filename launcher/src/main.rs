@@ -119,6 +119,10 @@ enum Command {
         /// Repetitions (each: the floor, then every configuration); ratios are given as medians.
         #[arg(long, default_value_t = 1)]
         repeat: usize,
+        /// Instead: how a step's cost grows with the model, for random stable plants of these
+        /// sizes with a UIO and a Luenberger observer in closed loop (e.g. 3,10,30).
+        #[arg(long, value_name = "N[,N…]", value_delimiter = ',')]
+        states: Vec<usize>,
     },
     /// One node of the benchmark's floor ring (started by `launcher bench`).
     #[command(hide = true)]
@@ -325,7 +329,7 @@ fn main() -> ExitCode {
                 Err(e) => fail(&LaunchError::Component(format!("floor node {index}: {e}"))),
             }
         }
-        Command::Bench { steps, json, wait, mode, recording, pin, repeat } => {
+        Command::Bench { steps, json, wait, mode, recording, pin, repeat, states } => {
             let wait = wait.unwrap_or_else(Wait::default_for_machine);
             let modes: Vec<Mode> = match mode.as_deref() {
                 Some("processes") => vec![Mode::Processes],
@@ -337,6 +341,19 @@ fn main() -> ExitCode {
                 Some(_) => vec![false],
                 None => vec![false, true],
             };
+            if !states.is_empty() {
+                return match launcher::bench::states::states(&states, steps, wait, pin == "auto", &modes, &rec) {
+                    Ok(runs) => {
+                        if json {
+                            println!("{}", serde_json::to_string_pretty(&serde_json::json!({ "states": runs })).expect("serialises"));
+                        } else {
+                            print!("{}", launcher::bench::states::table(&runs));
+                        }
+                        ExitCode::SUCCESS
+                    }
+                    Err(e) => fail(&e),
+                };
+            }
             match launcher::bench::bench(&shipped::dir().join("seed002-sine.toml"), steps, wait, pin == "auto", &modes, &rec, repeat) {
                 Ok(runs) => {
                     if json {

@@ -5,6 +5,7 @@
 //! configuration, so that the machine's drift falls on both sides of a ratio alike.
 
 pub mod floor;
+pub mod states;
 
 use std::path::Path;
 
