@@ -44,29 +44,36 @@ pub fn bench(scenario: &Path, steps: u64, wait: Wait, pin: bool, modes: &[Mode],
     let lay = crate::run::configs(&s, &p).layout;
     let mut out = Vec::new();
     for _ in 0..repeat.max(1) {
-    if modes.contains(&Mode::Processes) {
-        let f = floor::floor(steps, [lay.len(), lay.n, lay.l], wait, pin)?;
-        out.push(BenchRun { mode: "floor".into(), recording: false, steps, steps_per_s: f.steps_per_s, step_ns: f.inner.step_ns });
-    }
-    for &mode in modes {
-        for &record in recording {
-            let opts = Options { out: tmp.clone(), mode, wait, force: true, allow_unstable: false, record, pin, select: Default::default(), progress: false, realtime: None };
-            let o = run(&s, &p, &opts)?;
-            if o.stop != Stop::Completed {
-                return Err(LaunchError::Component(format!("benchmark run stopped: {:?}", o.stop)));
-            }
-            out.push(BenchRun {
-                mode: mode.name().into(),
-                recording: record,
-                steps: o.summary.steps,
-                steps_per_s: o.summary.steps_per_s,
-                step_ns: o.summary.latency_ns.step,
-            });
+        if modes.contains(&Mode::Processes) {
+            let f = floor::floor(steps, [lay.len(), lay.n, lay.l], wait, pin)?;
+            out.push(BenchRun { mode: "floor".into(), recording: false, steps, steps_per_s: f.steps_per_s, step_ns: f.inner.step_ns });
         }
-    }
+        for &mode in modes {
+            for &record in recording {
+                let o = measure(&s, &p, &tmp, mode, wait, record, pin)?;
+                out.push(BenchRun {
+                    mode: mode.name().into(),
+                    recording: record,
+                    steps: o.summary.steps,
+                    steps_per_s: o.summary.steps_per_s,
+                    step_ns: o.summary.latency_ns.step,
+                });
+            }
+        }
     }
     let _ = std::fs::remove_dir_all(&tmp);
     Ok(out)
+}
+
+/// One benchmark run of `s` (outputs overwritten in `tmp`, no progress bar, no pacing); a run
+/// that stops early is an error.
+pub(crate) fn measure(s: &Scenario, p: &crate::plan::Plan, tmp: &Path, mode: Mode, wait: Wait, record: bool, pin: bool) -> Result<crate::run::Outcome, LaunchError> {
+    let opts = Options { out: tmp.to_path_buf(), mode, wait, force: true, allow_unstable: false, record, pin, select: Default::default(), progress: false, realtime: None };
+    let o = run(s, p, &opts)?;
+    if o.stop != Stop::Completed {
+        return Err(LaunchError::Component(format!("{}: benchmark run stopped: {:?}", s.name, o.stop)));
+    }
+    Ok(o)
 }
 
 /// The printed table.

@@ -19,7 +19,7 @@ use scenario::Scenario;
 
 use crate::error::LaunchError;
 use crate::plan::plan;
-use crate::run::{run, Mode, Options, Stop};
+use crate::run::Mode;
 
 /// One (n, mode, recording) measurement.
 #[derive(Debug, Clone, Serialize)]
@@ -125,11 +125,7 @@ pub fn states(states: &[usize], steps: u64, wait: Wait, pin: bool, modes: &[Mode
         let design_s = t.elapsed().as_secs_f64();
         for &mode in modes {
             for &record in recording {
-                let opts = Options { out: tmp.clone(), mode, wait, force: true, allow_unstable: false, record, pin, select: Default::default(), progress: false, realtime: None };
-                let o = run(&s, &p, &opts)?;
-                if o.stop != Stop::Completed {
-                    return Err(LaunchError::Component(format!("states-{n}: benchmark run stopped: {:?}", o.stop)));
-                }
+                let o = super::measure(&s, &p, &tmp, mode, wait, record, pin)?;
                 let bytes = o.rrd.as_ref().and_then(|f| std::fs::metadata(f).ok()).map(|m| m.len() as f64 / o.summary.steps.max(1) as f64);
                 out.push(StatesRun {
                     n,
