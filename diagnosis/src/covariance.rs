@@ -18,12 +18,12 @@
 use lti::Mat;
 use observer::LinearObserver;
 
+use crate::residual::Residual;
+
 /// M with MΦ − FM = KC, by its Kronecker form (Φᵀ ⊗ I − I ⊗ F) vec M = vec KC.
-pub fn tracked(phi: &Mat, obs: &LinearObserver, c: &Mat) -> Result<Mat, String> {
-    let f: Mat = (&obs.f).into();
-    let k: Mat = (&obs.k).into();
+pub fn tracked(phi: &Mat, f: &Mat, k: &Mat, c: &Mat) -> Result<Mat, String> {
     let (n, r) = (phi.nrows(), f.nrows());
-    let op = phi.transpose().kronecker(&Mat::identity(r, r)) - Mat::identity(n, n).kronecker(&f);
+    let op = phi.transpose().kronecker(&Mat::identity(r, r)) - Mat::identity(n, n).kronecker(f);
     let rhs = k * c;
     let v = op
         .lu()
@@ -34,21 +34,15 @@ pub fn tracked(phi: &Mat, obs: &LinearObserver, c: &Mat) -> Result<Mat, String> 
 
 /// Σ_r of the residual on `outputs`.
 pub fn residual_covariance(phi: &Mat, c: &Mat, obs: &LinearObserver, outputs: &[usize], qd: &Mat, rn: &Mat) -> Result<Mat, String> {
-    let m = tracked(phi, obs, c)?;
-    let (n, p) = (phi.nrows(), c.nrows());
-    let f: Mat = (&obs.f).into();
-    let k: Mat = (&obs.k).into();
-    let pm: Mat = (&obs.p).into();
-    let q: Mat = (&obs.q).into();
+    let Residual { f, k, p: pm, q, s, i_cq, cp } = Residual::new(c, obs, outputs);
+    let m = tracked(phi, &f, &k, c)?;
+    let n = phi.nrows();
     let defect = (&pm * &m + &q * c - Mat::identity(n, n)).norm();
     if defect > 1e-8 * (1.0 + (&pm * &m).norm()) {
         return Err(format!("it does not estimate the plant's state (‖PM + QC − I‖ = {defect:.1e})"));
     }
     let w = &k * rn * k.transpose() + &m * qd * m.transpose();
     let sz = lti::lyapunov::discrete(&f.transpose(), &w).map_err(|e| e.to_string())?;
-    let s = Mat::from_fn(outputs.len(), p, |i, j| if outputs[i] == j { 1.0 } else { 0.0 });
-    let i_cq = Mat::identity(p, p) - c * &q;
-    let cp = c * &pm;
     let full = &cp * sz * cp.transpose() + &i_cq * rn * i_cq.transpose();
     let out = &s * full * s.transpose();
     Ok((&out + out.transpose()) * 0.5)

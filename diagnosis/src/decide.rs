@@ -6,9 +6,6 @@
 //! fault is "unknown" when a matches no column (or several). Before `ignore_before` nothing is
 //! decided: the observers start from zero and their start-up transient is no fault.
 
-use lti::kernel::mul_into;
-use lti::Mat;
-
 use crate::bank::Bank;
 use crate::evaluate::Evaluator;
 
@@ -45,17 +42,17 @@ pub struct Monitor {
     pub labels: Vec<String>,
     /// The structure matrix.
     pub structure: Vec<Vec<u8>>,
-    /// Index of each member's estimate among the run's observers.
+    /// Index of each member among the run's observers.
     observers: Vec<usize>,
     outputs: Vec<Vec<usize>>,
+    /// The false-alarm probability per sample the χ² thresholds were set for, if they were.
+    pub asked_false_alarm: Option<f64>,
     evaluators: Vec<Evaluator>,
     /// Per member.
     pub thresholds: Vec<f64>,
     persistence: u32,
     /// The first step decided.
     pub start_step: u64,
-    c: Mat,
-    full: Vec<f64>,
     counts: Vec<u32>,
     /// This step's residual per member (on its outputs).
     pub residuals: Vec<Vec<f64>>,
@@ -70,10 +67,9 @@ pub struct Monitor {
 }
 
 impl Monitor {
-    /// For `bank`, whose member i's estimate is observer `observers[i]` of the run.
-    pub fn new(bank: &Bank, observers: Vec<usize>, c: &Mat, dt: f64) -> Self {
+    /// For `bank`, whose member i is observer `observers[i]` of the run.
+    pub fn new(bank: &Bank, observers: Vec<usize>, dt: f64) -> Self {
         let m = bank.members.len();
-        let start_step = (bank.spec.ignore_before / dt - 1e-9).ceil().max(0.0) as u64;
         Monitor {
             name: bank.spec.name.clone(),
             channels: bank.spec.channels,
@@ -81,12 +77,11 @@ impl Monitor {
             structure: bank.structure.clone(),
             observers,
             outputs: bank.members.iter().map(|mb| mb.outputs.clone()).collect(),
+            asked_false_alarm: if let crate::Threshold::FalseAlarm(a) = bank.spec.threshold { Some(a) } else { None },
             evaluators: bank.members.iter().map(|mb| Evaluator::new(bank.spec.evaluation, mb.covariance.as_ref())).collect(),
             thresholds: bank.members.iter().map(|mb| mb.threshold).collect(),
             persistence: bank.spec.persistence.max(1),
-            start_step,
-            c: c.clone(),
-            full: vec![0.0; c.nrows()],
+            start_step: lti::signal::first_sample_from(bank.spec.ignore_before, dt),
             counts: vec![0; m],
             residuals: bank.members.iter().map(|mb| vec![0.0; mb.outputs.len()]).collect(),
             evals: vec![0.0; m],
@@ -96,13 +91,14 @@ impl Monitor {
         }
     }
 
-    /// Step k: residuals of the members' estimates against y_k, evaluations, alarms, isolation.
-    pub fn step(&mut self, k: u64, y: &[f64], xhat: &[Vec<f64>]) {
+    /// Step k, from every observer's residual y_k − Cx̂_k (as the run's figures computed them):
+    /// each member's residual on its outputs, evaluations, alarms, isolation.
+    pub fn step(&mut self, k: u64, residuals: &[Vec<f64>]) {
         let deciding = k >= self.start_step;
         for i in 0..self.observers.len() {
-            mul_into(&mut self.full, &self.c, &xhat[self.observers[i]]);
+            let full = &residuals[self.observers[i]];
             for (r, &j) in self.residuals[i].iter_mut().zip(&self.outputs[i]) {
-                *r = y[j] - self.full[j];
+                *r = full[j];
             }
             let j = self.evaluators[i].push(&self.residuals[i]);
             self.evals[i] = j;

@@ -101,15 +101,11 @@ pub struct Judge {
     max_eval: Vec<Vec<f64>>,
 }
 
-fn step_of(t: f64, dt: f64) -> u64 {
-    if t.is_finite() { (t / dt - 1e-9).ceil().max(0.0) as u64 } else { u64::MAX }
-}
-
 impl Judge {
     /// For a run with these faults and monitors.
     pub fn new(mut faults: Vec<FaultInfo>, monitors: &[Monitor], dt: f64) -> Self {
         faults.sort_by(|a, b| a.start.total_cmp(&b.start));
-        let starts: Vec<u64> = faults.iter().map(|f| step_of(f.start, dt)).collect();
+        let starts: Vec<u64> = faults.iter().map(|f| lti::signal::first_sample_from(f.start, dt)).collect();
         let windows = starts.iter().map(|&s| (s, starts.iter().copied().filter(|&t| t > s).min().unwrap_or(u64::MAX))).collect();
         let figures = faults
             .iter()
@@ -186,13 +182,13 @@ impl Judge {
         }
     }
 
-    /// The figures, with the thresholds asked for per monitor (χ² α, if any).
-    pub fn finish(self, monitors: &[Monitor], asked: &[Option<f64>]) -> Diagnosis {
+    /// The figures.
+    pub fn finish(self, monitors: &[Monitor]) -> Diagnosis {
         let residuals = monitors
             .iter()
             .zip(self.counts.iter().zip(&self.max_eval))
-            .zip(asked)
-            .flat_map(|((m, (counts, max)), &alpha)| {
+            .flat_map(|(m, (counts, max))| {
+                let alpha = m.asked_false_alarm;
                 counts.iter().enumerate().map(move |(i, &(steps, exc))| ResidualFigure {
                     residual: format!("{}-{}", m.name, i + 1),
                     threshold: m.thresholds[i],

@@ -5,6 +5,7 @@
 //!   threshold, decision;
 //! * [`bank`] — the members' models and designs (each one a [`observer::LinearObserver`]), and
 //!   the bank's structure matrix computed from them ([`structure`]);
+//! * [`residual`] — a member's residual in terms of its observer's state and the measurement;
 //! * [`covariance`] — the stationary covariance of a member's residual under the noise;
 //! * [`evaluate`] — residual evaluation signals and thresholds;
 //! * [`decide`] — alarms and isolation per step ([`Monitor`]);
@@ -15,6 +16,7 @@ pub mod covariance;
 pub mod decide;
 pub mod evaluate;
 pub mod figures;
+pub mod residual;
 pub mod spec;
 pub mod structure;
 

@@ -18,6 +18,8 @@ use lti::Mat;
 use nalgebra::DVector;
 use observer::LinearObserver;
 
+use crate::residual::Residual;
+
 /// How a fault enters the plant.
 #[derive(Debug, Clone)]
 pub enum FaultInput {
@@ -33,22 +35,17 @@ pub const BLIND: f64 = 1e-9;
 /// The largest relative Markov parameter of the fault-to-residual transfer: ≈ ε for a residual
 /// blind to the fault, O(1e-3 … 1) for one that reacts.
 pub fn sensitivity(phi: &Mat, c: &Mat, obs: &LinearObserver, outputs: &[usize], input: &FaultInput) -> f64 {
-    let (n, p) = (phi.nrows(), c.nrows());
-    let f: Mat = (&obs.f).into();
-    let k: Mat = (&obs.k).into();
-    let pm: Mat = (&obs.p).into();
-    let q: Mat = (&obs.q).into();
+    let n = phi.nrows();
+    let Residual { f, k, s, i_cq, cp, .. } = Residual::new(c, obs, outputs);
     let r = f.nrows();
     let dim = n + r;
     let mut a = Mat::zeros(dim, dim);
     a.view_mut((0, 0), (n, n)).copy_from(phi);
     a.view_mut((n, 0), (r, n)).copy_from(&(&k * c));
     a.view_mut((n, n), (r, r)).copy_from(&f);
-    let s = Mat::from_fn(outputs.len(), p, |i, j| if outputs[i] == j { 1.0 } else { 0.0 });
-    let i_cq = Mat::identity(p, p) - c * &q;
     let mut ca = Mat::zeros(outputs.len(), dim);
     ca.view_mut((0, 0), (outputs.len(), n)).copy_from(&(&s * &i_cq * c));
-    ca.view_mut((0, n), (outputs.len(), r)).copy_from(&(-(&s * c * &pm)));
+    ca.view_mut((0, n), (outputs.len(), r)).copy_from(&(-(&s * &cp)));
     let mut b = DVector::zeros(dim);
     let mut direct = 0.0;
     match input {

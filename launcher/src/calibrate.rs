@@ -26,18 +26,7 @@ pub fn calibrate(s: &Scenario, plan: &mut Plan) -> Result<(), LaunchError> {
     let mut clean = s.clone();
     clean.faults.clear();
     clean.expect = Default::default();
-    let opts = Options {
-        out: std::env::temp_dir(),
-        mode: Mode::InProcess,
-        wait: lockstep::Wait::default_for_machine(),
-        force: false,
-        allow_unstable: true,
-        record: false,
-        pin: false,
-        select: recording::write::Selection::default(),
-        progress: false,
-        realtime: None,
-    };
+    let opts = Options { allow_unstable: true, ..Options::quiet(&std::env::temp_dir(), Mode::InProcess, lockstep::Wait::default_for_machine(), false) };
     let mut top: Vec<Vec<f64>> = plan.banks.iter().map(|b| vec![f64::NEG_INFINITY; b.members.len()]).collect();
     for r in 0..most {
         clean.seed = SEED_OFFSET.wrapping_add(s.seed).wrapping_add(r as u64);
@@ -47,16 +36,12 @@ pub fn calibrate(s: &Scenario, plan: &mut Plan) -> Result<(), LaunchError> {
             return Err(LaunchError::Component(format!("{}: calibration realisation {} (seed {}) did not complete: {why}", s.name, r + 1, clean.seed)));
         }
         let figures = o.summary.diagnosis.map(|d| d.residuals).unwrap_or_default();
-        let mut at = 0;
-        for (b, tops) in top.iter_mut().enumerate() {
-            let runs = wanted.iter().find(|w| w.0 == b).map_or(0, |w| w.1);
-            for t in tops.iter_mut() {
-                if r < runs
-                    && let Some(v) = figures.get(at).and_then(|f| f.max_fault_free_evaluation)
-                {
+        for &(b, _, _) in wanted.iter().filter(|w| r < w.1) {
+            for (t, m) in top[b].iter_mut().zip(&plan.banks[b].members) {
+                // A residual's figures carry its member's name.
+                if let Some(v) = figures.iter().find(|f| f.residual == m.name).and_then(|f| f.max_fault_free_evaluation) {
                     *t = t.max(v);
                 }
-                at += 1;
             }
         }
     }

@@ -209,6 +209,17 @@ fn load(arg: &Path) -> Result<Scenario, LaunchError> {
     Ok(Scenario::load(&shipped::resolve(arg)?)?)
 }
 
+/// A scenario loaded, with `seed` in place of its own, designed, and its calibrated thresholds set.
+fn prepared(arg: &Path, seed: Option<u64>) -> Result<(Scenario, plan::Plan), LaunchError> {
+    let mut s = load(arg)?;
+    if let Some(seed) = seed {
+        s.seed = seed;
+    }
+    let mut p = plan::plan(&s).map_err(|e| LaunchError::Scenario(e.error))?;
+    launcher::calibrate::calibrate(&s, &mut p)?;
+    Ok((s, p))
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let command = cli.command.unwrap_or_else(|| Command::Run {
@@ -238,20 +249,10 @@ fn main() -> ExitCode {
                 Ok(x) => x,
                 Err(e) => return fail(&LaunchError::BadInput(e)),
             };
-            let mut s = match load(&scenario) {
-                Ok(s) => s,
+            let (s, p) = match prepared(&scenario, seed) {
+                Ok(x) => x,
                 Err(e) => return fail(&e),
             };
-            if let Some(seed) = seed {
-                s.seed = seed;
-            }
-            let mut p = match plan::plan(&s) {
-                Ok(p) => p,
-                Err(e) => return fail(&LaunchError::Scenario(e.error)),
-            };
-            if let Err(e) = launcher::calibrate::calibrate(&s, &mut p) {
-                return fail(&e);
-            }
             for w in &p.warnings {
                 eprintln!("warning: {w}");
             }
@@ -278,23 +279,14 @@ fn main() -> ExitCode {
             }
         }
         Command::Sweep { scenario, runs, jobs, seed, mode, out, keep_worst } => {
-            let s = match load(&scenario) {
-                Ok(s) => s,
+            // One calibration for every realisation, from the first seed.
+            let (s, p) = match prepared(&scenario, seed) {
+                Ok(x) => x,
                 Err(e) => return fail(&e),
             };
-            let mut p = match plan::plan(&s) {
-                Ok(p) => p,
-                Err(e) => return fail(&LaunchError::Scenario(e.error)),
-            };
-            // One calibration for every realisation, from the first seed.
-            let mut first = s.clone();
-            first.seed = seed.unwrap_or(s.seed);
-            if let Err(e) = launcher::calibrate::calibrate(&first, &mut p) {
-                return fail(&e);
-            }
             let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
             let mode = if mode == "processes" { Mode::Processes } else { Mode::InProcess };
-            let opts = launcher::sweep::SweepOptions { runs, jobs, seed: seed.unwrap_or(s.seed), mode, out: out.clone(), keep_worst, wait: Wait::default_for_machine() };
+            let opts = launcher::sweep::SweepOptions { runs, jobs, seed: s.seed, mode, out: out.clone(), keep_worst, wait: Wait::default_for_machine() };
             run::interrupt::install();
             match launcher::sweep::sweep(&s, &p, &opts) {
                 Ok(sw) => {

@@ -404,7 +404,7 @@ pub(crate) fn finite(name: &str, m: &Mat) -> Result<()> {
 
 /// What a symmetric argument must be.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Definite {
+pub enum Definite {
     /// ⪰ 0 (a covariance, a state weight).
     Semi,
     /// ≻ 0 (an input weight, a measurement covariance that is inverted).
@@ -415,7 +415,7 @@ pub(crate) enum Definite {
 /// and definite: λ_min ≥ −τ for ⪰ 0, λ_min > τ for ≻ 0, τ = 100·n·ε·‖M‖₁ — the rounding of a
 /// matrix that was formed by products, so that a computed covariance of exact rank deficiency
 /// passes as ⪰ 0 and an R with cond(R) ≳ 10¹³/n counts as singular.
-pub(crate) fn symmetric(name: &str, m: &Mat, definite: Definite) -> Result<Mat> {
+pub fn symmetric(name: &str, m: &Mat, definite: Definite) -> Result<Mat> {
     finite(name, m)?;
     let norm = one_norm(m);
     if one_norm(&(m - m.transpose())) > 100.0 * f64::EPSILON * norm {

@@ -64,6 +64,16 @@ pub fn locate(time: f64, dt: f64) -> Switch {
     }
 }
 
+/// The first sample at or after T, the decimals compared exactly as [`locate`] does (0 for
+/// T ≤ 0; `u64::MAX` for a T after any run, ∞ included).
+pub fn first_sample_from(time: f64, dt: f64) -> u64 {
+    match locate(time, dt) {
+        Switch::OnSample(k) => k,
+        Switch::Inside { step, .. } => step + 1,
+        Switch::Beyond => u64::MAX,
+    }
+}
+
 /// Whether a switch at T is in effect at sample k: T ≤ k·dt, the decimals compared exactly.
 /// Allocation-free (the plant and controller call it every step); the exact comparison runs only
 /// when T/dt is within 10⁻¹² (relative) of k, where the binary quotient could be on the wrong side.

@@ -111,24 +111,13 @@ pub(crate) struct Scheduled {
     ramp: bool,
 }
 
-/// The sample index of a time on the grid (validated to be on a sample); after the run: u64::MAX.
-fn sample_of(t: f64, dt: f64) -> u64 {
-    if !t.is_finite() {
-        return u64::MAX;
-    }
-    match lti::signal::locate(t, dt) {
-        lti::signal::Switch::OnSample(k) => k,
-        // Validation puts every time on a sample; anything else is read as its next sample.
-        lti::signal::Switch::Inside { step, .. } => step + 1,
-        lti::signal::Switch::Beyond => u64::MAX,
-    }
-}
-
 impl Scheduled {
     pub fn new(fault: &Fault, dt: f64) -> Self {
-        let steps = fault.profile.intervals().iter().map(|i| (sample_of(i[0], dt), sample_of(i[1], dt))).collect();
+        // Validation puts every time on a sample (a time between would take effect at the next).
+        let sample_of = |t: f64| lti::signal::first_sample_from(t, dt);
+        let steps = fault.profile.intervals().iter().map(|i| (sample_of(i[0]), sample_of(i[1]))).collect();
         let ramp = matches!(fault.profile, Profile::Ramp { .. }) || fault.kind == Kind::Drift;
-        Scheduled { fault: fault.clone(), steps, k0: sample_of(fault.profile.start(), dt), ramp }
+        Scheduled { fault: fault.clone(), steps, k0: sample_of(fault.profile.start()), ramp }
     }
 
     /// Whether the fault acts over step k (from t_k on).

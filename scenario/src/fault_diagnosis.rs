@@ -21,25 +21,17 @@ pub struct NoiseSpec {
     pub r: Mat,
 }
 
-/// A covariance: square of the size asked, symmetric, positive semi-definite.
-fn covariance(field: &str, rows: &super::raw::Rows, size: Option<usize>, why: &str) -> Result<Mat, Bad> {
+/// A covariance named `symbol` (Q_c, Q_d, R): of the size asked, and symmetric ⪰ 0 by the rule
+/// the Riccati and Van Loan code applies to its arguments ([`lti::dare::symmetric`]).
+fn covariance(field: &str, symbol: &str, rows: &super::raw::Rows, size: Option<usize>, why: &str) -> Result<Mat, Bad> {
     let m = matrix(field, rows, (size, size), why)?;
-    if m.nrows() != m.ncols() {
-        return Err(bad(field, format!("is {}×{}, a covariance is square", m.nrows(), m.ncols())));
-    }
-    let scale = m.iter().fold(0.0f64, |a, &b| a.max(b.abs())).max(f64::MIN_POSITIVE);
-    for i in 0..m.nrows() {
-        for j in 0..i {
-            if (m[(i, j)] - m[(j, i)]).abs() > 1e-12 * scale {
-                return Err(bad(field, format!("is not symmetric: entry ({}, {}) = {} but ({}, {}) = {}", i + 1, j + 1, m[(i, j)], j + 1, i + 1, m[(j, i)])));
-            }
-        }
-    }
-    let low = m.clone().symmetric_eigen().eigenvalues.min();
-    if low < -1e-12 * scale {
-        return Err(bad(field, format!("is not positive semi-definite: it has the eigenvalue {low:.6e}")));
-    }
-    Ok(m)
+    lti::dare::symmetric(symbol, &m, lti::dare::Definite::Semi).map_err(|e| {
+        let reason = match e {
+            lti::LtiError::InvalidInput(r) => r,
+            other => other.to_string(),
+        };
+        bad(field, reason)
+    })
 }
 
 /// `[noise]`, with Q_d computed from the continuous intensity by Van Loan's method.
@@ -53,14 +45,14 @@ pub(crate) fn noise(raw: &Option<RawNoise>, model: &Model, dt: f64) -> Result<Op
                 Some(g) => matrix("noise.G", g, (Some(n), None), "n rows, one column per process-noise input")?,
                 None => Mat::identity(n, n),
             };
-            let qc = covariance("noise.process", qc, Some(g.ncols()), "one row and column per column of noise.G")?;
+            let qc = covariance("noise.process", "Q_c", qc, Some(g.ncols()), "one row and column per column of noise.G")?;
             lti::process_noise_covariance(&model.a, &g, &qc, dt).map_err(|e| bad("noise.process", e.to_string()))?
         }
         (None, Some(qd)) => {
             if z.g.is_some() {
                 return Err(bad("noise.G", "G shapes the continuous intensity `process`; process_discrete is the state's own covariance"));
             }
-            covariance("noise.process_discrete", qd, Some(n), "n×n, the covariance of the state's noise per step")?
+            covariance("noise.process_discrete", "Q_d", qd, Some(n), "n×n, the covariance of the state's noise per step")?
         }
         (None, None) => {
             if z.g.is_some() {
@@ -70,7 +62,7 @@ pub(crate) fn noise(raw: &Option<RawNoise>, model: &Model, dt: f64) -> Result<Op
         }
     };
     let r = match &z.measurement {
-        Some(r) => covariance("noise.measurement", r, Some(p), "p×p, one row and column per output")?,
+        Some(r) => covariance("noise.measurement", "R", r, Some(p), "p×p, one row and column per output")?,
         None => Mat::zeros(p, p),
     };
     Ok(Some(NoiseSpec { qd, r }))

@@ -53,21 +53,17 @@ fn bank_members_decouple_to_rounding_and_give_the_asked_structure() {
 #[test]
 fn an_impossible_member_is_refused_by_name_and_condition() {
     let s = Scratch::new("two-sensors");
-    let text = std::fs::read_to_string(scenario("seed002-actuator-faults")).unwrap();
-    let text = text.replace("C = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]", "C = [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]").replace(
+    let source = std::fs::read_to_string(scenario("seed002-actuator-faults")).unwrap();
+    let source = source.replace("C = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]", "C = [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]").replace(
         "measurement = [[1e-4, 0.0, 0.0], [0.0, 1e-4, 0.0], [0.0, 0.0, 1e-4]]",
         "measurement = [[1e-4, 0.0], [0.0, 1e-4]]",
     );
     let p = s.join("two.toml");
-    std::fs::write(&p, text).unwrap();
+    std::fs::write(&p, source).unwrap();
     let out = launcher(&s).arg("design").arg(&p).output().unwrap();
-    let (stdout, _) = text_of(&out);
+    let (stdout, _) = text(&out);
     assert_eq!(out.status.code(), Some(2), "{stdout}");
     assert!(stdout.contains("member 1 (blind to u1 and the unknown inputs)") && stdout.contains("rank(CE) = rank(E) does not hold: 1 ≠ 2"), "{stdout}");
-}
-
-fn text_of(o: &std::process::Output) -> (String, String) {
-    text(o)
 }
 
 /// A scenario with a change of its text, written to the scratch directory.

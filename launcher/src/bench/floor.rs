@@ -74,17 +74,16 @@ pub fn floor(steps: u64, lens: [usize; 3], wait: Wait, pin: bool) -> Result<Floo
     let fail = |m: String| LaunchError::Component(format!("bench floor: {m}"));
     let space = RunSpace::create().map_err(|x| fail(x.to_string()))?;
     let exe = std::env::current_exe().map_err(|x| fail(x.to_string()))?;
-    let cpus = crate::run::allowed_cpus();
+    let cpus = crate::run::ring_cpus(3, pin);
     let start = Instant::now();
     let mut children = Vec::new();
     let result = (|| {
-        for i in 0..3 {
+        for (i, &cpu) in cpus.iter().enumerate() {
             let mut c = Command::new(&exe);
             c.arg("floor-node").arg(space.id()).args([i.to_string(), steps.to_string()]).args(lens.map(|l| l.to_string())).arg(wait.to_string());
             c.stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::inherit());
-            // As the run's ring: the plant alone on the first CPU, the others on the rest.
-            if pin && cpus.len() >= 2 {
-                let cpu = if i == 0 { cpus[0] } else { cpus[1 + (i - 1) % (cpus.len() - 1)] };
+            // Placed as the run's ring is (the plant on a CPU of its own).
+            if let Some(cpu) = cpu {
                 // SAFETY: the closure only calls sched_setaffinity (async-signal-safe).
                 unsafe {
                     c.pre_exec(move || {

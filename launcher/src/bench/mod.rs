@@ -68,7 +68,7 @@ pub fn bench(scenario: &Path, steps: u64, wait: Wait, pin: bool, modes: &[Mode],
 /// One benchmark run of `s` (outputs overwritten in `tmp`, no progress bar, no pacing); a run
 /// that stops early is an error.
 pub(crate) fn measure(s: &Scenario, p: &crate::plan::Plan, tmp: &Path, mode: Mode, wait: Wait, record: bool, pin: bool) -> Result<crate::run::Outcome, LaunchError> {
-    let opts = Options { out: tmp.to_path_buf(), mode, wait, force: true, allow_unstable: false, record, pin, select: Default::default(), progress: false, realtime: None };
+    let opts = Options { pin, ..Options::quiet(tmp, mode, wait, record) };
     let o = run(s, p, &opts)?;
     if o.stop != Stop::Completed {
         return Err(LaunchError::Component(format!("{}: benchmark run stopped: {:?}", s.name, o.stop)));

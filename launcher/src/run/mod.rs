@@ -18,7 +18,7 @@ use lockstep::Wait;
 pub use configs::{configs, Configs};
 pub use envelope::{envelopes, Launchable, Program};
 pub use session::{hop_entity, hop_names, Finished, RealtimeFigures, Session};
-pub(crate) use processes::placement::{allowed_cpus, pin_self};
+pub(crate) use processes::placement::{pin_self, ring_cpus};
 
 use crate::error::LaunchError;
 use crate::plan::Plan;
@@ -67,6 +67,25 @@ pub struct Options {
     pub progress: bool,
     /// Real-time pacing at this speed (`--realtime --speed X`): step k starts at k·dt/X.
     pub realtime: Option<f64>,
+}
+
+impl Options {
+    /// A run of the launcher's own (benchmarks, sweeps, calibration): no progress bar, no
+    /// pacing, the whole run recorded (when `record`) over whatever `out` holds.
+    pub fn quiet(out: &Path, mode: Mode, wait: Wait, record: bool) -> Self {
+        Options {
+            out: out.to_path_buf(),
+            mode,
+            wait,
+            force: true,
+            allow_unstable: false,
+            record,
+            pin: false,
+            select: recording::write::Selection::default(),
+            progress: false,
+            realtime: None,
+        }
+    }
 }
 
 /// How a run ended.

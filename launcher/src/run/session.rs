@@ -70,8 +70,6 @@ pub struct Session {
     monitors: Vec<Monitor>,
     /// The diagnosis figures (with any bank).
     judge: Option<Judge>,
-    /// Per bank, the false-alarm probability its χ² thresholds were asked for.
-    asked: Vec<Option<f64>>,
     /// Real-time pacing, with `--realtime`.
     pace: Option<Pace>,
     /// `/latency/overrun`'s group and series (paced runs).
@@ -164,10 +162,9 @@ impl Session {
             .iter()
             .map(|b| {
                 let index = b.members.iter().map(|mb| s.observers.iter().position(|o| o.name == mb.name).expect("members are observers")).collect();
-                Monitor::new(b, index, &s.model.c, s.dt)
+                Monitor::new(b, index, s.dt)
             })
             .collect();
-        let asked = banks.iter().map(|b| if let diagnosis::Threshold::FalseAlarm(a) = b.spec.threshold { Some(a) } else { None }).collect();
         let judge = (!banks.is_empty()).then(|| Judge::new(fault_infos(s), &monitors, s.dt));
         let controller_observer = s.controller.as_ref().and_then(|c| s.observers.iter().position(|o| o.name == c.observer));
         let hops = hop_names(s);
@@ -271,7 +268,6 @@ impl Session {
             hop_values: Vec::with_capacity(s.observers.len() + 2),
             monitors,
             judge,
-            asked,
             pace,
             overrun,
         })
@@ -376,7 +372,7 @@ impl Session {
         self.metrics.push(row);
         let lay = self.layout;
         for m in &mut self.monitors {
-            m.step(row.k, &row.plant[lay.y()], &row.xhat);
+            m.step(row.k, &self.metrics.residual);
         }
         if let Some(j) = &mut self.judge {
             j.push(row.k, &self.monitors);
@@ -447,7 +443,7 @@ impl Session {
             Some((sink, _)) => Some(sink.finish(self.steps).map_err(LaunchError::Component)?),
             None => None,
         };
-        let diagnosis = self.judge.map(|j| j.finish(&self.monitors, &self.asked));
+        let diagnosis = self.judge.map(|j| j.finish(&self.monitors));
         let realtime = self.pace.map(|p| RealtimeFigures {
             period_s: p.period_ns as f64 * 1e-9,
             steps: p.steps,

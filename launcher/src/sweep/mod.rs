@@ -117,19 +117,7 @@ fn one(s: &Scenario, plan: &Plan, seed: u64, opts: &SweepOptions, record: bool) 
     if record {
         s.name = format!("{}-seed{seed}", s.name);
     }
-    let o = Options {
-        out: opts.out.clone(),
-        mode: opts.mode,
-        wait: opts.wait,
-        force: true,
-        allow_unstable: false,
-        record,
-        pin: false,
-        select: recording::write::Selection::default(),
-        progress: false,
-        realtime: None,
-    };
-    let outcome = run::run(&s, plan, &o)?;
+    let outcome = run::run(&s, plan, &Options::quiet(&opts.out, opts.mode, opts.wait, record))?;
     if let Stop::Interrupted(sig) = outcome.stop {
         return Err(LaunchError::Interrupted(format!("{}: sweep interrupted by {sig}", s.name)));
     }

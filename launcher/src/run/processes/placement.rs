@@ -3,7 +3,7 @@
 use super::super::configs::Configs;
 
 /// The CPUs this process may run on.
-pub(crate) fn allowed_cpus() -> Vec<usize> {
+fn allowed_cpus() -> Vec<usize> {
     // SAFETY: sched_getaffinity fills the set we own.
     unsafe {
         let mut set: libc::cpu_set_t = std::mem::zeroed();
@@ -35,21 +35,30 @@ pub(crate) fn pin_self(cpu: usize) {
 /// between processes costs ~2.5 µs on the 2-vCPU machines this was measured on). In between,
 /// the plant keeps the first CPU and the rest of the ring takes the others in turn.
 pub(super) fn placement(cfg: &Configs, pin: bool) -> (Option<usize>, Vec<Option<usize>>, Option<usize>) {
-    let cpus = allowed_cpus();
-    let nobs = cfg.observers.len();
-    if !pin || cpus.len() < 2 {
-        return (None, vec![None; nobs], None);
-    }
     let ring_observers: Vec<bool> = cfg.followers.iter().map(|f| !f).collect();
     let ring = 1 + ring_observers.iter().filter(|&&r| r).count() + usize::from(cfg.closed_loop);
-    let mut next = 1;
-    let mut cpu_for = |_: ()| {
-        let c = if cpus.len() >= ring { cpus[next] } else { cpus[1 + (next - 1) % (cpus.len() - 1)] };
-        next += 1;
-        Some(c)
-    };
-    let observers = ring_observers.iter().map(|&r| if r { cpu_for(()) } else { None }).collect();
-    let controller = if cfg.closed_loop { cpu_for(()) } else { None };
-    (Some(cpus[0]), observers, controller)
+    let mut cpus = ring_cpus(ring, pin).into_iter();
+    let plant = cpus.next().flatten();
+    let observers = ring_observers.iter().map(|&r| if r { cpus.next().flatten() } else { None }).collect();
+    let controller = if cfg.closed_loop { cpus.next().flatten() } else { None };
+    (plant, observers, controller)
+}
+
+/// The CPU of each of a ring's `ring` processes, the plant first, by the rule of [`placement`]
+/// (all None without pinning or with fewer than two CPUs).
+pub(crate) fn ring_cpus(ring: usize, pin: bool) -> Vec<Option<usize>> {
+    let cpus = allowed_cpus();
+    if !pin || cpus.len() < 2 {
+        return vec![None; ring];
+    }
+    (0..ring)
+        .map(|i| {
+            Some(match i {
+                0 => cpus[0],
+                _ if cpus.len() >= ring => cpus[i],
+                _ => cpus[1 + (i - 1) % (cpus.len() - 1)],
+            })
+        })
+        .collect()
 }
 
