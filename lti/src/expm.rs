@@ -49,6 +49,12 @@
 //! step of the missile but costs ~300 ulps on part of a step (it lowers m while Γ's entries stay
 //! graded). Block-triangular structure survives exactly: the zero blocks of [[A, G], [0, W]] stay
 //! 0 through every product, and the solve never pivots into them. Set-up code only: it allocates.
+//!
+//! Above [`DOUBLE_DOUBLE_MAX`] rows the double-double products (≈ 20 flops each, no blocking)
+//! would dominate a large model's set-up — minutes at n = 1000 — so there the same algorithm runs
+//! in double precision on nalgebra's blocked GEMM (`Matrix::exp`, a port of scipy's `expm`):
+//! normwise accurate, ‖ΔΦ‖ ≲ u·‖Φ‖, as scipy and MATLAB are. Both paths are deterministic, so a
+//! run's processes still compute bit-identical designs.
 
 use nalgebra::DMatrix;
 
@@ -66,7 +72,10 @@ const THETA: [(usize, f64); 5] = [
     (13, 5.371920351148152e0),
 ];
 
-/// e^{Mh} for a square M, with the product M·h formed exactly.
+/// Largest matrix evaluated in double-double; larger ones run in double precision.
+pub const DOUBLE_DOUBLE_MAX: usize = 96;
+
+/// e^{Mh} for a square M, with the product M·h formed exactly (up to [`DOUBLE_DOUBLE_MAX`]).
 pub fn expm(m: &DMatrix<f64>, h: f64) -> DMatrix<f64> {
     let n = m.nrows();
     assert_eq!(n, m.ncols(), "expm of a non-square matrix");
@@ -75,6 +84,9 @@ pub fn expm(m: &DMatrix<f64>, h: f64) -> DMatrix<f64> {
     }
     if !h.is_finite() || m.iter().any(|x| !x.is_finite()) {
         return DMatrix::from_element(n, n, f64::NAN);
+    }
+    if n > DOUBLE_DOUBLE_MAX {
+        return (m * h).exp();
     }
     // X = M h exactly, row-major.
     let x = DdMat { n, v: (0..n * n).map(|k| two_prod(m[(k / n, k % n)], h)).collect() };
@@ -342,5 +354,22 @@ mod tests {
         assert!((e[(1, 1)] / (-60.0f64).exp() - 1.0).abs() <= f64::EPSILON);
         assert!(expm(&DMatrix::from_element(2, 2, f64::NAN), 1.0)[(0, 0)].is_nan());
         assert_eq!(expm(&DMatrix::zeros(0, 0), 1.0).nrows(), 0);
+    }
+
+    #[test]
+    fn large_matrices_agree_with_the_double_double_blocks() {
+        // e^{diag(A₁, A₂)} = diag(e^{A₁}, e^{A₂}): the 140×140 matrix takes the double path, its
+        // 70×70 blocks the double-double one.
+        let k = 70;
+        let block = |seed: f64| DMatrix::from_fn(k, k, |i, j| ((i * 31 + j * 17) as f64 * seed).sin() / 4.0 - if i == j { 1.0 } else { 0.0 });
+        let (a1, a2) = (block(0.37), block(0.91));
+        let mut big = DMatrix::zeros(2 * k, 2 * k);
+        big.view_mut((0, 0), (k, k)).copy_from(&a1);
+        big.view_mut((k, k), (k, k)).copy_from(&a2);
+        let e = expm(&big, 0.05);
+        let (e1, e2) = (expm(&a1, 0.05), expm(&a2, 0.05));
+        assert!((e.view((0, 0), (k, k)) - &e1).norm() <= 1e-14 * e1.norm());
+        assert!((e.view((k, k), (k, k)) - &e2).norm() <= 1e-14 * e2.norm());
+        assert_eq!(e.view((0, k), (k, k)).amax(), 0.0);
     }
 }

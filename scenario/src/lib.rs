@@ -5,6 +5,7 @@
 
 mod fault_diagnosis;
 mod locate;
+pub mod matrix_file;
 mod raw;
 pub mod untrusted;
 mod validate;

@@ -5,8 +5,38 @@ use std::collections::BTreeMap;
 use lti::signal::Signal;
 use serde::Deserialize;
 
-/// A matrix as rows of numbers.
-pub type Rows = Vec<Vec<f64>>;
+/// A matrix: rows of numbers, or the path of a `.npy` file beside the scenario
+/// ([`crate::matrix_file`]), which validation replaces by its rows before anything reads them.
+#[derive(Debug, Clone)]
+pub enum Rows {
+    /// `A = [[…], […]]`.
+    Inline(Vec<Vec<f64>>),
+    /// `A = "model/A.npy"`, relative to the scenario's folder.
+    File(String),
+}
+
+impl<'de> Deserialize<'de> for Rows {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visit;
+        impl<'de> serde::de::Visitor<'de> for Visit {
+            type Value = Rows;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("rows of numbers, or the path of a .npy file")
+            }
+            fn visit_str<E: serde::de::Error>(self, s: &str) -> Result<Rows, E> {
+                Ok(Rows::File(s.to_string()))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Rows, A::Error> {
+                let mut rows = Vec::new();
+                while let Some(r) = seq.next_element::<Vec<f64>>()? {
+                    rows.push(r);
+                }
+                Ok(Rows::Inline(rows))
+            }
+        }
+        d.deserialize_any(Visit)
+    }
+}
 
 /// The whole file.
 #[derive(Debug, Deserialize)]

@@ -44,6 +44,9 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<Scenario, ScenarioError> 
         let loc = e.inner().span().map(|s| line_col(text, s.start)).or_else(|| at(&field));
         ScenarioError { file: path.to_path_buf(), at: loc, field, reason }
     })?;
+    let mut raw = raw;
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    super::matrix_file::load_all(&mut raw, dir).map_err(error)?;
     build(path, raw).map_err(error).map(|mut s| {
         s.path = path.to_path_buf();
         s.source = text.to_string();
@@ -61,6 +64,10 @@ pub(crate) fn finite(field: &str, v: f64) -> Result<f64, Bad> {
 
 /// A matrix from rows: not empty, not ragged, finite, and of the required shape.
 pub(crate) fn matrix(field: &str, rows: &Rows, shape: (Option<usize>, Option<usize>), why: &str) -> Result<Mat, Bad> {
+    let rows = match rows {
+        Rows::Inline(rows) => rows,
+        Rows::File(name) => return Err(bad(field, format!("{}: a matrix file is read before validation", quoted(name)))),
+    };
     if rows.is_empty() || rows.iter().all(|r| r.is_empty()) {
         return Err(bad(field, "must not be empty"));
     }

@@ -71,6 +71,11 @@ fn shipped() -> Vec<Scenario> {
         .collect()
 }
 
+/// The benchmark's random plant with 120 states, 120 outputs, a UIO and a Luenberger observer.
+fn large() -> Scenario {
+    Scenario::parse(std::path::Path::new("states-120.toml"), &launcher::bench::states::scenario_text(120, 400)).unwrap()
+}
+
 #[test]
 fn step_functions_do_not_allocate() {
     let mut scenarios = shipped();
@@ -78,6 +83,8 @@ fn step_functions_do_not_allocate() {
     let mut split = Scenario::load(&scenario("seed002-piecewise")).unwrap();
     split.disturbances[0] = lti::signal::Signal::Piecewise { times: vec![0.0, 0.00105, 0.0023], values: vec![1.0, -1.0, 2.0] };
     scenarios.push(split);
+    // A large model: samples of hundreds of values, the double-precision exponential.
+    scenarios.push(large());
     for s in scenarios {
         let Ok(p) = plan(&s) else { panic!("{} does not design", s.name) };
         let cfg = configs(&s, &p);
@@ -117,8 +124,13 @@ fn process_loops_do_not_allocate() {
     let scratch = Scratch::new("no-alloc");
     // SAFETY: set before any run space is created; this test binary's other tests make none.
     unsafe { std::env::set_var(lockstep::RUNS_DIR_ENV, scratch.runs()) };
-    let s = Scenario::load(&scenario("seed002-sine")).unwrap();
-    let cfg = configs(&s, &plan(&s).unwrap());
+    for s in [Scenario::load(&scenario("seed002-sine")).unwrap(), large()] {
+        process_loop(&s);
+    }
+}
+
+fn process_loop(s: &Scenario) {
+    let cfg = configs(s, &plan(s).unwrap());
     /// Removes the run's files even when an assertion fails.
     struct Cleanup(RunSpace);
     impl Drop for Cleanup {
@@ -129,7 +141,7 @@ fn process_loops_do_not_allocate() {
     let space = Cleanup(RunSpace::create().unwrap());
     let space = &space.0;
     {
-        let components = launcher::run::envelopes(&s, &cfg, space, Wait::Yield);
+        let components = launcher::run::envelopes(s, &cfg, space, Wait::Yield);
         let bus = |c: &launcher::run::Launchable| Bus::join(space, &c.config.name, Wait::Yield).unwrap();
         let (plant_bus, ctrl_bus) = (bus(&components[0]), bus(components.last().unwrap()));
         let obs_buses: Vec<Bus> = components[1..components.len() - 1].iter().map(bus).collect();
@@ -152,7 +164,8 @@ fn process_loops_do_not_allocate() {
         for k in 0..100 {
             step(k);
         }
-        let n = allocations(|| (100..5000).for_each(&mut step));
-        assert_eq!(n, 0, "{n} allocations in 4900 steps of the process loops");
+        let end = s.steps.min(5000);
+        let n = allocations(|| (100..end).for_each(&mut step));
+        assert_eq!(n, 0, "{}: {n} allocations in {} steps of the process loops", s.name, end - 100);
     }
 }

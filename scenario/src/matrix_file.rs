@@ -1,0 +1,71 @@
+//! Matrices kept beside the scenario as NumPy `.npy` files (`A = "model/A.npy"`): a large
+//! model's A (8 MB of doubles at n = 1000) does not belong in TOML text, and its authors have it
+//! as an array already (`numpy.save`, or scipy.io from a MATLAB `.mat`). Paths are relative to
+//! the scenario's folder; the array must be 2-D float64, in either byte or storage order.
+
+use std::path::Path;
+
+use super::raw::{RawScenario, Rows};
+use super::untrusted::{open_regular, quoted};
+use super::validate::{bad, Bad};
+
+/// Largest matrix file read, bytes (1 GiB: n ≈ 11 000 states).
+pub const MAX_MATRIX_FILE_BYTES: u64 = 1 << 30;
+
+/// Replaces every matrix given as a file by its rows; an error names the field.
+pub(crate) fn load_all(raw: &mut RawScenario, dir: &Path) -> Result<(), Bad> {
+    let p = &mut raw.plant;
+    let mut fields: Vec<(String, &mut Rows)> = vec![("plant.A".into(), &mut p.a), ("plant.B".into(), &mut p.b), ("plant.C".into(), &mut p.c)];
+    for (name, m) in [("plant.E", &mut p.e), ("plant.D", &mut p.d), ("plant.Ff", &mut p.ff)] {
+        fields.extend(m.as_mut().map(|m| (name.to_string(), m)));
+    }
+    if let Some(noise) = raw.noise.as_mut() {
+        for (name, m) in [("noise.process", &mut noise.process), ("noise.G", &mut noise.g), ("noise.process_discrete", &mut noise.process_discrete), ("noise.measurement", &mut noise.measurement)] {
+            fields.extend(m.as_mut().map(|m| (name.to_string(), m)));
+        }
+    }
+    for (i, o) in raw.observer.iter_mut().enumerate() {
+        fields.extend(o.h.as_mut().map(|m| (format!("observer[{}].H", i + 1), m)));
+    }
+    if let Some(c) = raw.controller.as_mut() {
+        for (name, m) in [("controller.gain", &mut c.gain), ("controller.track", &mut c.track)] {
+            fields.extend(m.as_mut().map(|m| (name.to_string(), m)));
+        }
+    }
+    for (field, m) in fields {
+        if let Rows::File(name) = m {
+            *m = Rows::Inline(read(dir, name).map_err(|reason| bad(field, reason))?);
+        }
+    }
+    Ok(())
+}
+
+/// The rows of a 2-D float64 `.npy` file.
+pub fn read(dir: &Path, name: &str) -> Result<Vec<Vec<f64>>, String> {
+    let shown = quoted(name);
+    if name.is_empty() {
+        return Err("an empty path is not a matrix file".into());
+    }
+    let path = dir.join(name);
+    let (file, len) = open_regular(&path).map_err(|e| format!("{shown}: {e}"))?;
+    if len > MAX_MATRIX_FILE_BYTES {
+        return Err(format!("{shown}: {len} bytes, larger than the 1 GiB a matrix file may hold"));
+    }
+    let npy = npyz::NpyFile::new(std::io::BufReader::new(file)).map_err(|e| format!("{shown}: not a .npy file ({e})"))?;
+    let descr = npy.dtype().descr();
+    let dtype = descr.trim_matches('\'');
+    if !matches!(dtype, "<f8" | ">f8") {
+        return Err(format!("{shown}: holds {dtype} values; save it as float64 (<f8)"));
+    }
+    let (rows, cols) = match *npy.shape() {
+        [r, c] => (r as usize, c as usize),
+        ref s => return Err(format!("{shown}: has shape {s:?}; a matrix is 2-D (save a vector as (k, 1) or (1, k))")),
+    };
+    let order = npy.order();
+    let data: Vec<f64> = npy.into_vec().map_err(|e| format!("{shown}: cannot read its values ({e})"))?;
+    if data.len() != rows * cols {
+        return Err(format!("{shown}: holds {} values for a {rows}×{cols} shape", data.len()));
+    }
+    let at = |i: usize, j: usize| if order == npyz::Order::Fortran { data[j * rows + i] } else { data[i * cols + j] };
+    Ok((0..rows).map(|i| (0..cols).map(|j| at(i, j)).collect()).collect())
+}
