@@ -135,6 +135,16 @@ enum Command {
         len_controller: usize,
         wait: Wait,
     },
+    /// Take part in runs from another host: start the components a launcher places on this
+    /// host (`host = NAME` and `[hosts]` in its scenario). Runs `uio-bridge agent`.
+    Agent {
+        /// This host's name, as the scenarios' `[hosts]` tables call it.
+        #[arg(long)]
+        host: String,
+        /// The one Zenoh endpoint to listen on, e.g. tcp/10.0.0.2:7447 (never a wildcard by default).
+        #[arg(long)]
+        listen: String,
+    },
     /// List the shipped scenarios.
     List {
         /// Directory of scenarios.
@@ -357,6 +367,13 @@ fn main() -> ExitCode {
                 }
                 Err(e) => fail(&e),
             }
+        }
+        Command::Agent { host, listen } => {
+            use std::os::unix::process::CommandExt;
+            let bridge = launcher::run::bridge_path();
+            let e = std::process::Command::new(&bridge).args(["agent", "--host", &host, "--listen", &listen]).exec();
+            eprintln!("error: cannot run {}: {e} (build it with `cargo build --release --workspace`)", bridge.display());
+            ExitCode::from(3)
         }
         Command::List { dir } => match shipped::list(&dir.unwrap_or_else(shipped::dir)) {
             Ok(entries) => {

@@ -142,6 +142,20 @@ impl Outlet {
         self.send_header(WireHeader { step, sim_time, sent_ns: 0, taken_ns, protocol: PROTOCOL_VERSION, reserved: 0 }, values)
     }
 
+    /// Sends a sample another host published, header and all (its `sent_ns` kept: the bridge
+    /// between hosts is not a publisher of its own, and the hop it adds shows in the receiver's
+    /// latency instead). Returns the local send time.
+    pub fn forward(&self, header: &WireHeader, values: &[f64]) -> Result<u64, LockstepError> {
+        let mut sample = self.publisher.loan_slice_uninit(values.len()).map_err(LockstepError::ipc)?;
+        *sample.user_header_mut() = *header;
+        let sample = sample.write_from_slice(values);
+        sample.send().map_err(LockstepError::ipc)?;
+        if let Some(notifier) = &self.notifier {
+            notifier.notify().map_err(LockstepError::ipc)?;
+        }
+        Ok(now_ns())
+    }
+
     /// Sends `values` behind `header` as given (its `sent_ns` set to now), without checking
     /// either against the protocol: for a component that fills its headers itself — or a test
     /// that breaks the protocol on purpose. Returns the send time.

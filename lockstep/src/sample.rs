@@ -8,7 +8,7 @@
 
 use iceoryx2::prelude::*;
 
-/// The protocol version every sample and configuration carries (PROTOCOL.md §8).
+/// The protocol version every sample and configuration carries (PROTOCOL.md §9).
 pub const PROTOCOL_VERSION: u32 = 1;
 
 /// The user header of every sample (PROTOCOL.md §4): 40 bytes, little-endian, align 8.

@@ -20,7 +20,7 @@ from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
 
-#: The protocol version this kit speaks (PROTOCOL.md §8).
+#: The protocol version this kit speaks (PROTOCOL.md §9).
 PROTOCOL_VERSION = 1
 
 #: Exit codes (PROTOCOL.md §1, §6).

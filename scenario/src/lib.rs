@@ -4,6 +4,7 @@
 //! (as a path such as `plant.A` or `observer[1].poles`), and the reason.
 
 mod fault_diagnosis;
+mod hosts;
 mod locate;
 pub mod matrix_file;
 mod raw;
@@ -19,12 +20,15 @@ use lti::{Mat, Model};
 use observer::Spec;
 
 pub use fault_diagnosis::NoiseSpec;
+pub use hosts::Remote;
 pub use raw::RawExpect;
 pub use untrusted::{quoted, MAX_SCENARIO_BYTES};
 
 /// A scenario that passed every check.
 #[derive(Debug, Clone)]
 pub struct Scenario {
+    /// Components that run on other hosts (`[hosts]`, `host = …`), by component name.
+    pub remote: std::collections::BTreeMap<String, Remote>,
     /// The file it came from.
     pub path: PathBuf,
     /// Its name (also the recording's file name).

@@ -65,6 +65,8 @@ pub struct RawScenario {
     pub fault: Vec<RawFault>,
     #[serde(default)]
     pub diagnoser: Vec<RawDiagnoser>,
+    /// Host name → its agent's Zenoh endpoint.
+    pub hosts: Option<BTreeMap<String, String>>,
 }
 
 /// `[noise]`.
@@ -168,6 +170,8 @@ pub struct RawPlant {
     /// Fault distribution F_f (n×m): component faults act through its columns.
     #[serde(rename = "Ff")]
     pub ff: Option<Rows>,
+    /// The host it runs on (a name in `[hosts]`).
+    pub host: Option<String>,
 }
 
 /// An external component: its command and parameters (PROTOCOL.md §7).
@@ -201,6 +205,8 @@ pub struct RawObserver {
     /// `kind = "process"`: the command and its parameters.
     pub command: Option<Vec<String>>,
     pub params: Option<toml::Table>,
+    /// The host it runs on (a name in `[hosts]`).
+    pub host: Option<String>,
 }
 
 /// `[controller]`.
@@ -217,6 +223,8 @@ pub struct RawController {
     /// `kind = "process"`: the command and its parameters.
     pub command: Option<Vec<String>>,
     pub params: Option<toml::Table>,
+    /// The host it runs on (a name in `[hosts]`).
+    pub host: Option<String>,
 }
 
 /// `[expect]`: per-observer upper bounds on the run's figures.

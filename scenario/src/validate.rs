@@ -201,6 +201,7 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
         return Err(bad("duration", format!("{steps_f} steps is more than 1e9")));
     }
     let steps = steps_f as u64;
+    let remote = super::hosts::placements(&raw)?;
 
     // Plant.
     let p = &raw.plant;
@@ -311,6 +312,7 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
         return Err(bad("expect", "detection, isolation and false alarms are judged by a [[diagnoser]]; the scenario has none"));
     }
     Ok(Scenario {
+        remote,
         path: Default::default(),
         name: raw.name,
         description: raw.description,

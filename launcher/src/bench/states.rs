@@ -4,10 +4,14 @@
 //! table gives steps/s, the step's p50 and, with recording, the bytes written per step.
 //!
 //! The plant: A = −2I + R/√n (R standard normal: eigenvalues near −2, within about ±1), B with 2
-//! columns, C with p = max(2, ⌈n/3⌉) rows, E one column — generic, so rank CE = rank E and
-//! (A, E, C) has no invariant zeros. Observer poles −3 − 0.05·i; the feedback is a small random
-//! gain G = 0.1·R/√n (placing n poles with two inputs is ill-conditioned for large n, and the
-//! step costs the same whatever G is).
+//! columns, C n×n (every state measured, as on a sensor-dense FE or thermal model), E one column
+//! — generic, so rank CE = rank E and (A, E, C) has no invariant zeros. Observer poles
+//! −3 − 0.05·i; the feedback is a small random gain G = 0.1·R/√n (placing n poles with two inputs
+//! is ill-conditioned for large n, and the step costs the same whatever G is).
+//!
+//! Why p = n: with p = n the observer placements are direct (K = Cᵀ⁻¹-like, O(n³)), so the
+//! designs reach n = 1000. With p < n, robust eigenstructure assignment (Tits–Yang) is O(n⁵) per
+//! sweep here and stops near n = 50–100 (BENCHMARKS.md).
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

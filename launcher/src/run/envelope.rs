@@ -17,6 +17,15 @@ pub enum Program {
     Builtin(&'static str),
     /// The scenario's command.
     External(ProcessSpec),
+    /// Our binary of this name on another host, through its agent: the launcher starts the
+    /// bridge's proxy (`uio-bridge remote`) in its place.
+    Remote(&'static str, scenario::Remote),
+}
+
+/// The bridge's binary (`uio-bridge`), built beside the launcher: it carries components to
+/// other hosts, so that Zenoh stays out of the launcher.
+pub fn bridge_path() -> std::path::PathBuf {
+    std::env::current_exe().unwrap_or_else(|_| "launcher".into()).with_file_name("uio-bridge")
 }
 
 /// A component ready to be started.
@@ -135,6 +144,12 @@ pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> V
         let mut config = base("controller", Role::Controller, publishes, reads, params);
         config.signals = json!({ "inputs": s.inputs });
         out.push(Launchable { label: "controller".into(), program, config });
+    }
+    for c in &mut out {
+        if let (Program::Builtin(kind), Some(r)) = (&c.program, s.remote.get(&c.config.name)) {
+            c.label = format!("{} (on host {})", c.label, r.host);
+            c.program = Program::Remote(kind, r.clone());
+        }
     }
     out
 }

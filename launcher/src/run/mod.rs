@@ -16,7 +16,7 @@ use std::time::Instant;
 use lockstep::Wait;
 
 pub use configs::{configs, Configs};
-pub use envelope::{envelopes, Launchable, Program};
+pub use envelope::{bridge_path, envelopes, Launchable, Program};
 pub use session::{hop_entity, hop_names, Finished, RealtimeFigures, Session};
 pub(crate) use processes::placement::{pin_self, ring_cpus};
 

@@ -21,11 +21,17 @@ pub(super) struct Queue {
     free: Vec<Vec<f64>>,
     /// The highest step any of its samples carried.
     pub(super) last: Option<u64>,
+    /// The host it runs on, when not this one: its times are of that host's clock.
+    host: Option<String>,
 }
 
 impl Queue {
     pub(super) fn new(c: &Launchable) -> Self {
-        Queue { label: c.label.clone(), names: c.config.publishes.names.clone(), items: VecDeque::new(), free: Vec::new(), last: None }
+        let host = match &c.program {
+            super::super::envelope::Program::Remote(_, r) => Some(r.host.clone()),
+            _ => None,
+        };
+        Queue { label: c.label.clone(), names: c.config.publishes.names.clone(), items: VecDeque::new(), free: Vec::new(), last: None, host }
     }
 
     pub(super) fn is_empty(&self) -> bool {
@@ -72,8 +78,10 @@ impl Queue {
     /// Checks that the sample of step k was made from its input's sample k: it cannot have taken
     /// its input (`taken_ns`) before that input was sent. A component that publishes without
     /// reading would otherwise go unnoticed until its full subscriber buffer blocks the plant.
-    pub(super) fn made_after(&self, k: u64, own: &Header, input: &Header, input_label: &str) -> Result<(), LaunchError> {
-        if own.taken_ns < input.sent_ns {
+    /// Two hosts' CLOCK_MONOTONIC have unrelated origins, so a hop between hosts is not checked.
+    pub(super) fn made_after(&self, k: u64, own: &Header, input: &Header, input_queue: &Queue) -> Result<(), LaunchError> {
+        let input_label = if input_queue.label.starts_with("plant") { format!("the {}", input_queue.label) } else { input_queue.label.clone() };
+        if self.host == input_queue.host && own.taken_ns < input.sent_ns {
             return Err(LaunchError::Component(format!(
                 "{} broke the protocol at step {k}: it published the step before {input_label}'s sample {k} was sent (it does not read its input)",
                 self.label
@@ -128,12 +136,12 @@ impl Assembly {
             row.t = k as f64 * self.dt;
             for (i, q) in self.observers.iter_mut().enumerate() {
                 row.xhat_hdr[i] = q.take(k, &mut row.xhat[i])?;
-                q.made_after(k, &row.xhat_hdr[i], &row.plant_hdr, "the plant")?;
+                q.made_after(k, &row.xhat_hdr[i], &row.plant_hdr, &self.plant)?;
             }
             if let Some(q) = &mut self.controller {
                 row.u_hdr = q.take(k, &mut row.u)?;
                 if let Some(c) = self.controller_observer {
-                    q.made_after(k, &row.u_hdr, &row.xhat_hdr[c], &self.observers[c].label)?;
+                    q.made_after(k, &row.u_hdr, &row.xhat_hdr[c], &self.observers[c])?;
                 }
             }
             session.record(row)?;

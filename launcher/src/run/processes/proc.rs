@@ -135,6 +135,11 @@ pub(super) fn spawn(c: &Launchable, workdir: &Path, space: &RunSpace, cpu: Optio
             cmd.args(&p.command[1..]).current_dir(workdir);
             cmd
         }
+        Program::Remote(kind, r) => {
+            let mut cmd = Command::new(crate::run::bridge_path());
+            cmd.args(["remote", "--host", &r.host, "--connect", &r.endpoint, "--builtin", kind]);
+            cmd
+        }
     };
     cmd.env("UIO_PROTOCOL", PROTOCOL_VERSION.to_string())
         .env("UIO_RUN", space.id())
@@ -162,6 +167,7 @@ pub(super) fn spawn(c: &Launchable, workdir: &Path, space: &RunSpace, cpu: Optio
                 scenario::untrusted::quoted(&p.command[0])
             ),
             Program::External(p) => format!(" ({})", scenario::untrusted::quoted(&p.command[0])),
+            Program::Remote(..) => format!(" ({}: build it with `cargo build --release --workspace`)", crate::run::bridge_path().display()),
             Program::Builtin(_) => String::new(),
         };
         LaunchError::Component(format!("cannot start {label}{what}: {e}"))

@@ -1,0 +1,40 @@
+//! The Zenoh key expressions of a run across hosts. A run is named by the launcher's run id; a
+//! component by its name; a host by the name the scenario gives it.
+
+/// An agent's liveliness token: present while `uio-bridge agent --host <host>` runs.
+pub fn agent(host: &str) -> String {
+    format!("uio/agent/{host}")
+}
+
+/// The agent's queryable that starts a component.
+pub fn start(host: &str) -> String {
+    format!("uio/agent/{host}/start")
+}
+
+/// The samples of a service of a run.
+pub fn samples(run: &str, service: &str) -> String {
+    format!("uio/run/{run}/s/{service}")
+}
+
+/// A remote component's status, from its host's worker: `ready`, then `exit …`.
+pub fn status(run: &str, name: &str) -> String {
+    format!("uio/run/{run}/c/{name}/status")
+}
+
+/// The launcher's `go`, relayed by the proxy.
+pub fn go(run: &str, name: &str) -> String {
+    format!("uio/run/{run}/c/{name}/go")
+}
+
+/// Liveliness of the proxy (launcher's host) and of the worker (component's host).
+pub fn alive(run: &str, name: &str, side: &str) -> String {
+    format!("uio/run/{run}/c/{name}/{side}")
+}
+
+/// A host name is one key chunk: letters, digits, `-` and `_`.
+pub fn check_host(host: &str) -> Result<(), String> {
+    if host.is_empty() || host.len() > 64 || !host.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_') {
+        return Err(format!("'{}' is not a host name (1–64 letters, digits, - and _)", host.escape_debug()));
+    }
+    Ok(())
+}

@@ -1,0 +1,151 @@
+//! The proxy: on the launcher's host, it stands in for a component that runs on another host.
+//! The launcher starts it as it would start the component (same environment, same configuration
+//! file); it asks that host's agent to start the component, relays `ready` and `go`, carries the
+//! component's inputs there and its samples back, and exits as the component did — or with
+//! status 3 naming the host when the agent or the link is lost.
+
+use std::time::{Duration, Instant};
+
+use lockstep::component::ComponentConfig;
+use lockstep::{Bus, RunSpace, Wait};
+use zenoh::sample::SampleKind;
+use zenoh::Wait as _;
+
+use crate::keys;
+use crate::pump::{publisher, Exports, Idle, Imports};
+use crate::session::{open, Role};
+
+/// What the agent is asked to start.
+#[derive(serde::Serialize, serde::Deserialize)]
+pub struct StartRequest {
+    /// The launcher's run id (names the keys of the run).
+    pub run: String,
+    /// Our built-in component: `plant`, `observer` or `controller`.
+    pub builtin: String,
+    /// The component's configuration, as the launcher wrote it.
+    pub config: String,
+}
+
+/// Exit code for everything that is not the component's own exit.
+const FAILED: i32 = 3;
+
+/// Runs the proxy; returns the process's exit code.
+pub fn run(host: &str, connect: &str, builtin: &str) -> i32 {
+    lockstep::die_with_parent();
+    match proxy(host, connect, builtin) {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("host {host}: {e}");
+            FAILED
+        }
+    }
+}
+
+fn proxy(host: &str, connect: &str, builtin: &str) -> Result<i32, String> {
+    let path = std::env::var("UIO_CONFIG").map_err(|_| "UIO_CONFIG is not set: the proxy is started by the launcher".to_string())?;
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("{path}: {e}"))?;
+    let cfg: ComponentConfig = serde_json::from_str(&text).map_err(|e| format!("{path}: {e}"))?;
+    let wait: Wait = cfg.wait.parse().map_err(|e| format!("{path}: wait: {e}"))?;
+    let space = RunSpace::open(&cfg.run).map_err(|e| e.to_string())?;
+    let bus = Bus::join(&space, &format!("bridge-{}", cfg.name), wait).map_err(|e| e.to_string())?;
+
+    let z = open(Role::Client { connect }).map_err(|e| format!("cannot reach its agent at {e}"))?;
+    // The agent's token says it is there; the session may still be settling, so ask for 2 s.
+    let asked = Instant::now();
+    loop {
+        let replies = z.liveliness().get(keys::agent(host)).timeout(Duration::from_millis(500)).wait().map_err(|e| e.to_string())?;
+        if replies.recv().is_ok() {
+            break;
+        }
+        if asked.elapsed() > Duration::from_secs(2) {
+            return Err(format!("no agent answers at {connect} (start `launcher agent --host {host} --listen {connect}` there)"));
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let (run, name) = (cfg.run.as_str(), cfg.name.as_str());
+    let _token = z.liveliness().declare_token(keys::alive(run, name, "proxy")).wait().map_err(|e| e.to_string())?;
+    let worker = z.liveliness().declare_subscriber(keys::alive(run, name, "worker")).wait().map_err(|e| e.to_string())?;
+    let status = z.declare_subscriber(keys::status(run, name)).wait().map_err(|e| e.to_string())?;
+    let go = publisher(&z, keys::go(run, name))?;
+    let mut imports = Imports::new(&bus, &z, run, &[(cfg.publishes.service.clone(), cfg.publishes.len)])?;
+    let mut exports = Exports::new(&bus, &z, run, &cfg.reads.iter().map(|r| r.service.clone()).collect::<Vec<_>>())?;
+
+    let request = serde_json::to_string(&StartRequest { run: run.to_string(), builtin: builtin.to_string(), config: text.clone() }).expect("serialises");
+    let replies = z.get(keys::start(host)).payload(request).timeout(Duration::from_secs(10)).wait().map_err(|e| e.to_string())?;
+    match replies.recv() {
+        Ok(reply) => {
+            if let Err(e) = reply.result() {
+                return Err(format!("its agent cannot start {name}: {}", e.payload().try_to_string().unwrap_or_default()));
+            }
+        }
+        Err(_) => return Err(format!("its agent at {connect} did not answer the start of {name}")),
+    }
+    // The component is up on the other host when its worker says `ready`.
+    let mut worker_seen = false;
+    let deadline = Instant::now() + Duration::from_secs(20);
+    loop {
+        if let Ok(Some(s)) = worker.try_recv() {
+            match s.kind() {
+                SampleKind::Put => worker_seen = true,
+                SampleKind::Delete => return Err(format!("its worker for {name} stopped before the component was ready")),
+            }
+        }
+        if let Ok(Some(s)) = status.try_recv() {
+            let line = s.payload().try_to_string().unwrap_or_default().to_string();
+            if line == "ready" {
+                break;
+            }
+            return Err(exit_message(name, &line));
+        }
+        if Instant::now() > deadline {
+            return Err(format!("{name} did not become ready there within 20 s"));
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    let _ = worker_seen;
+    lockstep::ready_then_wait_for_go().map_err(|e| e.to_string())?;
+    go.put("go").wait().map_err(|e| e.to_string())?;
+
+    let mut idle = Idle::new();
+    loop {
+        let worked = exports.pump()? + imports.pump()? > 0;
+        if let Ok(Some(s)) = worker.try_recv()
+            && s.kind() == SampleKind::Delete
+        {
+            return Err(format!("lost its agent while {name} ran (the link was cut, or the agent or the host stopped)"));
+        }
+        if let Ok(Some(s)) = status.try_recv() {
+            let line = s.payload().try_to_string().unwrap_or_default().to_string();
+            return finish(name, &line, &mut imports);
+        }
+        idle.after(worked);
+    }
+}
+
+/// The component has exited on the other host: publish every sample it sent first, then exit
+/// as it did.
+fn finish(name: &str, line: &str, imports: &mut Imports) -> Result<i32, String> {
+    let mut parts = line.splitn(4, ' ');
+    let (Some("exit"), Some(code), Some(count)) = (parts.next(), parts.next().and_then(|c| c.parse::<i32>().ok()), parts.next().and_then(|c| c.parse::<u64>().ok())) else {
+        return Err(format!("{name}: its worker said '{}'", line.escape_debug()));
+    };
+    let message = parts.next().unwrap_or("");
+    let deadline = Instant::now() + Duration::from_secs(2);
+    while imports.received < count && Instant::now() < deadline {
+        if imports.pump()? == 0 {
+            std::thread::sleep(Duration::from_micros(100));
+        }
+    }
+    if imports.received < count {
+        return Err(format!("{name} sent {count} samples, {} arrived", imports.received));
+    }
+    if code != 0 {
+        eprintln!("{name} on its host: {message}");
+    }
+    Ok(code)
+}
+
+fn exit_message(name: &str, line: &str) -> String {
+    let message = line.splitn(4, ' ').nth(3).unwrap_or(line);
+    format!("{name} failed to start there: {message}")
+}

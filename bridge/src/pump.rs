@@ -1,0 +1,137 @@
+//! The samples that cross a host boundary: [`Exports`] read local services and put them on
+//! Zenoh, [`Imports`] take them from Zenoh and publish them on the local services. Zenoh's
+//! reliable, blocking-congestion publishers and FIFO subscribers keep every sample, in order;
+//! the lockstep step checks of the receiving components and the launcher stay end to end.
+
+use lockstep::{Bus, Outlet, Reader};
+use zenoh::handlers::FifoChannelHandler;
+use zenoh::pubsub::{Publisher, Subscriber};
+use zenoh::qos::{CongestionControl, Priority};
+use zenoh::sample::Sample;
+use zenoh::{Session, Wait};
+
+use crate::keys;
+use crate::wire::{decode, encode};
+
+/// Local services read and sent to the other host.
+pub struct Exports {
+    list: Vec<(Reader, Publisher<'static>)>,
+    buf: Vec<u8>,
+    /// Samples sent so far.
+    pub sent: u64,
+}
+
+/// Samples of the other host published on local services.
+pub struct Imports {
+    list: Vec<(Subscriber<FifoChannelHandler<Sample>>, Outlet, String)>,
+    values: Vec<f64>,
+    /// Samples published so far.
+    pub received: u64,
+}
+
+/// A publisher that never drops (the lockstep's no-loss rule, across the link): Zenoh's
+/// default reliable delivery, and blocking congestion control instead of dropping.
+pub fn publisher(z: &Session, key: String) -> Result<Publisher<'static>, String> {
+    z.declare_publisher(key.clone())
+        .congestion_control(CongestionControl::Block)
+        .priority(Priority::RealTime)
+        .express(true)
+        .wait()
+        .map_err(|e| format!("zenoh publisher {key}: {e}"))
+}
+
+impl Exports {
+    /// Reads each of `services` on `bus` and sends it under the run's key.
+    pub fn new(bus: &Bus, z: &Session, run: &str, services: &[String]) -> Result<Self, String> {
+        let mut list = Vec::new();
+        for s in services {
+            let reader = bus.reader(s).map_err(|e| format!("{s}: {e}"))?;
+            list.push((reader, publisher(z, keys::samples(run, s))?));
+        }
+        Ok(Exports { list, buf: Vec::new(), sent: 0 })
+    }
+
+    /// Sends what has arrived; returns how many samples.
+    pub fn pump(&mut self) -> Result<usize, String> {
+        let mut n = 0;
+        for (reader, publisher) in &self.list {
+            let mut failed = None;
+            n += reader
+                .drain_up_to(64, |h, v| {
+                    encode(h, v, &mut self.buf);
+                    if let Err(e) = publisher.put(self.buf.as_slice()).wait() {
+                        failed = Some(e.to_string());
+                    }
+                })
+                .map_err(|e| e.to_string())?;
+            if let Some(e) = failed {
+                return Err(format!("sending to the other host: {e}"));
+            }
+        }
+        self.sent += n as u64;
+        Ok(n)
+    }
+}
+
+impl Imports {
+    /// Publishes each of `services` (name, values per sample) on `bus` from the run's key.
+    pub fn new(bus: &Bus, z: &Session, run: &str, services: &[(String, usize)]) -> Result<Self, String> {
+        let mut list = Vec::new();
+        for (s, len) in services {
+            let outlet = bus.outlet(s, *len).map_err(|e| format!("{s}: {e}"))?;
+            let key = keys::samples(run, s);
+            let sub = z.declare_subscriber(key.clone()).wait().map_err(|e| format!("zenoh subscriber {key}: {e}"))?;
+            list.push((sub, outlet, s.clone()));
+        }
+        Ok(Imports { list, values: Vec::new(), received: 0 })
+    }
+
+    /// Publishes what has arrived; returns how many samples. A sample of the wrong size is the
+    /// other side breaking the protocol.
+    pub fn pump(&mut self) -> Result<usize, String> {
+        let mut n = 0;
+        for (sub, outlet, service) in &self.list {
+            for _ in 0..64 {
+                let Ok(Some(sample)) = sub.try_recv() else { break };
+                let h = decode(&sample.payload().to_bytes(), &mut self.values).map_err(|e| format!("{service}: {e}"))?;
+                if self.values.len() != outlet.len() {
+                    return Err(format!("{service}: a sample of {} values arrived; the service holds {}", self.values.len(), outlet.len()));
+                }
+                outlet.forward(&h, &self.values).map_err(|e| format!("{service}: {e}"))?;
+                n += 1;
+            }
+        }
+        self.received += n as u64;
+        Ok(n)
+    }
+}
+
+/// Polls without holding a core: yields while work is recent, then sleeps briefly.
+pub struct Idle(u32);
+
+impl Idle {
+    /// A fresh idle counter.
+    pub fn new() -> Self {
+        Idle(0)
+    }
+
+    /// Call after each round with whether it did any work.
+    pub fn after(&mut self, worked: bool) {
+        if worked {
+            self.0 = 0;
+            return;
+        }
+        self.0 = self.0.saturating_add(1);
+        if self.0 < 256 {
+            std::thread::yield_now();
+        } else {
+            std::thread::sleep(std::time::Duration::from_micros(50));
+        }
+    }
+}
+
+impl Default for Idle {
+    fn default() -> Self {
+        Self::new()
+    }
+}

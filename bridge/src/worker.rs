@@ -1,0 +1,216 @@
+//! The worker: on the component's host, one per remote component. Started by the agent with the
+//! start request on stdin, it makes a run space of this host's own (its id is fresh, so even two
+//! "hosts" on one machine never share shared memory), writes the component's configuration
+//! there, starts the component, relays `ready` and `go`, carries its samples to the launcher's
+//! host and its inputs back, and reports how it exited. It dies with the agent, the launcher's
+//! proxy or the link, and removes the component and the run space whichever happens.
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::os::unix::process::{CommandExt, ExitStatusExt};
+use std::process::{Child, Command, Stdio};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{mpsc, Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use lockstep::component::{ComponentConfig, Iceoryx2Place, Role as ComponentRole};
+use lockstep::{Bus, RunSpace, Wait};
+use zenoh::sample::SampleKind;
+use zenoh::Wait as _;
+
+use crate::keys;
+use crate::proxy::StartRequest;
+use crate::pump::{publisher, Exports, Idle, Imports};
+use crate::session::{open, Role};
+
+static STOP: AtomicBool = AtomicBool::new(false);
+
+extern "C" fn on_term(_: libc::c_int) {
+    STOP.store(true, Ordering::Relaxed);
+}
+
+/// Runs the worker for the request on stdin; returns the exit code.
+pub fn run(connect: &str) -> i32 {
+    // The agent's death (SIGTERM, set by the agent at spawn) or a stop: tear down, then exit.
+    // SAFETY: the handler only stores to an atomic.
+    unsafe {
+        libc::signal(libc::SIGTERM, on_term as *const () as libc::sighandler_t);
+        libc::signal(libc::SIGINT, on_term as *const () as libc::sighandler_t);
+    }
+    let mut text = String::new();
+    if let Err(e) = std::io::stdin().read_to_string(&mut text) {
+        eprintln!("worker: stdin: {e}");
+        return 3;
+    }
+    let req: StartRequest = match serde_json::from_str(&text) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("worker: bad request: {e}");
+            return 3;
+        }
+    };
+    let space = match RunSpace::create() {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("worker: {e}");
+            return 3;
+        }
+    };
+    let code = match serve(connect, &req, &space) {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("worker for {}: {e}", req.run);
+            3
+        }
+    };
+    space.remove();
+    code
+}
+
+fn serve(connect: &str, req: &StartRequest, space: &RunSpace) -> Result<(), String> {
+    let mut cfg: ComponentConfig = serde_json::from_str(&req.config).map_err(|e| format!("configuration: {e}"))?;
+    let (run, name) = (req.run.clone(), cfg.name.clone());
+    let wait: Wait = cfg.wait.parse().map_err(|e| format!("wait: {e}"))?;
+    // The component's world is this host's run space.
+    cfg.run = space.id().to_string();
+    cfg.iceoryx2 = Iceoryx2Place { prefix: format!("uio{}_", space.id()), root: format!("{}/", space.iox2_root().display()) };
+    let file = match cfg.role {
+        ComponentRole::Observer => format!("observer-{}", cfg.name),
+        r => r.name().to_string(),
+    };
+    space.write_config(&file, &serde_json::to_string_pretty(&cfg).expect("serialises")).map_err(|e| e.to_string())?;
+    let bus = Bus::join(space, "bridge", wait).map_err(|e| e.to_string())?;
+
+    let z = open(Role::Client { connect })?;
+    let _token = z.liveliness().declare_token(keys::alive(&run, &name, "worker")).wait().map_err(|e| e.to_string())?;
+    let proxy = z.liveliness().declare_subscriber(keys::alive(&run, &name, "proxy")).history(true).wait().map_err(|e| e.to_string())?;
+    let status = publisher(&z, keys::status(&run, &name))?;
+    let go = z.declare_subscriber(keys::go(&run, &name)).wait().map_err(|e| e.to_string())?;
+    let mut imports = Imports::new(&bus, &z, &run, &cfg.reads.iter().map(|r| (r.service.clone(), r.len)).collect::<Vec<_>>())?;
+    let mut exports = Exports::new(&bus, &z, &run, std::slice::from_ref(&cfg.publishes.service))?;
+    let report = |line: String| status.put(line).wait().map_err(|e| e.to_string());
+
+    let mut child = spawn(&req.builtin, space, &cfg, &file, wait).inspect_err(|e| {
+        let _ = report(format!("exit 3 0 {e}"));
+    })?;
+    let last_err = collect_stderr(&mut child);
+    let (tx, rx) = mpsc::channel();
+    let out = child.stdout.take().expect("piped");
+    std::thread::spawn(move || {
+        for line in BufReader::new(out).lines().map_while(Result::ok) {
+            if line.trim() == "ready" {
+                let _ = tx.send(());
+                break;
+            }
+        }
+    });
+    let mut stdin = child.stdin.take();
+    let mut proxy_seen = false;
+    let mut phase = Phase::Starting;
+    let started = Instant::now();
+    let mut idle = Idle::new();
+    loop {
+        if STOP.load(Ordering::Relaxed) {
+            kill(&mut child);
+            return Err("stopped (the agent went away)".into());
+        }
+        while let Ok(Some(s)) = proxy.try_recv() {
+            match s.kind() {
+                SampleKind::Put => proxy_seen = true,
+                SampleKind::Delete => {
+                    kill(&mut child);
+                    return Err(format!("the launcher's side of {name} went away (run stopped, or the link was cut)"));
+                }
+            }
+        }
+        if !proxy_seen && started.elapsed() > Duration::from_secs(5) {
+            kill(&mut child);
+            return Err(format!("no launcher-side proxy for {name}"));
+        }
+        match phase {
+            Phase::Starting if rx.try_recv().is_ok() => {
+                report("ready".into())?;
+                phase = Phase::Ready;
+            }
+            Phase::Ready if go.try_recv().ok().flatten().is_some() => {
+                if let Some(mut s) = stdin.take() {
+                    s.write_all(b"go\n").and_then(|_| s.flush()).map_err(|e| format!("{name}: {e}"))?;
+                    stdin = Some(s);
+                }
+                phase = Phase::Running;
+            }
+            _ => {}
+        }
+        let worked = if phase == Phase::Running { exports.pump()? + imports.pump()? > 0 } else { false };
+        if let Ok(Some(st)) = child.try_wait() {
+            // Everything it published before it exited goes first.
+            while exports.pump()? > 0 {}
+            let code = st.code().unwrap_or(3);
+            let why = match (st.code(), st.signal()) {
+                (_, Some(sig)) => format!("killed by signal {sig}"),
+                (Some(0), _) => "exited".to_string(),
+                (Some(c), _) => format!("exited with status {c}: {}", last_err.lock().map(|s| s.clone()).unwrap_or_default()),
+                _ => "exited".to_string(),
+            };
+            report(format!("exit {code} {} {why}", exports.sent))?;
+            // Let the report leave before the session closes.
+            std::thread::sleep(Duration::from_millis(100));
+            drop(stdin);
+            return Ok(());
+        }
+        idle.after(worked);
+    }
+}
+
+#[derive(PartialEq, Clone, Copy)]
+enum Phase {
+    Starting,
+    Ready,
+    Running,
+}
+
+/// Starts our built-in component of this kind, beside this executable, in its own process
+/// group, as the launcher would (PROTOCOL.md §1).
+fn spawn(builtin: &str, space: &RunSpace, cfg: &ComponentConfig, file: &str, wait: Wait) -> Result<Child, String> {
+    if !matches!(builtin, "plant" | "observer" | "controller") {
+        return Err(format!("'{}' is not a built-in component", builtin.escape_debug()));
+    }
+    let exe = std::env::current_exe().map_err(|e| e.to_string())?.with_file_name(builtin);
+    Command::new(&exe)
+        .args(["--run", space.id(), "--name", &cfg.name, "--wait", &wait.to_string()])
+        .env("UIO_PROTOCOL", lockstep::PROTOCOL_VERSION.to_string())
+        .env("UIO_RUN", space.id())
+        .env("UIO_NAME", &cfg.name)
+        .env("UIO_ROLE", cfg.role.name())
+        .env("UIO_CONFIG", space.config_path(file))
+        .env(lockstep::RUNS_DIR_ENV, space.dir().parent().unwrap_or(space.dir()))
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .process_group(0)
+        .spawn()
+        .map_err(|e| format!("cannot start {}: {e}", exe.display()))
+}
+
+/// The last line the component wrote on stderr.
+fn collect_stderr(child: &mut Child) -> Arc<Mutex<String>> {
+    let last = Arc::new(Mutex::new(String::new()));
+    let sink = last.clone();
+    let err = child.stderr.take().expect("piped");
+    std::thread::spawn(move || {
+        for line in BufReader::new(err).lines().map_while(Result::ok) {
+            if let Ok(mut l) = sink.lock() {
+                *l = line;
+            }
+        }
+    });
+    last
+}
+
+/// Kills the component's process group and waits for it.
+fn kill(child: &mut Child) {
+    // SAFETY: signals the process group this worker created for the child.
+    unsafe {
+        libc::kill(-(child.id() as i32), libc::SIGKILL);
+    }
+    let _ = child.wait();
+}
