@@ -96,8 +96,10 @@ case "$case_name" in
     "$launcher" compare "$work/out1/two-hosts.rrd" "$work/out2/two-hosts.rrd" >"$work/compare.out" 2>&1 || { cat "$work/compare.out"; fail "the recordings differ"; }
     grep -q "bit for bit" "$work/compare.out" || fail "$(cat "$work/compare.out")"
     check_clean
-    lat() { python3 -c 'import json,sys; s=json.load(open(sys.argv[1]))["latency_ns"]["step"]; print("p50 %.1f µs, p99 %.1f µs" % (s["p50"] / 1e3, s["p99"] / 1e3))' "$1"; }
-    echo "ok run: $(cat "$work/compare.out"); two hosts: step $(lat "$work/out2/two-hosts.summary.json"); one host: step $(lat "$work/out1/two-hosts.summary.json"); B listens on: $listeners"
+    lat() { python3 -c 'import json,sys; l=json.load(open(sys.argv[1]))["latency_ns"]; f=lambda s: "p50 %.1f µs, p99 %.1f µs" % (s["p50"] / 1e3, s["p99"] / 1e3); print("step " + f(l["step"]) + "; hops: " + "; ".join(k + " " + f(v) for k, v in sorted(l["hops"].items())))' "$1"; }
+    echo "ok run: $(cat "$work/compare.out"); B listens on: $listeners"
+    echo "  two hosts: $(lat "$work/out2/two-hosts.summary.json")"
+    echo "  one host:  $(lat "$work/out1/two-hosts.summary.json")"
     ;;
   kill-component|kill-agent|cut-link)
     scenario 60.0 > "$work/two.toml"
