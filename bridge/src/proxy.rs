@@ -116,7 +116,7 @@ fn proxy(host: &str, connect: &str, builtin: &str) -> Result<i32, String> {
         }
         if let Ok(Some(s)) = status.try_recv() {
             let line = s.payload().try_to_string().unwrap_or_default().to_string();
-            return finish(name, &line, &mut imports);
+            return finish(name, host, &line, &mut imports);
         }
         idle.after(worked);
     }
@@ -124,7 +124,7 @@ fn proxy(host: &str, connect: &str, builtin: &str) -> Result<i32, String> {
 
 /// The component has exited on the other host: publish every sample it sent first, then exit
 /// as it did.
-fn finish(name: &str, line: &str, imports: &mut Imports) -> Result<i32, String> {
+fn finish(name: &str, host: &str, line: &str, imports: &mut Imports) -> Result<i32, String> {
     let mut parts = line.splitn(4, ' ');
     let (Some("exit"), Some(code), Some(count)) = (parts.next(), parts.next().and_then(|c| c.parse::<i32>().ok()), parts.next().and_then(|c| c.parse::<u64>().ok())) else {
         return Err(format!("{name}: its worker said '{}'", line.escape_debug()));
@@ -140,7 +140,7 @@ fn finish(name: &str, line: &str, imports: &mut Imports) -> Result<i32, String> 
         return Err(format!("{name} sent {count} samples, {} arrived", imports.received));
     }
     if code != 0 {
-        eprintln!("{name} on its host: {message}");
+        eprintln!("{name} on host {host}: {message}");
     }
     Ok(code)
 }
