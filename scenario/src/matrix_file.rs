@@ -61,6 +61,10 @@ pub fn read(dir: &Path, name: &str) -> Result<Vec<Vec<f64>>, String> {
         [r, c] => (r as usize, c as usize),
         ref s => return Err(format!("{shown}: has shape {s:?}; a matrix is 2-D (save a vector as (k, 1) or (1, k))")),
     };
+    // The header's shape must fit the file before anything is allocated for it.
+    if rows.checked_mul(cols).and_then(|k| k.checked_mul(8)).is_none_or(|b| b as u64 > len) {
+        return Err(format!("{shown}: its header says {rows}×{cols}, more values than its {len} bytes hold"));
+    }
     let order = npy.order();
     let data: Vec<f64> = npy.into_vec().map_err(|e| format!("{shown}: cannot read its values ({e})"))?;
     if data.len() != rows * cols {

@@ -78,12 +78,23 @@ fn bad_files_are_named_with_the_field() {
     std::fs::write(d.join("model/text.npy"), "A = 1").unwrap();
     let text = err("\"model/text.npy\"");
     assert!(text.contains("not a .npy file"), "{text}");
+    // A header claiming more values than the file holds is refused before anything is read.
+    npy(&d.join("model/huge.npy"), "<f8", false, &[3, 3], &A);
+    let bytes = std::fs::read(d.join("model/huge.npy")).unwrap();
+    let header = String::from_utf8_lossy(&bytes[10..bytes.len() - 72]).replace("(3, 3)", "(300000, 300000)");
+    let mut forged = bytes[..8].to_vec();
+    forged.extend((header.len() as u16).to_le_bytes());
+    forged.extend(header.as_bytes());
+    forged.extend(&bytes[bytes.len() - 72..]);
+    std::fs::write(d.join("model/huge.npy"), forged).unwrap();
+    let huge = err("\"model/huge.npy\"");
+    assert!(huge.contains("300000×300000") && huge.contains("more values"), "{huge}");
     // The shape is checked as for inline rows: a 2×3 A is not square.
     npy(&d.join("model/A23.npy"), "<f8", false, &[2, 3], &A[..6]);
     let shape = err("\"model/A23.npy\"");
     assert!(shape.contains("plant.A") && shape.contains("square"), "{shape}");
     // Every message is one line, located at the key.
-    for e in [missing, single, vector, text, shape] {
+    for e in [missing, single, vector, text, shape, huge] {
         assert_eq!(e.lines().count(), 1, "{e}");
         assert!(e.contains("npy.toml:5:"), "{e}");
     }
