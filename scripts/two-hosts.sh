@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Two "hosts" on one machine: network namespaces joined by a veth pair with private test
 # addresses (10.77.0.1 ↔ 10.77.0.2). Host B runs an agent (`launcher agent`); host A runs the
-# launcher with the seed 002 closed loop whose plant is placed on B (`[hosts]`, `plant.host`).
+# launcher with the seed 002 closed loop whose plant and Luenberger observer are placed on B
+# (`[hosts]`, `host = …`).
 # Traffic stays between the two namespaces; both are removed on exit, also on failure.
 #
 #   scripts/two-hosts.sh run             the two-host run equals the single-host run bit for bit
@@ -63,10 +64,11 @@ grep -q "listening on" "$work/agent.err" || fail "the agent did not start"
 ip netns exec "$nsb" ss -ltn | grep -q '10.77.0.2:7447' || fail "the agent is not listening on $endpoint"
 listeners="$(ip netns exec "$nsb" ss -ltnH | awk '{print $4}' | sort -u | tr '\n' ' ')"
 
-# The scenario: seed 002, its plant on B.
+# The scenario: seed 002 with its plant and its Luenberger observer on B (two components there,
+# one reading the other), the UIO and the controller on A.
 scenario() {  # $1: duration, s
   sed -e "s/^duration = .*/duration = $1/" -e '0,/^name = .*/s//name = "two-hosts"/' "$repo/scenarios/seed002-sine.toml" \
-    | sed -e '/^\[plant\]/a host = "rig"'
+    | sed -e '/^\[plant\]/a host = "rig"' -e '/^kind = "luenberger"/a host = "rig"'
   printf '\n[hosts]\nrig = "%s"\n' "$endpoint"
 }
 single() {  # the same scenario on one host

@@ -11,9 +11,17 @@ pub fn start(host: &str) -> String {
     format!("uio/agent/{host}/start")
 }
 
-/// The samples of a service of a run.
-pub fn samples(run: &str, service: &str) -> String {
-    format!("uio/run/{run}/s/{service}")
+/// The samples of `service` that the remote component `name` reads, sent by its proxy. Every
+/// crossing is between a remote component and the launcher's host, where every service exists
+/// (the remote ones as their proxies republish them): one publisher and one subscriber per key,
+/// so no sample can arrive twice, even when several remote components read one service.
+pub fn to_component(run: &str, name: &str, service: &str) -> String {
+    format!("uio/run/{run}/c/{name}/in/{service}")
+}
+
+/// The samples the remote component `name` publishes, sent by its worker.
+pub fn from_component(run: &str, name: &str) -> String {
+    format!("uio/run/{run}/c/{name}/out")
 }
 
 /// A remote component's status, from its host's worker: `ready`, then `exit …`.

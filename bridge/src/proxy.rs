@@ -67,8 +67,9 @@ fn proxy(host: &str, connect: &str, builtin: &str) -> Result<i32, String> {
     let worker = z.liveliness().declare_subscriber(keys::alive(run, name, "worker")).wait().map_err(|e| e.to_string())?;
     let status = z.declare_subscriber(keys::status(run, name)).wait().map_err(|e| e.to_string())?;
     let go = publisher(&z, keys::go(run, name))?;
-    let mut imports = Imports::new(&bus, &z, run, &[(cfg.publishes.service.clone(), cfg.publishes.len)])?;
-    let mut exports = Exports::new(&bus, &z, run, &cfg.reads.iter().map(|r| r.service.clone()).collect::<Vec<_>>())?;
+    let mut imports = Imports::new(&bus, &z, &[(cfg.publishes.service.clone(), cfg.publishes.len, keys::from_component(run, name))])?;
+    let reads: Vec<(String, String)> = cfg.reads.iter().map(|r| (r.service.clone(), keys::to_component(run, name, &r.service))).collect();
+    let mut exports = Exports::new(&bus, &z, &reads)?;
 
     let request = serde_json::to_string(&StartRequest { run: run.to_string(), builtin: builtin.to_string(), config: text.clone() }).expect("serialises");
     let replies = z.get(keys::start(host)).payload(request).timeout(Duration::from_secs(10)).wait().map_err(|e| e.to_string())?;

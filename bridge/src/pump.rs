@@ -10,7 +10,6 @@ use zenoh::qos::{CongestionControl, Priority};
 use zenoh::sample::Sample;
 use zenoh::{Session, Wait};
 
-use crate::keys;
 use crate::wire::{decode, encode};
 
 /// Local services read and sent to the other host.
@@ -41,12 +40,12 @@ pub fn publisher(z: &Session, key: String) -> Result<Publisher<'static>, String>
 }
 
 impl Exports {
-    /// Reads each of `services` on `bus` and sends it under the run's key.
-    pub fn new(bus: &Bus, z: &Session, run: &str, services: &[String]) -> Result<Self, String> {
+    /// Reads each (service, key) on `bus` and sends it under its key.
+    pub fn new(bus: &Bus, z: &Session, services: &[(String, String)]) -> Result<Self, String> {
         let mut list = Vec::new();
-        for s in services {
+        for (s, key) in services {
             let reader = bus.reader(s).map_err(|e| format!("{s}: {e}"))?;
-            list.push((reader, publisher(z, keys::samples(run, s))?));
+            list.push((reader, publisher(z, key.clone())?));
         }
         Ok(Exports { list, buf: Vec::new(), sent: 0 })
     }
@@ -74,12 +73,11 @@ impl Exports {
 }
 
 impl Imports {
-    /// Publishes each of `services` (name, values per sample) on `bus` from the run's key.
-    pub fn new(bus: &Bus, z: &Session, run: &str, services: &[(String, usize)]) -> Result<Self, String> {
+    /// Publishes each (service, values per sample, key) on `bus` from its key.
+    pub fn new(bus: &Bus, z: &Session, services: &[(String, usize, String)]) -> Result<Self, String> {
         let mut list = Vec::new();
-        for (s, len) in services {
+        for (s, len, key) in services {
             let outlet = bus.outlet(s, *len).map_err(|e| format!("{s}: {e}"))?;
-            let key = keys::samples(run, s);
             let sub = z.declare_subscriber(key.clone()).wait().map_err(|e| format!("zenoh subscriber {key}: {e}"))?;
             list.push((sub, outlet, s.clone()));
         }

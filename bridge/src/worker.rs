@@ -85,8 +85,9 @@ fn serve(connect: &str, req: &StartRequest, space: &RunSpace) -> Result<(), Stri
     let proxy = z.liveliness().declare_subscriber(keys::alive(&run, &name, "proxy")).history(true).wait().map_err(|e| e.to_string())?;
     let status = publisher(&z, keys::status(&run, &name))?;
     let go = z.declare_subscriber(keys::go(&run, &name)).wait().map_err(|e| e.to_string())?;
-    let mut imports = Imports::new(&bus, &z, &run, &cfg.reads.iter().map(|r| (r.service.clone(), r.len)).collect::<Vec<_>>())?;
-    let mut exports = Exports::new(&bus, &z, &run, std::slice::from_ref(&cfg.publishes.service))?;
+    let reads: Vec<(String, usize, String)> = cfg.reads.iter().map(|r| (r.service.clone(), r.len, keys::to_component(&run, &name, &r.service))).collect();
+    let mut imports = Imports::new(&bus, &z, &reads)?;
+    let mut exports = Exports::new(&bus, &z, &[(cfg.publishes.service.clone(), keys::from_component(&run, &name))])?;
     let report = |line: String| status.put(line).wait().map_err(|e| e.to_string());
 
     let mut child = spawn(&req.builtin, space, &cfg, &file, wait).inspect_err(|e| {

@@ -205,9 +205,14 @@ pub(crate) fn place_detectable(
     domain: Domain,
 ) -> Result<(Mat, Vec<C64>), DesignError> {
     let n = a.nrows();
-    let stairs = observability_staircase(a, c);
-    let fixed = stairs.unobservable_modes().map_err(|e| checks.error(pair, e.to_string()))?;
-    if stairs.no < n {
+    // Every state measured (rank C = n) is observable: no staircase, whose SVDs and rotations
+    // are a large model's costliest step.
+    let stairs = (lti::pinv::rank(c) < n).then(|| observability_staircase(a, c));
+    let (no, fixed) = match &stairs {
+        Some(s) => (s.no, s.unobservable_modes().map_err(|e| checks.error(pair, e.to_string()))?),
+        None => (n, Vec::new()),
+    };
+    if no < n {
         let what = if domain == Domain::Continuous { "Re < 0" } else { "|z| < 1" };
         let unstable: Vec<C64> = fixed.iter().copied().filter(|&z| !domain.stable(z)).collect();
         checks.require(
@@ -224,23 +229,23 @@ pub(crate) fn place_detectable(
         Domain::Continuous => free.clone(),
         Domain::Discrete(dt) => sampled_target(free, carried, &fixed, dt).map_err(|e| checks.error("poles", e))?,
     };
-    if target.len() != stairs.no {
+    if target.len() != no {
         let detail = match domain {
-            Domain::Continuous if stairs.no == n => {
+            Domain::Continuous if no == n => {
                 format!("{pair} is observable: give {n} pole(s) (poles = [...]), {} given", free.len())
             }
             Domain::Continuous => format!(
                 "{pair} has {} fixed mode(s) {} that no gain moves; give {} pole(s) for the observable part{}, {} given",
-                n - stairs.no,
+                n - no,
                 format_list(&fixed),
-                stairs.no,
-                if stairs.no == 0 { " (poles = [] or no poles key)" } else { "" },
+                no,
+                if no == 0 { " (poles = [] or no poles key)" } else { "" },
                 free.len()
             ),
             Domain::Discrete(_) => format!(
                 "{pair} needs {} pole(s) but the continuous design's {} free pole(s) and {} fixed mode(s) {} map to {} \
                  (the sampled pair has fixed mode(s) {} that sampling did not carry over)",
-                stairs.no,
+                no,
                 free.len(),
                 carried.len(),
                 format_list(carried),
@@ -250,16 +255,17 @@ pub(crate) fn place_detectable(
         };
         return Err(checks.error("poles", detail));
     }
-    if stairs.no == n {
+    if no == n {
         let placed = place_observer(a, c, &target, method).map_err(|e| checks.error("pole placement", e.to_string()))?;
         return Ok((placed.gain, Vec::new()));
     }
-    if stairs.no == 0 {
+    if no == 0 {
         return Ok((Mat::zeros(n, c.nrows()), fixed));
     }
+    let stairs = stairs.expect("a staircase whenever no < n");
     let (ao, co) = stairs.observable_part();
     let placed = place_observer(&ao, &co, &target, method).map_err(|e| checks.error("pole placement", e.to_string()))?;
-    let l = stairs.q.columns(0, stairs.no) * placed.gain;
+    let l = stairs.q.columns(0, no) * placed.gain;
     Ok((l, fixed))
 }
 
