@@ -9,6 +9,7 @@
 #   scripts/two-hosts.sh kill-component  the plant is killed on B: the run stops within 2 s
 #   scripts/two-hosts.sh kill-agent      B's agent is killed: the run stops within 2 s
 #   scripts/two-hosts.sh cut-link        the link goes down: the run stops within 2 s
+#   scripts/two-hosts.sh kill-local      the controller is killed on A: B removes its side too
 #
 # Each case checks its own outcome and that neither host keeps a process, a run directory or a
 # shared-memory file; it prints "ok <case>: …" and exits 0, or says why and exits 1. Without
@@ -103,7 +104,7 @@ case "$case_name" in
     echo "  two hosts: $(lat "$work/out2/two-hosts.summary.json")"
     echo "  one host:  $(lat "$work/out1/two-hosts.summary.json")"
     ;;
-  kill-component|kill-agent|cut-link)
+  kill-component|kill-agent|cut-link|kill-local)
     scenario 60.0 > "$work/two.toml"
     ip netns exec "$nsa" env UIO_RUNS_DIR="$work/a" "$launcher" run "$work/two.toml" --out "$work/out2" --force --realtime >"$work/launcher.out" 2>"$work/launcher.err" &
     run_pid=$!
@@ -119,6 +120,7 @@ case "$case_name" in
       kill-component) pkill -KILL -f "^$bin/plant --run" || fail "no plant on B" ;;
       kill-agent) kill -KILL "$agent_pid"; agent_pid="" ;;
       cut-link) ip -n "$nsa" link set "$va" down ;;
+      kill-local) pkill -KILL -f "^$bin/controller --run" || fail "no controller on A" ;;
     esac
     rc=0; wait "$run_pid" || rc=$?
     t1="$(now)"
@@ -126,7 +128,8 @@ case "$case_name" in
     [ "$rc" -eq 3 ] || fail "launcher run exited $rc, not 3"
     python3 -c "import sys; sys.exit(0 if $t1 - $t0 <= 2.0 else 1)" || fail "the run took $took s to stop"
     why="$(grep -m1 -E 'error|stopped' "$work/launcher.err" || tail -1 "$work/launcher.err")"
-    echo "$why" | grep -q "plant (on host rig)" || fail "the message does not name the plant on host rig: $why"
+    lost="plant (on host rig)"; [ "$case_name" = kill-local ] && lost="controller"
+    echo "$why" | grep -q "$lost" || fail "the message does not name $lost: $why"
     [ -f "$work/out2/two-hosts.rrd" ] || fail "no recording was finalized"
     if [ "$case_name" = cut-link ]; then ip -n "$nsa" link set "$va" up; fi
     # B's worker notices too (the link's lease, 1 s) and removes the plant and its run space.
@@ -134,5 +137,5 @@ case "$case_name" in
     check_clean
     echo "ok $case_name: stopped in $took s: $why"
     ;;
-  *) echo "usage: $0 run|kill-component|kill-agent|cut-link"; exit 2 ;;
+  *) echo "usage: $0 run|kill-component|kill-agent|cut-link|kill-local"; exit 2 ;;
 esac

@@ -1,8 +1,8 @@
 //! Issue 14: a run whose plant sits on another host, over Zenoh, tested on one machine as two
 //! hosts (network namespaces joined by a veth pair, scripts/two-hosts.sh). The script checks each
 //! case itself — the recording against a single-host run bit for bit; a killed plant, a killed
-//! agent and a cut link each stopping the run within 2 s with the plant on its host named;
-//! nothing left in either namespace — and this test runs it and reads its verdict. Where network
+//! agent and a cut link each stopping the run within 2 s with the plant on its host named; a
+//! killed local controller stopping the other host's side too; nothing left in either namespace — and this test runs it and reads its verdict. Where network
 //! namespaces are not allowed the script says "skipped" (exit 77) and so does this test.
 
 use std::process::Command;
@@ -29,7 +29,7 @@ fn case(name: &str) {
 // two cores with the runs.
 #[test]
 fn two_hosts() {
-    for c in ["run", "kill-component", "kill-agent", "cut-link"] {
+    for c in ["run", "kill-component", "kill-agent", "cut-link", "kill-local"] {
         case(c);
     }
 }
