@@ -43,5 +43,9 @@ pub fn open(role: Role) -> Result<Session, String> {
     set(&mut c, "scouting/multicast/enabled", "false".into())?;
     set(&mut c, "scouting/gossip/enabled", "false".into())?;
     set(&mut c, "transport/link/tx/lease", LEASE_MS.to_string())?;
-    zenoh::open(c).wait().map_err(|e| format!("{endpoint}: {e}"))
+    // Zenoh's messages end with the source location that raised them: not the user's concern.
+    zenoh::open(c).wait().map_err(|e| {
+        let e = e.to_string();
+        format!("{endpoint}: {}", e.split("  at ").next().unwrap_or(&e).trim_end_matches(['!', ' ']))
+    })
 }

@@ -267,6 +267,9 @@ fn main() -> ExitCode {
                 eprintln!("warning: {w}");
             }
             let mode = if mode == "in-process" { Mode::InProcess } else { Mode::Processes };
+            if mode == Mode::InProcess && !s.remote.is_empty() {
+                eprintln!("note: --mode in-process runs every component here; the scenario's [hosts] placements apply across processes");
+            }
             let opts = Options { out, mode, wait: wait.unwrap_or_else(Wait::default_for_machine), force, allow_unstable, record: true, pin: pin == "auto", select, progress: true, realtime };
             match run::run(&s, &p, &opts) {
                 Ok(o) => {
