@@ -100,7 +100,11 @@ case "$case_name" in
     grep -q "bit for bit" "$work/compare.out" || fail "$(cat "$work/compare.out")"
     check_clean
     lat() { python3 -c 'import json,sys; l=json.load(open(sys.argv[1]))["latency_ns"]; f=lambda s: "p50 %.1f µs, p99 %.1f µs" % (s["p50"] / 1e3, s["p99"] / 1e3); print("step " + f(l["step"]) + "; hops: " + "; ".join(k + " " + f(v) for k, v in sorted(l["hops"].items())))' "$1"; }
-    echo "ok run: $(cat "$work/compare.out"); B listens on: $listeners"
+    # One clock on both "hosts": the estimated offset must be within its own error bound.
+    clock="$(grep -m1 'worker for plant: this host' "$work/agent.err")" || fail "no clock offset reported"
+    read -r theta bound < <(echo "$clock" | sed -E 's/.*reads (-?[0-9]+) ns ahead.*± ([0-9]+) ns.*/\1 \2/')
+    [ "${theta#-}" -le "$bound" ] || fail "clock offset $theta ns on one machine, beyond its bound ± $bound ns"
+    echo "ok run: $(cat "$work/compare.out"); clock offset $theta ns (± $bound ns); B listens on: $listeners"
     echo "  two hosts: $(lat "$work/out2/two-hosts.summary.json")"
     echo "  one host:  $(lat "$work/out1/two-hosts.summary.json")"
     ;;

@@ -34,6 +34,16 @@ pub fn go(run: &str, name: &str) -> String {
     format!("uio/run/{run}/c/{name}/go")
 }
 
+/// The proxy's clock probes, and the worker's answers ([`crate::clock`]).
+pub fn ping(run: &str, name: &str) -> String {
+    format!("uio/run/{run}/c/{name}/ping")
+}
+
+/// The worker's answers to [`ping`].
+pub fn pong(run: &str, name: &str) -> String {
+    format!("uio/run/{run}/c/{name}/pong")
+}
+
 /// Liveliness of the proxy (launcher's host) and of the worker (component's host).
 pub fn alive(run: &str, name: &str, side: &str) -> String {
     format!("uio/run/{run}/c/{name}/{side}")

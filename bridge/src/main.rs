@@ -3,6 +3,7 @@
 //! `uio-bridge agent` on that host; the agent starts `uio-bridge worker`s.
 
 mod agent;
+mod clock;
 mod keys;
 mod proxy;
 mod pump;

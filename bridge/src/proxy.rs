@@ -11,6 +11,7 @@ use lockstep::{Bus, RunSpace, Wait};
 use zenoh::sample::SampleKind;
 use zenoh::Wait as _;
 
+use crate::clock::{estimate, Offset};
 use crate::keys;
 use crate::pump::{publisher, Exports, Idle, Imports};
 use crate::session::{open, Role};
@@ -104,8 +105,11 @@ fn proxy(host: &str, connect: &str, builtin: &str) -> Result<i32, String> {
         std::thread::sleep(Duration::from_millis(2));
     }
     let _ = worker_seen;
+    // The hosts' clocks, before the run: the worker's samples then carry this host's times.
+    let offset = probe_clock(&z, run, name)?;
+    imports.shift_ns = -offset.theta_ns;
     lockstep::ready_then_wait_for_go().map_err(|e| e.to_string())?;
-    go.put("go").wait().map_err(|e| e.to_string())?;
+    go.put(format!("go {} {}", offset.theta_ns, offset.rtt_ns)).wait().map_err(|e| e.to_string())?;
 
     let mut idle = Idle::new();
     loop {
@@ -144,6 +148,28 @@ fn finish(name: &str, host: &str, line: &str, imports: &mut Imports) -> Result<i
         eprintln!("{name} on host {host}: {message}");
     }
     Ok(code)
+}
+
+/// Round trips with the worker ([`crate::clock`]): 16 exchanges, the shortest one's offset.
+fn probe_clock(z: &zenoh::Session, run: &str, name: &str) -> Result<Offset, String> {
+    let pongs = z.declare_subscriber(keys::pong(run, name)).wait().map_err(|e| e.to_string())?;
+    let ping = publisher(z, keys::ping(run, name))?;
+    let mut exchanges = Vec::new();
+    for _ in 0..16 {
+        let t1 = lockstep::now_ns();
+        ping.put(t1.to_le_bytes().to_vec()).wait().map_err(|e| e.to_string())?;
+        let deadline = Instant::now() + Duration::from_secs(1);
+        while Instant::now() < deadline {
+            let Ok(Some(s)) = pongs.recv_timeout(Duration::from_millis(100)) else { continue };
+            let t3 = lockstep::now_ns();
+            let b = s.payload().to_bytes();
+            if b.len() == 16 && b[..8] == t1.to_le_bytes() {
+                exchanges.push((t1, u64::from_le_bytes(b[8..].try_into().expect("8 bytes")), t3));
+                break;
+            }
+        }
+    }
+    estimate(&exchanges).ok_or_else(|| format!("its worker for {name} does not answer the clock probes"))
 }
 
 fn exit_message(name: &str, line: &str) -> String {

@@ -10,6 +10,7 @@ use zenoh::qos::{CongestionControl, Priority};
 use zenoh::sample::Sample;
 use zenoh::{Session, Wait};
 
+use crate::clock::shift;
 use crate::wire::{decode, encode};
 
 /// Local services read and sent to the other host.
@@ -26,6 +27,8 @@ pub struct Imports {
     values: Vec<f64>,
     /// Samples published so far.
     pub received: u64,
+    /// Added to the header's times: the sending host's clock onto this one's ([`crate::clock`]).
+    pub shift_ns: i64,
 }
 
 /// A publisher that never drops (the lockstep's no-loss rule, across the link): Zenoh's
@@ -81,7 +84,7 @@ impl Imports {
             let sub = z.declare_subscriber(key.clone()).wait().map_err(|e| format!("zenoh subscriber {key}: {e}"))?;
             list.push((sub, outlet, s.clone()));
         }
-        Ok(Imports { list, values: Vec::new(), received: 0 })
+        Ok(Imports { list, values: Vec::new(), received: 0, shift_ns: 0 })
     }
 
     /// Publishes what has arrived; returns how many samples. A sample of the wrong size is the
@@ -91,7 +94,9 @@ impl Imports {
         for (sub, outlet, service) in &self.list {
             for _ in 0..64 {
                 let Ok(Some(sample)) = sub.try_recv() else { break };
-                let h = decode(&sample.payload().to_bytes(), &mut self.values).map_err(|e| format!("{service}: {e}"))?;
+                let mut h = decode(&sample.payload().to_bytes(), &mut self.values).map_err(|e| format!("{service}: {e}"))?;
+                h.sent_ns = shift(h.sent_ns, self.shift_ns);
+                h.taken_ns = shift(h.taken_ns, self.shift_ns);
                 if self.values.len() != outlet.len() {
                     return Err(format!("{service}: a sample of {} values arrived; the service holds {}", self.values.len(), outlet.len()));
                 }

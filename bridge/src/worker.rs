@@ -85,6 +85,8 @@ fn serve(connect: &str, req: &StartRequest, space: &RunSpace) -> Result<(), Stri
     let proxy = z.liveliness().declare_subscriber(keys::alive(&run, &name, "proxy")).history(true).wait().map_err(|e| e.to_string())?;
     let status = publisher(&z, keys::status(&run, &name))?;
     let go = z.declare_subscriber(keys::go(&run, &name)).wait().map_err(|e| e.to_string())?;
+    let pings = z.declare_subscriber(keys::ping(&run, &name)).wait().map_err(|e| e.to_string())?;
+    let pong = publisher(&z, keys::pong(&run, &name))?;
     let reads: Vec<(String, usize, String)> = cfg.reads.iter().map(|r| (r.service.clone(), r.len, keys::to_component(&run, &name, &r.service))).collect();
     let mut imports = Imports::new(&bus, &z, &reads)?;
     let mut exports = Exports::new(&bus, &z, &[(cfg.publishes.service.clone(), keys::from_component(&run, &name))])?;
@@ -127,12 +129,26 @@ fn serve(connect: &str, req: &StartRequest, space: &RunSpace) -> Result<(), Stri
             kill(&mut child);
             return Err(format!("no launcher-side proxy for {name}"));
         }
+        // The proxy's clock probes: answer at once with this host's time.
+        while let Ok(Some(p)) = pings.try_recv() {
+            let mut answer = p.payload().to_bytes().to_vec();
+            answer.extend(lockstep::now_ns().to_le_bytes());
+            pong.put(answer).wait().map_err(|e| e.to_string())?;
+        }
         match phase {
             Phase::Starting if rx.try_recv().is_ok() => {
                 report("ready".into())?;
                 phase = Phase::Ready;
             }
-            Phase::Ready if go.try_recv().ok().flatten().is_some() => {
+            Phase::Ready if let Ok(Some(g)) = go.try_recv() => {
+                // `go <θ> <round trip>`: the launcher's host's times onto this one's.
+                let text = g.payload().try_to_string().map(|t| t.to_string()).unwrap_or_default();
+                let mut words = text.split(' ');
+                let (Some("go"), Some(Ok(theta)), Some(Ok(rtt))) = (words.next(), words.next().map(str::parse::<i64>), words.next().map(str::parse::<u64>)) else {
+                    return Err(format!("{name}: a malformed go from the proxy: '{}'", text.escape_debug()));
+                };
+                imports.shift_ns = theta;
+                eprintln!("worker for {name}: this host's clock reads {theta} ns ahead of the launcher's host's (± {} ns, half the shortest of 16 round trips)", rtt / 2);
                 if let Some(mut s) = stdin.take() {
                     s.write_all(b"go\n").and_then(|_| s.flush()).map_err(|e| format!("{name}: {e}"))?;
                     stdin = Some(s);
