@@ -132,7 +132,12 @@ case "$case_name" in
     [ "$rc" -eq 3 ] || fail "launcher run exited $rc, not 3"
     python3 -c "import sys; sys.exit(0 if $t1 - $t0 <= 2.0 else 1)" || fail "the run took $took s to stop"
     why="$(grep -m1 -E 'error|stopped' "$work/launcher.err" || tail -1 "$work/launcher.err")"
-    lost="plant (on host rig)"; [ "$case_name" = kill-local ] && lost="controller"
+    # A lost agent or link is noticed by whichever of B's components' proxies sees it first.
+    case "$case_name" in
+      kill-component) lost="plant (on host rig)" ;;
+      kill-local) lost="controller" ;;
+      *) lost="(on host rig)" ;;
+    esac
     echo "$why" | grep -q "$lost" || fail "the message does not name $lost: $why"
     [ -f "$work/out2/two-hosts.rrd" ] || fail "no recording was finalized"
     if [ "$case_name" = cut-link ]; then ip -n "$nsa" link set "$va" up; fi

@@ -1,9 +1,14 @@
-//! Issue 14: a run whose plant sits on another host, over Zenoh, tested on one machine as two
+//! Issue 14: a run with components on another host, over Zenoh, tested on one machine as two
 //! hosts (network namespaces joined by a veth pair, scripts/two-hosts.sh). The script checks each
-//! case itself — the recording against a single-host run bit for bit; a killed plant, a killed
-//! agent and a cut link each stopping the run within 2 s with the plant on its host named; a
-//! killed local controller stopping the other host's side too; nothing left in either namespace — and this test runs it and reads its verdict. Where network
-//! namespaces are not allowed the script says "skipped" (exit 77) and so does this test.
+//! case itself and this test runs it and reads its verdict:
+//! - the recording against a single-host run, bit for bit;
+//! - a killed plant, a killed agent and a cut link each stop the run within 2 s, naming a
+//!   component on the other host;
+//! - a killed local controller stops the other host's side too;
+//! - nothing is left in either namespace.
+//!
+//! Where network namespaces are not allowed the script says "skipped" (exit 77), and so does this
+//! test.
 
 use std::process::Command;
 
