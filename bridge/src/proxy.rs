@@ -51,18 +51,7 @@ fn proxy(host: &str, connect: &str, builtin: &str) -> Result<i32, String> {
     let bus = Bus::join(&space, &format!("bridge-{}", cfg.name), wait).map_err(|e| e.to_string())?;
 
     let z = open(Role::Client { connect }).map_err(|e| format!("cannot reach its agent at {e}"))?;
-    // The agent's token says it is there; the session may still be settling, so ask for 2 s.
-    let asked = Instant::now();
-    loop {
-        let replies = z.liveliness().get(keys::agent(host)).timeout(Duration::from_millis(500)).wait().map_err(|e| e.to_string())?;
-        if replies.recv().is_ok() {
-            break;
-        }
-        if asked.elapsed() > Duration::from_secs(2) {
-            return Err(format!("no agent answers at {connect} (start `launcher agent --host {host} --listen {connect}` there)"));
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    }
+    wait_for_agent(&z, host, connect)?;
     let (run, name) = (cfg.run.as_str(), cfg.name.as_str());
     let _token = z.liveliness().declare_token(keys::alive(run, name, "proxy")).wait().map_err(|e| e.to_string())?;
     let worker = z.liveliness().declare_subscriber(keys::alive(run, name, "worker")).wait().map_err(|e| e.to_string())?;
@@ -83,14 +72,12 @@ fn proxy(host: &str, connect: &str, builtin: &str) -> Result<i32, String> {
         Err(_) => return Err(format!("its agent at {connect} did not answer the start of {name}")),
     }
     // The component is up on the other host when its worker says `ready`.
-    let mut worker_seen = false;
     let deadline = Instant::now() + Duration::from_secs(20);
     loop {
-        if let Ok(Some(s)) = worker.try_recv() {
-            match s.kind() {
-                SampleKind::Put => worker_seen = true,
-                SampleKind::Delete => return Err(format!("its worker for {name} stopped before the component was ready")),
-            }
+        if let Ok(Some(s)) = worker.try_recv()
+            && s.kind() == SampleKind::Delete
+        {
+            return Err(format!("its worker for {name} stopped before the component was ready"));
         }
         if let Ok(Some(s)) = status.try_recv() {
             let line = s.payload().try_to_string().unwrap_or_default().to_string();
@@ -104,7 +91,6 @@ fn proxy(host: &str, connect: &str, builtin: &str) -> Result<i32, String> {
         }
         std::thread::sleep(Duration::from_millis(2));
     }
-    let _ = worker_seen;
     // The hosts' clocks, before the run: the worker's samples then carry this host's times.
     let offset = probe_clock(&z, run, name)?;
     imports.shift_ns = -offset.theta_ns;
@@ -148,6 +134,22 @@ fn finish(name: &str, host: &str, line: &str, imports: &mut Imports) -> Result<i
         eprintln!("{name} on host {host}: {message}");
     }
     Ok(code)
+}
+
+/// The agent's liveliness token says it is there; a fresh session may still be settling, so
+/// it is asked for up to 2 s.
+fn wait_for_agent(z: &zenoh::Session, host: &str, connect: &str) -> Result<(), String> {
+    let asked = Instant::now();
+    loop {
+        let replies = z.liveliness().get(keys::agent(host)).timeout(Duration::from_millis(500)).wait().map_err(|e| e.to_string())?;
+        if replies.recv().is_ok() {
+            return Ok(());
+        }
+        if asked.elapsed() > Duration::from_secs(2) {
+            return Err(format!("no agent answers at {connect} (start `launcher agent --host {host} --listen {connect}` there)"));
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
 }
 
 /// Round trips with the worker ([`crate::clock`]): 16 exchanges, the shortest one's offset.

@@ -106,6 +106,7 @@ fn serve(connect: &str, req: &StartRequest, space: &RunSpace) -> Result<(), Stri
             }
         }
     });
+    // Kept open for the run: a closed stdin before `go` means "stopped" to a component.
     let mut stdin = child.stdin.take();
     let mut proxy_seen = false;
     let mut phase = Phase::Starting;
@@ -149,9 +150,8 @@ fn serve(connect: &str, req: &StartRequest, space: &RunSpace) -> Result<(), Stri
                 };
                 imports.shift_ns = theta;
                 eprintln!("worker for {name}: this host's clock reads {theta} ns ahead of the launcher's host's (± {} ns, half the shortest of 16 round trips)", rtt / 2);
-                if let Some(mut s) = stdin.take() {
+                if let Some(s) = stdin.as_mut() {
                     s.write_all(b"go\n").and_then(|_| s.flush()).map_err(|e| format!("{name}: {e}"))?;
-                    stdin = Some(s);
                 }
                 phase = Phase::Running;
             }
