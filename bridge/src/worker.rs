@@ -12,7 +12,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use lockstep::component::{ComponentConfig, Iceoryx2Place, Role as ComponentRole};
+use lockstep::component::{ComponentConfig, Iceoryx2Place};
 use lockstep::{Bus, RunSpace, Wait};
 use zenoh::sample::SampleKind;
 use zenoh::Wait as _;
@@ -72,12 +72,8 @@ fn serve(connect: &str, req: &StartRequest, space: &RunSpace) -> Result<(), Stri
     let wait: Wait = cfg.wait.parse().map_err(|e| format!("wait: {e}"))?;
     // The component's world is this host's run space.
     cfg.run = space.id().to_string();
-    cfg.iceoryx2 = Iceoryx2Place { prefix: format!("uio{}_", space.id()), root: format!("{}/", space.iox2_root().display()) };
-    let file = match cfg.role {
-        ComponentRole::Observer => format!("observer-{}", cfg.name),
-        r => r.name().to_string(),
-    };
-    space.write_config(&file, &serde_json::to_string_pretty(&cfg).expect("serialises")).map_err(|e| e.to_string())?;
+    cfg.iceoryx2 = Iceoryx2Place::of(space);
+    space.write_config(&cfg.file(), &serde_json::to_string_pretty(&cfg).expect("serialises")).map_err(|e| e.to_string())?;
     let bus = Bus::join(space, "bridge", wait).map_err(|e| e.to_string())?;
 
     let z = open(Role::Client { connect })?;
@@ -92,7 +88,7 @@ fn serve(connect: &str, req: &StartRequest, space: &RunSpace) -> Result<(), Stri
     let mut exports = Exports::new(&bus, &z, &[(cfg.publishes.service.clone(), keys::from_component(&run, &name))])?;
     let report = |line: String| status.put(line).wait().map_err(|e| e.to_string());
 
-    let mut child = spawn(&req.builtin, space, &cfg, &file, wait).inspect_err(|e| {
+    let mut child = spawn(&req.builtin, space, &cfg, wait).inspect_err(|e| {
         let _ = report(format!("exit 3 0 {e}"));
     })?;
     let last_err = collect_stderr(&mut child);
@@ -187,19 +183,14 @@ enum Phase {
 
 /// Starts our built-in component of this kind, beside this executable, in its own process
 /// group, as the launcher would (PROTOCOL.md §1).
-fn spawn(builtin: &str, space: &RunSpace, cfg: &ComponentConfig, file: &str, wait: Wait) -> Result<Child, String> {
+fn spawn(builtin: &str, space: &RunSpace, cfg: &ComponentConfig, wait: Wait) -> Result<Child, String> {
     if !matches!(builtin, "plant" | "observer" | "controller") {
         return Err(format!("'{}' is not a built-in component", builtin.escape_debug()));
     }
     let exe = std::env::current_exe().map_err(|e| e.to_string())?.with_file_name(builtin);
     Command::new(&exe)
         .args(["--run", space.id(), "--name", &cfg.name, "--wait", &wait.to_string()])
-        .env("UIO_PROTOCOL", lockstep::PROTOCOL_VERSION.to_string())
-        .env("UIO_RUN", space.id())
-        .env("UIO_NAME", &cfg.name)
-        .env("UIO_ROLE", cfg.role.name())
-        .env("UIO_CONFIG", space.config_path(file))
-        .env(lockstep::RUNS_DIR_ENV, space.dir().parent().unwrap_or(space.dir()))
+        .envs(cfg.launch_env(space))
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())

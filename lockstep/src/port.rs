@@ -144,32 +144,35 @@ impl Outlet {
 
     /// Sends a sample another host published, header and all (its `sent_ns` kept: the bridge
     /// between hosts is not a publisher of its own, and the hop it adds shows in the receiver's
-    /// latency instead). Returns the local send time.
-    pub fn forward(&self, header: &WireHeader, values: &[f64]) -> Result<u64, LockstepError> {
-        let mut sample = self.publisher.loan_slice_uninit(values.len()).map_err(LockstepError::ipc)?;
-        *sample.user_header_mut() = *header;
-        let sample = sample.write_from_slice(values);
-        sample.send().map_err(LockstepError::ipc)?;
-        if let Some(notifier) = &self.notifier {
-            notifier.notify().map_err(LockstepError::ipc)?;
-        }
-        Ok(now_ns())
+    /// latency instead).
+    pub fn forward(&self, header: &WireHeader, values: &[f64]) -> Result<(), LockstepError> {
+        self.publish(values, || *header)
     }
 
     /// Sends `values` behind `header` as given (its `sent_ns` set to now), without checking
     /// either against the protocol: for a component that fills its headers itself — or a test
     /// that breaks the protocol on purpose. Returns the send time.
     pub fn send_header(&self, mut header: WireHeader, values: &[f64]) -> Result<u64, LockstepError> {
+        let mut sent_ns = 0;
+        self.publish(values, || {
+            sent_ns = now_ns();
+            header.sent_ns = sent_ns;
+            header
+        })?;
+        Ok(sent_ns)
+    }
+
+    /// Loans a sample, writes the header `header()` gives once the loan is had (a send time is
+    /// taken as late as it can be) and the values, sends it, and notifies when the wait needs it.
+    fn publish(&self, values: &[f64], header: impl FnOnce() -> WireHeader) -> Result<(), LockstepError> {
         let mut sample = self.publisher.loan_slice_uninit(values.len()).map_err(LockstepError::ipc)?;
-        let sent_ns = now_ns();
-        header.sent_ns = sent_ns;
-        *sample.user_header_mut() = header;
+        *sample.user_header_mut() = header();
         let sample = sample.write_from_slice(values);
         sample.send().map_err(LockstepError::ipc)?;
         if let Some(notifier) = &self.notifier {
             notifier.notify().map_err(LockstepError::ipc)?;
         }
-        Ok(sent_ns)
+        Ok(())
     }
 }
 

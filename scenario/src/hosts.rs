@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 
 use super::raw::RawScenario;
 use super::untrusted::quoted;
-use super::validate::{bad, Bad};
+use super::validate::{bad, check_name, Bad};
 
 /// Where a component runs when not on the launcher's host.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -23,9 +23,7 @@ pub(crate) fn placements(raw: &RawScenario) -> Result<BTreeMap<String, Remote>, 
     let hosts = raw.hosts.clone().unwrap_or_default();
     for (name, endpoint) in &hosts {
         let f = format!("hosts.{name}");
-        if name.is_empty() || name.len() > 64 || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_') {
-            return Err(bad(f, format!("{} is not a host name (1–64 letters, digits, - and _)", quoted(name))));
-        }
+        check_name(&f, name, "it names a host")?;
         endpoint_ok(endpoint).map_err(|why| bad(&f, format!("{}: {why}", quoted(endpoint))))?;
     }
     let mut out = BTreeMap::new();

@@ -49,7 +49,7 @@ fn bad_placements_are_named() {
         assert!(e.contains("hosts.rig") && e.contains(why), "{endpoint}: {e}");
     }
     let bad_name = parse("", "[hosts]\n\"a b\" = \"tcp/10.0.0.1:7447\"\n").unwrap_err();
-    assert!(bad_name.contains("not a host name"), "{bad_name}");
+    assert!(bad_name.contains("'a b' must be non-empty letters, digits") && bad_name.contains("names a host"), "{bad_name}");
     let external = parse("host = \"rig\"\n[plant.process]\ncommand = [\"python3\", \"p.py\"]", "[hosts]\nrig = \"tcp/10.0.0.1:7447\"\n").unwrap_err();
     assert!(external.contains("plant.host") && external.contains("built-in"), "{external}");
     for e in [unknown, bad_name, external] {

@@ -65,8 +65,7 @@ pub fn scenario_text(n: usize, steps: u64) -> String {
         }
         row[i] -= 2.0;
     }
-    let p = n;
-    let (b, c, e) = (normal(n, 2), normal(p, n), normal(n, 1));
+    let (b, c, e) = (normal(n, 2), normal(n, n), normal(n, 1));
     let g: Vec<Vec<f64>> = normal(2, n).into_iter().map(|r| r.into_iter().map(|v| 0.1 * v * scale).collect()).collect();
     format!(
         r#"name = "states-{n}"

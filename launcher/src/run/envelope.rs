@@ -42,10 +42,7 @@ pub struct Launchable {
 impl Launchable {
     /// The configuration's file name in the run directory (without `.json`).
     pub fn file(&self) -> String {
-        match self.config.role {
-            Role::Observer => format!("observer-{}", self.config.name),
-            r => r.name().to_string(),
-        }
+        self.config.file()
     }
 }
 
@@ -75,7 +72,7 @@ pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> V
         run: space.id().to_string(),
         name: name.to_string(),
         role,
-        iceoryx2: Iceoryx2Place { prefix: format!("uio{}_", space.id()), root: format!("{}/", space.iox2_root().display()) },
+        iceoryx2: Iceoryx2Place::of(space),
         wait: wait.to_string(),
         dt: s.dt,
         steps: s.steps,

@@ -106,7 +106,36 @@ pub struct ComponentConfig {
     pub pace_s: Option<f64>,
 }
 
+impl Iceoryx2Place {
+    /// The prefix and root of `space` (PROTOCOL.md §2).
+    pub fn of(space: &crate::RunSpace) -> Self {
+        Iceoryx2Place { prefix: format!("uio{}_", space.id()), root: format!("{}/", space.iox2_root().display()) }
+    }
+}
+
 impl ComponentConfig {
+    /// The name of its configuration file in the run directory, without `.json`: the role, or
+    /// `observer-<name>` for an observer.
+    pub fn file(&self) -> String {
+        match self.role {
+            Role::Observer => format!("observer-{}", self.name),
+            r => r.name().to_string(),
+        }
+    }
+
+    /// The environment a component is started with (PROTOCOL.md §1), its configuration written
+    /// in `space` under [`ComponentConfig::file`].
+    pub fn launch_env(&self, space: &crate::RunSpace) -> [(&'static str, std::ffi::OsString); 6] {
+        [
+            ("UIO_PROTOCOL", crate::PROTOCOL_VERSION.to_string().into()),
+            ("UIO_RUN", space.id().into()),
+            ("UIO_NAME", self.name.clone().into()),
+            ("UIO_ROLE", self.role.name().into()),
+            ("UIO_CONFIG", space.config_path(&self.file()).into()),
+            (crate::RUNS_DIR_ENV, space.dir().parent().unwrap_or(space.dir()).into()),
+        ]
+    }
+
     /// Index of the input read from `service`, if any.
     pub fn read_index(&self, service: &str) -> Option<usize> {
         self.reads.iter().position(|r| r.service == service)

@@ -79,9 +79,8 @@ impl Queue {
     /// its input (`taken_ns`) before that input was sent. A component that publishes without
     /// reading would otherwise go unnoticed until its full subscriber buffer blocks the plant.
     /// Two hosts' CLOCK_MONOTONIC have unrelated origins, so a hop between hosts is not checked.
-    pub(super) fn made_after(&self, k: u64, own: &Header, input: &Header, input_queue: &Queue) -> Result<(), LaunchError> {
-        let input_label = if input_queue.label.starts_with("plant") { format!("the {}", input_queue.label) } else { input_queue.label.clone() };
-        if self.host == input_queue.host && own.taken_ns < input.sent_ns {
+    pub(super) fn made_after(&self, k: u64, own: &Header, input: &Header, input_label: &str, input_host: &Option<String>) -> Result<(), LaunchError> {
+        if self.host == *input_host && own.taken_ns < input.sent_ns {
             return Err(LaunchError::Component(format!(
                 "{} broke the protocol at step {k}: it published the step before {input_label}'s sample {k} was sent (it does not read its input)",
                 self.label
@@ -136,12 +135,13 @@ impl Assembly {
             row.t = k as f64 * self.dt;
             for (i, q) in self.observers.iter_mut().enumerate() {
                 row.xhat_hdr[i] = q.take(k, &mut row.xhat[i])?;
-                q.made_after(k, &row.xhat_hdr[i], &row.plant_hdr, &self.plant)?;
+                q.made_after(k, &row.xhat_hdr[i], &row.plant_hdr, "the plant", &self.plant.host)?;
             }
             if let Some(q) = &mut self.controller {
                 row.u_hdr = q.take(k, &mut row.u)?;
                 if let Some(c) = self.controller_observer {
-                    q.made_after(k, &row.u_hdr, &row.xhat_hdr[c], &self.observers[c])?;
+                    let o = &self.observers[c];
+                    q.made_after(k, &row.u_hdr, &row.xhat_hdr[c], &o.label, &o.host)?;
                 }
             }
             session.record(row)?;

@@ -8,7 +8,7 @@ use std::process::{Child, Command, ExitStatus, Stdio};
 use std::sync::mpsc;
 use std::sync::{Arc, Mutex};
 
-use lockstep::{RunSpace, PROTOCOL_VERSION};
+use lockstep::RunSpace;
 
 use super::super::envelope::{Launchable, Program};
 use super::placement::pin_self;
@@ -141,12 +141,7 @@ pub(super) fn spawn(c: &Launchable, workdir: &Path, space: &RunSpace, cpu: Optio
             cmd
         }
     };
-    cmd.env("UIO_PROTOCOL", PROTOCOL_VERSION.to_string())
-        .env("UIO_RUN", space.id())
-        .env("UIO_NAME", &c.config.name)
-        .env("UIO_ROLE", c.config.role.name())
-        .env("UIO_CONFIG", space.config_path(&c.file()))
-        .env(lockstep::RUNS_DIR_ENV, space.dir().parent().unwrap_or(space.dir()))
+    cmd.envs(c.config.launch_env(space))
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
