@@ -86,13 +86,24 @@ pub fn verify(read: &BTreeMap<String, Running>, scenario: Option<&str>, stored: 
     for (entity, hex) in &expected {
         let actual = if entity == SCENARIO_KEY { scenario.map(of_text) } else { read.get(entity).map(Running::hex) };
         if actual.as_deref() != Some(hex.as_str()) {
-            return Integrity::Damaged(entity.clone());
+            return Integrity::Damaged(named(entity));
         }
     }
     // Data the digest does not know of was not written by this run.
     match read.keys().find(|k| !expected.contains_key(*k)) {
-        Some(extra) => Integrity::Damaged(extra.clone()),
+        Some(extra) => Integrity::Damaged(named(extra)),
         None => Integrity::Verified,
+    }
+}
+
+/// What [`Integrity::Damaged`] names: an entity path (from `/`) or [`SCENARIO_KEY`], which the
+/// caller quotes; any other key, itself damaged, as a sentence with the key quoted, since it
+/// comes from the file and may hold control characters.
+fn named(key: &str) -> String {
+    if key.starts_with('/') || key == SCENARIO_KEY {
+        key.to_string()
+    } else {
+        format!("its digest lists {}, which is no signal of a recording", scenario::untrusted::quoted(key))
     }
 }
 

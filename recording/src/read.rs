@@ -1,20 +1,26 @@
 //! Reading a `.rrd` back: every scalar series by entity path, with its steps, decoded with
-//! Rerun's own decoder. A file whose writer was killed (no footer, or a truncated last message)
-//! is read as far as it goes and marked incomplete. A finished file is checked against the
-//! digest its writer stored ([`crate::digest`]): data that does not match, or that cannot be
-//! decoded although the file was finished, makes it [`Integrity::Damaged`].
+//! Rerun's own decoder from frames this module reads and bounds itself ([`frames`]). A file
+//! whose writer was killed (no footer, or a truncated last message) is read as far as it goes
+//! and marked incomplete. A finished file (one that ends with a stream footer) is checked
+//! against the digest its writer stored ([`crate::digest`]): data that does not match, a frame
+//! or footer that is wrong, or data that cannot be decoded, makes it [`Integrity::Damaged`].
 
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
 
-use re_log_encoding::DecoderApp;
+use re_log_encoding::{CachingApplicationIdInjector, CrateVersion, MessageKind, ToApplication as _};
 use rerun::external::re_log_types::LogMsg;
 use rerun::log::Chunk;
 use rerun::{Scalars, SeriesLines, TextDocument};
 
 use crate::digest::{self, Integrity};
+use frames::{Fault, Frames, Message};
+
+mod frames;
+mod payload;
+mod unwind;
 
 /// One scalar time series.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -55,78 +61,80 @@ pub struct ReadError {
     pub reason: String,
 }
 
-/// Decodes `path`, which must be a regular file (a FIFO would block the read).
+/// Decodes `path`, which must be a regular file (a FIFO would block the read). Nothing is
+/// allocated beyond what the file holds ([`frames`], [`payload`]) and a panic inside Rerun's
+/// decoder is caught ([`unwind`]): any damage gives [`Integrity::Damaged`] for a file its
+/// writer finished, or an incomplete recording of what was read for one it did not.
 pub fn read(path: &Path) -> Result<Recording, ReadError> {
     let err = |reason: String| ReadError { path: path.display().to_string(), reason };
     let (mut file, len) = scenario::untrusted::open_regular(path).map_err(err)?;
-    let finished = has_stream_footer(&mut file, len);
-    let mut messages = DecoderApp::decode_lazy(BufReader::new(file));
+    let tail_footer = has_stream_footer(&mut file, len);
+    let mut frames = Frames::new(BufReader::new(file), len);
+    let mut injector = CachingApplicationIdInjector::default();
     let mut rec = Recording::default();
-    let scalars = Scalars::descriptor_scalars().component;
-    let text = TextDocument::descriptor_text().component;
-    let legend = SeriesLines::descriptor_names().component;
-    let mut seen_any = false;
     let mut stored_digest = None;
     // The digest of what is read, per entity, in file order (the order it was written in).
     let mut read_digests: BTreeMap<String, digest::Running> = BTreeMap::new();
-    // Data that cannot be decoded: the end of a killed writer's file, or damage in a finished one.
-    let mut undecodable = None;
-    while let Some(msg) = messages.next() {
-        let msg = match msg {
-            Ok(m) => m,
-            Err(e) => {
-                if !seen_any {
-                    return Err(err(format!("not a Rerun recording: {e}")));
-                }
-                undecodable = Some(format!("undecodable after byte {}: {e}", messages.num_bytes_processed()));
+    // Where reading stopped before the end: a cut (a killed writer) or damage.
+    let mut fault = None;
+    loop {
+        let msg = match frames.next_message() {
+            Ok(Some(m)) => m,
+            Ok(None) => break,
+            Err(f) => {
+                fault = Some(f);
                 break;
             }
         };
-        seen_any = true;
-        let LogMsg::ArrowMsg(store, arrow) = msg else { continue };
-        if !store.is_recording() {
-            continue;
-        }
-        let chunk = match Chunk::from_arrow_msg(&arrow) {
-            Ok(c) => c,
-            Err(e) => {
-                undecodable = Some(format!("bad chunk after byte {}: {e}", messages.num_bytes_processed()));
+        let item = match unwind::quietly(|| decode(&msg, frames.version(), &mut injector)) {
+            Ok(Ok(item)) => item,
+            Ok(Err(e)) => {
+                fault = Some(Fault::Bad(format!("the message at byte {} cannot be decoded: {e}", msg.at)));
+                break;
+            }
+            Err(panic) => {
+                fault = Some(Fault::Bad(format!("the message at byte {} cannot be decoded (the decoder failed: {panic})", msg.at)));
                 break;
             }
         };
-        let path = chunk.entity_path().to_string();
-        if chunk.is_static() {
-            if let Some(s) = chunk.iter_slices::<String>(text).next().and_then(|v| v.into_iter().next()) {
-                if path.starts_with("/__properties") && path.ends_with("/digest") {
-                    stored_digest = Some(s.to_string());
-                } else if path.starts_with("/__properties") && path.ends_with("/steps") {
-                    rec.steps_completed = s.trim().parse().ok();
-                } else {
-                    rec.scenario = Some(s.to_string());
+        match item {
+            Some(Item::Static { path, text, legend }) => {
+                if let Some(s) = text {
+                    if path.starts_with("/__properties") && path.ends_with("/digest") {
+                        stored_digest = Some(s);
+                    } else if path.starts_with("/__properties") && path.ends_with("/steps") {
+                        rec.steps_completed = s.trim().parse().ok();
+                    } else {
+                        rec.scenario = Some(s);
+                    }
+                }
+                if let Some(n) = legend {
+                    rec.names.insert(path, n);
                 }
             }
-            if let Some(n) = chunk.iter_slices::<String>(legend).next().and_then(|v| v.into_iter().next()) {
-                rec.names.insert(path, n.to_string());
+            Some(Item::Rows { path, steps, times, values }) => {
+                read_digests.entry(path.clone()).or_default().update(&steps, times.as_deref(), &values);
+                let series = rec.series.entry(path).or_default();
+                series.steps.extend_from_slice(&steps);
+                series.values.extend_from_slice(&values);
             }
-            continue;
+            None => {}
         }
-        let timeline = |name: &str| chunk.timelines().iter().find(|(n, _)| n.as_str() == name).map(|(_, c)| c.times_raw().to_vec());
-        let Some(steps) = timeline("step") else {
-            continue;
-        };
-        let values: Vec<f64> = chunk.iter_slices::<f64>(scalars).map(|s| s.first().copied().unwrap_or(f64::NAN)).collect();
-        if values.is_empty() {
-            continue;
-        }
-        let rows = values.len().min(steps.len());
-        read_digests.entry(path.clone()).or_default().update(&steps[..rows], timeline("sim_time").as_deref(), &values[..rows]);
-        let series = rec.series.entry(path).or_default();
-        series.steps.extend_from_slice(&steps[..values.len().min(steps.len())]);
-        series.values.extend_from_slice(&values[..values.len().min(steps.len())]);
     }
-    if !seen_any && len > 0 {
-        return Err(err("not a Rerun recording".into()));
+    // A file whose writer finished ends with the stream footer; a damaged footer (whole, but
+    // wrong) after the RRD footer only a finishing writer writes counts as finished too.
+    let finished = tail_footer || frames.closing() && matches!(fault, Some(Fault::Bad(_)));
+    let problem = match fault {
+        Some(Fault::NotRrd(e)) if !finished => return Err(err(format!("not a Rerun recording: {e}"))),
+        Some(Fault::NotRrd(e)) => Some(format!("its stream header is not Rerun's ({e})")),
+        Some(Fault::Bad(what)) => Some(what),
+        Some(Fault::Cut(what)) if finished => Some(what),
+        // A killed writer's file: read as far as it goes, nothing wrong in it.
+        Some(Fault::Cut(_)) => None,
+        None if finished && !frames.footer_ok() => Some("its stream footer is not where the stream ends".into()),
+        None => None,
     }
+    .map(|p| shown(&p));
     for s in rec.series.values_mut() {
         if s.steps.windows(2).any(|w| w[1] < w[0]) {
             let mut idx: Vec<usize> = (0..s.steps.len()).collect();
@@ -135,18 +143,75 @@ pub fn read(path: &Path) -> Result<Recording, ReadError> {
             s.values = idx.iter().map(|&i| s.values[i]).collect();
         }
     }
-    rec.integrity = match (&undecodable, &stored_digest) {
+    rec.integrity = match (&problem, &stored_digest) {
         // A finished writer's file decodes to its end: anything else is damage.
-        (Some(what), _) if finished => Integrity::Damaged(format!("its data cannot be decoded although its writer finished ({what})")),
+        (Some(what), _) if finished => Integrity::Damaged(format!("its writer finished it, but {what}")),
         (Some(_), _) | (None, None) => Integrity::Absent,
         (None, Some(d)) => digest::verify(&read_digests, rec.scenario.as_deref(), d),
     };
-    rec.problem = match (&undecodable, &rec.integrity) {
-        (Some(what), Integrity::Absent) => Some(format!("damaged after the last whole message: {what}")),
+    rec.complete = problem.is_none() && frames.footer_ok();
+    rec.problem = match &rec.integrity {
+        Integrity::Absent => problem.map(|p| format!("damaged after the last whole message: {p}")),
         _ => None,
     };
-    rec.complete = undecodable.is_none() && messages.rrd_manifests().map(|m| !m.is_empty()).unwrap_or(false);
     Ok(rec)
+}
+
+/// Untrusted text from a decoder's error, on one line and at most 300 characters.
+fn shown(text: &str) -> String {
+    let line = scenario::untrusted::one_line(text);
+    match line.char_indices().nth(300) {
+        Some((cut, _)) => format!("{}…", &line[..cut]),
+        None => line,
+    }
+}
+
+/// What one message adds to the recording.
+enum Item {
+    /// A static chunk: a property or the scenario text, and a series' legend.
+    Static { path: String, text: Option<String>, legend: Option<String> },
+    /// Rows of one series: steps, sim_time in ns where recorded, values.
+    Rows { path: String, steps: Vec<i64>, times: Option<Vec<i64>>, values: Vec<f64> },
+}
+
+/// Decodes one message, its lengths checked first; None for what is not a recording's chunk.
+fn decode(msg: &Message, version: Option<CrateVersion>, injector: &mut CachingApplicationIdInjector) -> Result<Option<Item>, String> {
+    use re_log_encoding::Decodable as _;
+    use re_protos::log_msg::v1alpha1 as proto;
+    let e = |e: re_log_encoding::CodecError| e.to_string();
+    let transport = match msg.kind {
+        MessageKind::ArrowMsg => {
+            let arrow = proto::ArrowMsg::from_rrd_bytes(&msg.payload).map_err(e)?;
+            payload::check(&arrow)?;
+            proto::log_msg::Msg::ArrowMsg(arrow)
+        }
+        MessageKind::SetStoreInfo => proto::log_msg::Msg::SetStoreInfo(proto::SetStoreInfo::from_rrd_bytes(&msg.payload).map_err(e)?),
+        MessageKind::BlueprintActivationCommand => proto::log_msg::Msg::BlueprintActivationCommand(proto::BlueprintActivationCommand::from_rrd_bytes(&msg.payload).map_err(e)?),
+        MessageKind::End => return Ok(None),
+    };
+    let LogMsg::ArrowMsg(store, arrow) = transport.to_application((injector, version)).map_err(e)? else {
+        return Ok(None);
+    };
+    if !store.is_recording() {
+        return Ok(None);
+    }
+    let chunk = Chunk::from_arrow_msg(&arrow).map_err(|e| format!("bad chunk: {e}"))?;
+    let path = chunk.entity_path().to_string();
+    if chunk.is_static() {
+        let first = |c| chunk.iter_slices::<String>(c).next().and_then(|v| v.into_iter().next()).map(|s| s.to_string());
+        return Ok(Some(Item::Static { path, text: first(TextDocument::descriptor_text().component), legend: first(SeriesLines::descriptor_names().component) }));
+    }
+    let timeline = |name: &str| chunk.timelines().iter().find(|(n, _)| n.as_str() == name).map(|(_, c)| c.times_raw().to_vec());
+    let Some(mut steps) = timeline("step") else {
+        return Ok(None);
+    };
+    let values: Vec<f64> = chunk.iter_slices::<f64>(Scalars::descriptor_scalars().component).map(|s| s.first().copied().unwrap_or(f64::NAN)).collect();
+    if values.is_empty() {
+        return Ok(None);
+    }
+    let rows = values.len().min(steps.len());
+    steps.truncate(rows);
+    Ok(Some(Item::Rows { path, steps, times: timeline("sim_time"), values: values[..rows].to_vec() }))
 }
 
 /// Whether the file ends with the stream footer (`RRF2FOOT` and an entry count) that only a

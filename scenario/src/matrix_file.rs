@@ -51,7 +51,9 @@ pub fn read(dir: &Path, name: &str) -> Result<Vec<Vec<f64>>, String> {
     if len > MAX_MATRIX_FILE_BYTES {
         return Err(format!("{shown}: {len} bytes, larger than the 1 GiB a matrix file may hold"));
     }
-    let npy = npyz::NpyFile::new(std::io::BufReader::new(file)).map_err(|e| format!("{shown}: not a .npy file ({e})"))?;
+    let mut file = std::io::BufReader::new(file);
+    let data_at = data_offset(&mut file, len).map_err(|e| format!("{shown}: not a .npy file ({e})"))?;
+    let npy = npyz::NpyFile::new(file).map_err(|e| format!("{shown}: not a .npy file ({e})"))?;
     let descr = npy.dtype().descr();
     let dtype = descr.trim_matches('\'');
     if !matches!(dtype, "<f8" | ">f8") {
@@ -61,9 +63,13 @@ pub fn read(dir: &Path, name: &str) -> Result<Vec<Vec<f64>>, String> {
         [r, c] => (r as usize, c as usize),
         ref s => return Err(format!("{shown}: has shape {s:?}; a matrix is 2-D (save a vector as (k, 1) or (1, k))")),
     };
-    // The header's shape must fit the file before anything is allocated for it.
-    if rows.checked_mul(cols).and_then(|k| k.checked_mul(8)).is_none_or(|b| b as u64 > len) {
-        return Err(format!("{shown}: its header says {rows}×{cols}, more values than its {len} bytes hold"));
+    // The header's shape must be what the file holds (exactly, as numpy.save writes it) before
+    // anything is allocated or read for it.
+    let values = len - data_at;
+    match rows.checked_mul(cols).and_then(|k| k.checked_mul(8)) {
+        Some(b) if b as u64 == values => {}
+        Some(b) if (b as u64) < values => return Err(format!("{shown}: its header says {rows}×{cols} ({b} bytes of values), but {values} bytes follow the header")),
+        _ => return Err(format!("{shown}: its header says {rows}×{cols}, more values than its {len} bytes hold")),
     }
     let order = npy.order();
     let data: Vec<f64> = npy.into_vec().map_err(|e| format!("{shown}: cannot read its values ({e})"))?;
@@ -72,4 +78,44 @@ pub fn read(dir: &Path, name: &str) -> Result<Vec<Vec<f64>>, String> {
     }
     let at = |i: usize, j: usize| if order == npyz::Order::Fortran { data[j * rows + i] } else { data[i * cols + j] };
     Ok((0..rows).map(|i| (0..cols).map(|j| at(i, j)).collect()).collect())
+}
+
+/// Longest `.npy` header text read: numpy's own reader refuses more than 10 000 bytes.
+const MAX_HEADER_BYTES: u64 = 10_000;
+
+/// Where the values start, from the magic, version and header length (NEP 1), checked against
+/// the file's `len` before npyz reads (and allocates) the header; the reader is left at 0. The
+/// header's brackets are limited to a depth of 4 (numpy writes 2), so a parser of nested
+/// literals cannot run out of stack.
+fn data_offset<R: std::io::Read + std::io::Seek>(file: &mut R, len: u64) -> Result<u64, String> {
+    use std::io::Read as _;
+    let mut pre = Vec::with_capacity(12);
+    file.by_ref().take(12).read_to_end(&mut pre).map_err(|e| e.to_string())?;
+    let got = pre.len();
+    if got < 10 || &pre[..6] != b"\x93NUMPY" {
+        return Err("no .npy magic".into());
+    }
+    let (size, at) = match pre[6] {
+        1 => (u16::from_le_bytes([pre[8], pre[9]]) as u64, 10),
+        2 | 3 if got == 12 => (u32::from_le_bytes([pre[8], pre[9], pre[10], pre[11]]) as u64, 12),
+        v => return Err(format!("format version {v} is not 1, 2 or 3")),
+    };
+    if size > MAX_HEADER_BYTES || at + size > len {
+        return Err(format!("its header claims {size} bytes, in a file of {len}"));
+    }
+    let mut header = vec![0u8; size as usize];
+    file.seek(std::io::SeekFrom::Start(at)).and_then(|_| file.read_exact(&mut header)).map_err(|e| e.to_string())?;
+    let mut depth = 0i32;
+    for b in &header {
+        depth += match b {
+            b'(' | b'[' | b'{' => 1,
+            b')' | b']' | b'}' => -1,
+            _ => 0,
+        };
+        if depth > 4 {
+            return Err("its header nests brackets deeper than a shape does".into());
+        }
+    }
+    file.seek(std::io::SeekFrom::Start(0)).map_err(|e| e.to_string())?;
+    Ok(at + size)
 }

@@ -100,3 +100,33 @@ fn bad_files_are_named_with_the_field() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn a_header_is_checked_before_it_is_read() {
+    let d = dir("header");
+    npy(&d.join("model/B.npy"), "<f8", false, &[3, 1], &[0.0, 0.0, 1.0]);
+    let err = |a: &str| scenario(&d, a).unwrap_err();
+    // Version 2.0 with a header length of 4 GiB − 1 in a file of a few bytes.
+    std::fs::write(d.join("model/long.npy"), b"\x93NUMPY\x02\x00\xff\xff\xff\xff{").unwrap();
+    let long = err("\"model/long.npy\"");
+    assert!(long.contains("plant.A") && long.contains("4294967295 bytes"), "{long}");
+    // Brackets nested 4000 deep, which a recursive parser would follow.
+    let header = format!("{}{}\n", "(".repeat(4000), ")".repeat(4000));
+    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+    bytes.extend((header.len() as u16).to_le_bytes());
+    bytes.extend(header.as_bytes());
+    std::fs::write(d.join("model/deep.npy"), bytes).unwrap();
+    let deep = err("\"model/deep.npy\"");
+    assert!(deep.contains("nests"), "{deep}");
+    // Fewer values than the header's shape, and more: the size must be exact.
+    npy(&d.join("model/A.npy"), "<f8", false, &[3, 3], &A);
+    let whole = std::fs::read(d.join("model/A.npy")).unwrap();
+    std::fs::write(d.join("model/short.npy"), &whole[..whole.len() - 8]).unwrap();
+    assert!(err("\"model/short.npy\"").contains("more values"));
+    let mut long_tail = whole.clone();
+    long_tail.extend([0u8; 8]);
+    std::fs::write(d.join("model/tail.npy"), long_tail).unwrap();
+    let tail = err("\"model/tail.npy\"");
+    assert!(tail.contains("3×3") && tail.contains("80 bytes follow"), "{tail}");
+    let _ = std::fs::remove_dir_all(&d);
+}
