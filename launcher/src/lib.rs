@@ -6,6 +6,7 @@ pub mod bench;
 pub mod calibrate;
 pub mod design_report;
 pub mod error;
+pub mod limits;
 pub mod output;
 pub mod plan;
 pub mod run;

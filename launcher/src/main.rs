@@ -7,7 +7,7 @@ use clap::{Parser, Subcommand};
 use launcher::error::{LaunchError, EXIT_BAD_INPUT, EXIT_EXPECT};
 // Printing that neither panics on a closed stdout nor passes control characters through.
 use launcher::{eprintln, print, println};
-use launcher::shipped;
+use launcher::{limits, shipped};
 use launcher::run::{Mode, Options, Stop};
 use launcher::{design_report, plan, run};
 use scenario::Scenario;
@@ -249,8 +249,8 @@ fn main() -> ExitCode {
     match command {
         Command::Run { scenario, out, mode, wait, force, allow_unstable, pin, record_every, record, seed, realtime, speed } => {
             let speed = speed.unwrap_or(1.0);
-            if !(speed.is_finite() && speed > 0.0) {
-                return fail(&LaunchError::BadInput(format!("--speed {speed}: must be a finite number > 0")));
+            if let Err(e) = limits::speed(speed) {
+                return fail(&e);
             }
             let realtime = realtime.then_some(speed);
             // A paced run sleeps while it waits, unless told otherwise.
@@ -263,6 +263,11 @@ fn main() -> ExitCode {
                 Ok(x) => x,
                 Err(e) => return fail(&e),
             };
+            if let Some(x) = realtime
+                && let Err(e) = limits::schedule(x, s.dt, s.steps)
+            {
+                return fail(&e);
+            }
             for w in &p.warnings {
                 eprintln!("warning: {w}");
             }
@@ -292,12 +297,15 @@ fn main() -> ExitCode {
             }
         }
         Command::Sweep { scenario, runs, jobs, seed, mode, out, keep_worst } => {
+            let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()).min(limits::MAX_JOBS));
+            if let Err(e) = limits::sweep_runs(runs).and_then(|_| limits::jobs(jobs)) {
+                return fail(&e);
+            }
             // One calibration for every realisation, from the first seed.
             let (s, p) = match prepared(&scenario, seed) {
                 Ok(x) => x,
                 Err(e) => return fail(&e),
             };
-            let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
             let mode = if mode == "processes" { Mode::Processes } else { Mode::InProcess };
             let opts = launcher::sweep::SweepOptions { runs, jobs, seed: s.seed, mode, out: out.clone(), keep_worst, wait: Wait::default_for_machine() };
             run::interrupt::install();
@@ -307,7 +315,7 @@ fn main() -> ExitCode {
                     match sw.write(&out) {
                         Ok(path) => {
                             println!("sweep summary: {}", path.display());
-                            ExitCode::SUCCESS
+                            sw.verdict().map_or(ExitCode::SUCCESS, |e| fail(&e))
                         }
                         Err(e) => fail(&LaunchError::Component(e)),
                     }
@@ -335,6 +343,9 @@ fn main() -> ExitCode {
             }
         }
         Command::Bench { steps, json, wait, mode, recording, pin, repeat, states } => {
+            if let Err(e) = limits::bench(steps, repeat).and_then(|_| limits::states(&states)) {
+                return fail(&e);
+            }
             let wait = wait.unwrap_or_else(Wait::default_for_machine);
             let modes: Vec<Mode> = match mode.as_deref() {
                 Some("processes") => vec![Mode::Processes],

@@ -31,6 +31,22 @@ pub struct WireHeader {
     pub reserved: u32,
 }
 
+impl WireHeader {
+    /// What is wrong with the header's own stamps, if anything (PROTOCOL.md §6): a `sim_time`
+    /// that is not finite, or a `taken_ns` later than `sent_ns` — a publisher takes its input
+    /// before it sends what it made of it, so a later stamp (`u64::MAX` included) is forged, the
+    /// way a component that publishes without reading would hide it.
+    pub fn stamp_violation(&self) -> Option<String> {
+        if !self.sim_time.is_finite() {
+            return Some(format!("its sample's sim_time is {}", self.sim_time));
+        }
+        if self.taken_ns > self.sent_ns {
+            return Some(format!("its sample says it took its input at {} ns, after it sent the sample at {} ns (CLOCK_MONOTONIC)", self.taken_ns, self.sent_ns));
+        }
+        None
+    }
+}
+
 /// The header of a received sample, plus the time this process took it.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Header {
@@ -50,5 +66,20 @@ impl Header {
     /// The header of a received sample, taken at `received_ns`.
     pub fn of(w: &WireHeader, received_ns: u64) -> Self {
         Header { step: w.step, sim_time: w.sim_time, sent_ns: w.sent_ns, taken_ns: w.taken_ns, received_ns }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn forged_stamps_are_named() {
+        let ok = WireHeader { step: 3, sim_time: 0.003, sent_ns: 200, taken_ns: 150, protocol: PROTOCOL_VERSION, reserved: 0 };
+        assert_eq!(ok.stamp_violation(), None);
+        assert_eq!(WireHeader { taken_ns: 0, ..ok }.stamp_violation(), None, "the plant's k = 0");
+        assert!(WireHeader { taken_ns: u64::MAX, ..ok }.stamp_violation().unwrap().contains("after it sent"));
+        assert!(WireHeader { sim_time: f64::NAN, ..ok }.stamp_violation().unwrap().contains("sim_time is NaN"));
+        assert!(WireHeader { sim_time: f64::INFINITY, ..ok }.stamp_violation().is_some());
     }
 }

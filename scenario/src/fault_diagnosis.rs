@@ -8,6 +8,7 @@ use lti::signal::{locate, Switch};
 use lti::{Mat, Model};
 use plant::fault::{Fault, Kind, Profile, Target};
 
+use super::limits::{MAX_CALIBRATION_RUNS, MAX_WINDOW};
 use super::raw::{RawDiagnoser, RawFault, RawNoise};
 use super::untrusted::quoted;
 use super::validate::{bad, check_name, finite, matrix, placement, poles, Bad};
@@ -250,6 +251,9 @@ pub(crate) fn diagnosers(raw: &[RawDiagnoser], model: &Model, ff: &Mat, noise: O
                 if w < 1 {
                     return Err(bad(at("window"), format!("{w} must be a whole number of samples ≥ 1")));
                 }
+                if w > MAX_WINDOW {
+                    return Err(bad(at("window"), format!("{w} samples: at most {MAX_WINDOW} (each member keeps its window in memory, 8 bytes a sample)")));
+                }
                 Evaluation::Rms { window: w as usize }
             }
             "forgetting" => {
@@ -277,6 +281,9 @@ pub(crate) fn diagnosers(raw: &[RawDiagnoser], model: &Model, ff: &Mat, noise: O
                 let c = d.calibrate.as_ref().expect("given");
                 if c.runs < 1 {
                     return Err(bad(at("calibrate.runs"), format!("{} must be a whole number of realisations ≥ 1", c.runs)));
+                }
+                if c.runs > MAX_CALIBRATION_RUNS {
+                    return Err(bad(at("calibrate.runs"), format!("{} realisations: at most {MAX_CALIBRATION_RUNS} (each is a whole run of the scenario, made before the run starts)", c.runs)));
                 }
                 let margin = finite(&at("calibrate.margin"), c.margin.unwrap_or(1.2))?;
                 if margin < 1.0 {

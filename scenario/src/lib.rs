@@ -5,6 +5,7 @@
 
 mod fault_diagnosis;
 mod hosts;
+pub mod limits;
 mod locate;
 pub mod matrix_file;
 mod raw;

@@ -10,6 +10,7 @@ use lti::{Mat, Model, PoleSpec, Poles};
 use observer::design::Path as HuiZakPath;
 use observer::Spec;
 
+use super::limits::{MAX_FAULTS, MAX_OBSERVERS, MAX_STEPS};
 use super::locate::{line_col, offset, one_based, parse_path};
 use super::raw::{RawController, RawExpect, RawObserver, RawPole, RawProcess, RawScenario, Rows};
 use super::untrusted::quoted;
@@ -197,8 +198,8 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
     if (steps_f * dt - duration).abs() > 1e-9 * duration {
         return Err(bad("duration", format!("{duration} is not a whole number of steps of dt = {dt}")));
     }
-    if steps_f > 1e9 {
-        return Err(bad("duration", format!("{steps_f} steps is more than 1e9")));
+    if steps_f > MAX_STEPS as f64 {
+        return Err(bad("duration", format!("{steps_f} steps is more than {MAX_STEPS} (duration / dt)")));
     }
     let steps = steps_f as u64;
     let remote = super::hosts::placements(&raw)?;
@@ -255,6 +256,9 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
     };
     let model = Model { a, b, c, e, d };
     let noise = super::fault_diagnosis::noise(&raw.noise, &model, dt)?;
+    if raw.fault.len() > MAX_FAULTS {
+        return Err(bad(format!("fault[{}]", MAX_FAULTS + 1), format!("{} faults: at most {MAX_FAULTS} (each adds two values to every plant sample and two recorded signals)", raw.fault.len())));
+    }
     let faults = super::fault_diagnosis::faults(&raw.fault, &model, &ff, dt)?;
     if p.process.is_some()
         && let Some(what) = [(!raw.fault.is_empty(), "fault"), (raw.noise.is_some(), "noise")].iter().find(|w| w.0).map(|w| w.1)
@@ -294,6 +298,8 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
             observers.push(ObserverEntry { name: format!("{}-{}", d.name, j + 1), spec: None, process: None, member: Some((di, j)) });
         }
     }
+
+    observer_cap(raw.observer.len(), &observers)?;
 
     let controller = raw.controller.as_ref().map(|c| controller_entry(c, &model, &seen)).transpose()?;
     let expect = raw.expect.unwrap_or_default();
@@ -337,6 +343,29 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
         faults,
         diagnosers,
     })
+}
+
+/// At most [`MAX_OBSERVERS`] observers, bank members included: the field named is the
+/// `[[observer]]` or `[[diagnoser]]` that goes past the cap.
+fn observer_cap(own: usize, observers: &[ObserverEntry]) -> Result<(), Bad> {
+    if observers.len() <= MAX_OBSERVERS {
+        return Ok(());
+    }
+    let members = observers.len() - own;
+    let field = if own > MAX_OBSERVERS {
+        format!("observer[{}]", MAX_OBSERVERS + 1)
+    } else {
+        let (d, _) = observers[MAX_OBSERVERS].member.expect("past the scenario's own observers come bank members");
+        format!("diagnoser[{}]", d + 1)
+    };
+    Err(bad(
+        field,
+        format!(
+            "the run would hold {} observers ({own} [[observer]] + {members} bank members); at most {MAX_OBSERVERS}: each subscribes to the plant's samples, and a service allows {} subscribers, one of them the launcher's recorder",
+            observers.len(),
+            lockstep::settings::MAX_SUBSCRIBERS
+        ),
+    ))
 }
 
 fn observer_spec(f: &str, o: &RawObserver, model: &Model, noise: Option<&super::NoiseSpec>) -> Result<Spec, Bad> {

@@ -153,3 +153,30 @@ fn params_must_be_representable_in_json() {
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("observer[3].params.gain") && err.contains("not a finite number"), "{err}");
 }
+
+/// Issue 19: stamps a component could forge are checked too — a `taken_ns` of u64::MAX (later
+/// than it sent the sample, later than the launcher received it) hides that it did not read its
+/// input, and a `sim_time` that is not a number is no time at all.
+#[test]
+fn forged_stamps_break_the_protocol() {
+    for (fault, want) in [("taken_max", "took its input at 18446744073709551615 ns, after it sent the sample"), ("nan_time", "sim_time is NaN")] {
+        let s = Scratch::new(&format!("bad-{fault}"));
+        let path = with_bad_observer(&s, 10, r#"["faulty_observer"]"#, &format!("{{ fault = \"{fault}\" }}"));
+        let (code, err, took) = run_checked(&s, &path);
+        assert_eq!(code, Some(3), "{fault}: {err}");
+        assert!(err.contains("observer 'bad' broke the protocol at step 100") && err.contains(want), "{fault}: {err}");
+        assert!(took < Duration::from_secs(5), "{fault}: took {took:?}");
+    }
+}
+
+/// Issue 19: a component that closes its stdout before `ready` (and lives on) cannot report
+/// ready: it is named at once, not after the 20 s the launcher waits for `ready`.
+#[test]
+fn a_component_that_closes_its_stdout_before_ready_is_named_at_once() {
+    let s = Scratch::new("bad-close-stdout");
+    let path = with_bad_observer(&s, 10, r#"["faulty_observer"]"#, r#"{ fault = "close_stdout" }"#);
+    let (code, err, took) = run_checked(&s, &path);
+    assert_eq!(code, Some(3), "{err}");
+    assert!(err.contains("observer 'bad' (pid") && err.contains("closed its stdout before it reported ready"), "{err}");
+    assert!(took < Duration::from_secs(3), "took {took:?}");
+}

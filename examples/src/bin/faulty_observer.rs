@@ -9,7 +9,10 @@
 //! 7: the child must not outlive the run), `kill` (dies by SIGKILL), `no_read` (publishes every
 //! step at once, without reading the plant's samples), `never_ready` (never writes `ready`),
 //! `refuse_version` (refuses the run's protocol version at start, as a component of another
-//! version must). Until then it publishes
+//! version must), `taken_max` (stamps `taken_ns` = u64::MAX, "never", which hides that it did
+//! not wait for its input), `nan_time` (its sample's `sim_time` is NaN), `close_stdout` (closes
+//! its stdout before `ready` and lives on, as a component that failed to start without dying
+//! would). Until then it publishes
 //! y's first n values padded with zeros — a poor estimate, but a well-formed one.
 
 use std::process::ExitCode;
@@ -54,6 +57,13 @@ fn main() -> ExitCode {
     if p.fault == "refuse_version" {
         eprintln!("faulty_observer: the run speaks protocol version {PROTOCOL_VERSION}, this component 2");
         return ExitCode::from(2);
+    }
+    if p.fault == "close_stdout" {
+        // SAFETY: close(2) on this process's own stdout, which nothing here writes to again.
+        unsafe { libc::close(1) };
+        loop {
+            std::thread::sleep(std::time::Duration::from_secs(60));
+        }
     }
     if p.fault == "never_ready" {
         loop {
@@ -103,6 +113,8 @@ fn main() -> ExitCode {
                 "nan" => out[0] = f64::NAN,
                 "wrong_step" => header.step = k + 1,
                 "protocol" => header.protocol = 2,
+                "taken_max" => header.taken_ns = u64::MAX,
+                "nan_time" => header.sim_time = f64::NAN,
                 "hang" => loop {
                     std::thread::sleep(std::time::Duration::from_secs(60));
                 },

@@ -1,5 +1,6 @@
 //! Running a scenario: output checks, the chosen mode, the recording, the summary.
 
+pub mod budget;
 mod configs;
 mod envelope;
 pub mod interrupt;
@@ -163,13 +164,15 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
     {
         return Err(LaunchError::BadInput(format!("{}: {what} is an external process: --mode in-process runs only built-in components", s.path.display())));
     }
+    let mut cfg = configs(s, plan);
+    // What the run will take of disk, memory and shared memory, before any output exists.
+    budget::check(s, plan, opts, cfg.layout.len(), 1)?;
     let (rrd, summary_path) = if opts.record { prepare_output(&opts.out, &s.name, opts.force).map(|(a, b)| (Some(a), Some(b)))? } else { (None, None) };
     // The recording is written under a temporary name and renamed when the run ends, however it
     // ends: a finished `<name>.rrd` is never half-written, and what a killed launcher leaves
     // (`<name>.rrd.partial`, without footer) does not stand in the next run's way.
     let partial = rrd.as_ref().map(|p| p.with_extension("rrd.partial"));
     interrupt::install();
-    let mut cfg = configs(s, plan);
     cfg.pace_s = opts.realtime.map(|x| s.dt / x);
     let mut session = Session::new(s, cfg.layout, &plan.banks, partial.as_deref(), &opts.select, cfg.pace_s).inspect_err(|_| {
         // A recording that could not even be started is of no use to anyone.

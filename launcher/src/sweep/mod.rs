@@ -5,8 +5,11 @@
 //! rate beside the false-alarm probability its χ² threshold was asked for, and each observer's
 //! tail error. Realisations are independent and gathered in seed order, so the result is the
 //! same whatever the number of jobs. The worst realisations can be run again with a recording
-//! (the same seed gives the same run, bit for bit).
+//! (the same seed gives the same run, bit for bit). A realisation that does not complete is
+//! counted as failed and left out of the statistics; an interrupted sweep writes the statistics
+//! of the realisations it finished, marked partial ([`outcome`]).
 
+mod outcome;
 mod stats;
 
 use std::path::{Path, PathBuf};
@@ -16,6 +19,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+pub use outcome::Failed;
 pub use stats::{spread, Spread};
 
 use crate::error::LaunchError;
@@ -54,8 +58,8 @@ pub struct FaultSweep {
     pub detection_delay: Option<Spread>,
     /// Realisations that isolated it correctly.
     pub isolated_correctly: usize,
-    /// isolated_correctly / runs.
-    pub isolation_accuracy: f64,
+    /// isolated_correctly / runs (none without a completed realisation).
+    pub isolation_accuracy: Option<f64>,
 }
 
 /// One residual over the sweep.
@@ -80,9 +84,17 @@ pub struct ResidualSweep {
 pub struct SweepSummary {
     /// Scenario name.
     pub scenario: String,
-    /// Realisations.
+    /// Realisations in the statistics: those that completed.
     pub runs: usize,
-    /// Seeds used: first and last.
+    /// Realisations asked for (`--runs`).
+    pub requested: usize,
+    /// Realisations that ended, completed or failed (fewer than asked when interrupted).
+    pub finished: usize,
+    /// Whether the sweep was interrupted: the statistics are of the realisations it finished.
+    pub partial: bool,
+    /// The signal that interrupted it.
+    pub interrupted_by: Option<&'static str>,
+    /// Seeds asked for: first and last.
     pub seeds: [u64; 2],
     /// Mode.
     pub mode: String,
@@ -90,8 +102,9 @@ pub struct SweepSummary {
     pub jobs: usize,
     /// Wall-clock time, s.
     pub wall_s: f64,
-    /// Realisations that stopped early (diverged, failed), by seed.
-    pub stopped: Vec<(u64, String)>,
+    /// Realisations that did not complete (a component failed, hung or was killed; a state
+    /// diverged), by seed: not in the statistics.
+    pub failed: Vec<Failed>,
     /// Per fault.
     pub faults: Vec<FaultSweep>,
     /// Alarm episodes while no fault acted, over all realisations.
@@ -110,8 +123,11 @@ pub struct SweepSummary {
     pub kept: Vec<u64>,
 }
 
-/// Runs realisation `seed`.
-fn one(s: &Scenario, plan: &Plan, seed: u64, opts: &SweepOptions, record: bool) -> Result<Summary, LaunchError> {
+/// A realisation run: its summary and how it ended, or why it could not run.
+type Ran = Result<(Summary, Stop), LaunchError>;
+
+/// Runs realisation `seed`: its summary and how it ended (an interruption is an error).
+fn one(s: &Scenario, plan: &Plan, seed: u64, opts: &SweepOptions, record: bool) -> Ran {
     let mut s = s.clone();
     s.seed = seed;
     if record {
@@ -121,7 +137,7 @@ fn one(s: &Scenario, plan: &Plan, seed: u64, opts: &SweepOptions, record: bool) 
     if let Stop::Interrupted(sig) = outcome.stop {
         return Err(LaunchError::Interrupted(format!("{}: sweep interrupted by {sig}", s.name)));
     }
-    Ok(outcome.summary)
+    Ok((outcome.summary, outcome.stop))
 }
 
 /// How bad a realisation went: wrong isolations, then false alarms, then the longest delay.
@@ -134,14 +150,14 @@ fn badness(s: &Summary) -> (usize, u64, u64) {
 
 /// Runs the sweep.
 pub fn sweep(s: &Scenario, plan: &Plan, opts: &SweepOptions) -> Result<SweepSummary, LaunchError> {
-    if opts.runs == 0 {
-        return Err(LaunchError::BadInput("--runs must be at least 1".into()));
-    }
-    std::fs::create_dir_all(&opts.out).map_err(|e| LaunchError::BadInput(format!("{}: cannot create the output directory: {e}", opts.out.display())))?;
+    crate::limits::sweep_runs(opts.runs)?;
+    crate::limits::jobs(opts.jobs)?;
     let jobs = if opts.mode == Mode::Processes { 1 } else { opts.jobs.clamp(1, opts.runs) };
+    run::budget::check_memory(s, plan, jobs as u64)?;
+    std::fs::create_dir_all(&opts.out).map_err(|e| LaunchError::BadInput(format!("{}: cannot create the output directory: {e}", opts.out.display())))?;
     let start = Instant::now();
     let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<Option<Result<Summary, LaunchError>>>> = Mutex::new((0..opts.runs).map(|_| None).collect());
+    let results: Mutex<Vec<Option<Ran>>> = Mutex::new((0..opts.runs).map(|_| None).collect());
     let bar = progress_bar(opts.runs);
     std::thread::scope(|scope| {
         for _ in 0..jobs {
@@ -151,12 +167,14 @@ pub fn sweep(s: &Scenario, plan: &Plan, opts: &SweepOptions) -> Result<SweepSumm
                     break;
                 }
                 let r = one(s, plan, opts.seed.wrapping_add(i as u64), opts, false);
-                let failed = r.is_err();
+                // A realisation that could not run at all (or was interrupted) ends the sweep; one
+                // that ran and failed is counted, and the others go on.
+                let fatal = r.is_err();
                 results.lock().expect("no worker panics")[i] = Some(r);
                 if let Some(b) = &bar {
                     b.inc(1);
                 }
-                if failed {
+                if fatal {
                     next.store(opts.runs, Ordering::Relaxed);
                 }
             });
@@ -165,20 +183,38 @@ pub fn sweep(s: &Scenario, plan: &Plan, opts: &SweepOptions) -> Result<SweepSumm
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    if let Some(sig) = run::interrupt::received() {
-        return Err(LaunchError::Interrupted(format!("{}: sweep interrupted by {sig}", s.name)));
-    }
-    let mut summaries = Vec::with_capacity(opts.runs);
-    for r in results.into_inner().expect("no worker panics").into_iter().flatten() {
-        summaries.push(r?);
-    }
-    let mut out = gather(s, opts, jobs, &summaries);
-    out.wall_s = start.elapsed().as_secs_f64();
-    // The worst realisations, again, with their recordings.
-    let mut order: Vec<usize> = (0..summaries.len()).collect();
-    order.sort_by_key(|&i| std::cmp::Reverse(badness(&summaries[i])));
-    for &i in order.iter().take(opts.keep_worst) {
+    let interrupted = run::interrupt::received();
+    let (mut completed, mut failed, mut finished) = (Vec::new(), Vec::new(), 0);
+    for (i, r) in results.into_inner().expect("no worker panics").into_iter().enumerate() {
         let seed = opts.seed.wrapping_add(i as u64);
+        match r {
+            None => {}
+            // Cut short by the interruption: not finished.
+            Some(Err(_)) if interrupted.is_some() => {}
+            Some(Err(e)) => return Err(e),
+            Some(Ok((summary, stop))) => {
+                finished += 1;
+                match Failed::of(seed, &stop) {
+                    Some(f) => failed.push(f),
+                    None => completed.push((seed, summary)),
+                }
+            }
+        }
+    }
+    let mut out = gather(s, opts, jobs, &completed);
+    out.finished = finished;
+    out.failed = failed;
+    out.partial = interrupted.is_some();
+    out.interrupted_by = interrupted;
+    out.wall_s = start.elapsed().as_secs_f64();
+    if interrupted.is_some() {
+        return Ok(out);
+    }
+    // The worst realisations, again, with their recordings.
+    let mut order: Vec<usize> = (0..completed.len()).collect();
+    order.sort_by_key(|&i| std::cmp::Reverse(badness(&completed[i].1)));
+    for &i in order.iter().take(opts.keep_worst) {
+        let seed = completed[i].0;
         one(s, plan, seed, opts, true)?;
         out.kept.push(seed);
     }
@@ -196,9 +232,10 @@ fn progress_bar(total: usize) -> Option<indicatif::ProgressBar> {
     })
 }
 
-/// The distributions over the realisations' summaries, in seed order.
-pub fn gather(s: &Scenario, opts: &SweepOptions, jobs: usize, runs: &[Summary]) -> SweepSummary {
-    let stopped = runs.iter().enumerate().filter_map(|(i, r)| r.stopped.clone().map(|w| (opts.seed.wrapping_add(i as u64), w))).collect();
+/// The distributions over the completed realisations' summaries (with their seeds), in seed
+/// order; `finished`, `failed` and `partial` are the caller's.
+pub fn gather(s: &Scenario, opts: &SweepOptions, jobs: usize, completed: &[(u64, Summary)]) -> SweepSummary {
+    let runs: Vec<&Summary> = completed.iter().map(|(_, r)| r).collect();
     let diag: Vec<&diagnosis::Diagnosis> = runs.iter().filter_map(|r| r.diagnosis.as_ref()).collect();
     let faults = s
         .faults
@@ -207,7 +244,7 @@ pub fn gather(s: &Scenario, opts: &SweepOptions, jobs: usize, runs: &[Summary]) 
             let figs: Vec<&diagnosis::FaultFigure> = diag.iter().filter_map(|d| d.faults.iter().find(|x| x.name == f.name)).collect();
             let delays: Vec<f64> = figs.iter().filter_map(|x| x.delay).collect();
             let correct = figs.iter().filter(|x| x.correct).count();
-            FaultSweep { name: f.name.clone(), detected: delays.len(), detection_delay: spread(&delays), isolated_correctly: correct, isolation_accuracy: correct as f64 / runs.len() as f64 }
+            FaultSweep { name: f.name.clone(), detected: delays.len(), detection_delay: spread(&delays), isolated_correctly: correct, isolation_accuracy: (!runs.is_empty()).then(|| correct as f64 / runs.len() as f64) }
         })
         .collect();
     let false_alarms: u64 = diag.iter().map(|d| d.false_alarms).sum();
@@ -245,11 +282,15 @@ pub fn gather(s: &Scenario, opts: &SweepOptions, jobs: usize, runs: &[Summary]) 
     SweepSummary {
         scenario: s.name.clone(),
         runs: runs.len(),
-        seeds: [opts.seed, opts.seed.wrapping_add(runs.len().saturating_sub(1) as u64)],
+        requested: opts.runs,
+        finished: runs.len(),
+        partial: false,
+        interrupted_by: None,
+        seeds: [opts.seed, opts.seed.wrapping_add(opts.runs.saturating_sub(1) as u64)],
         mode: opts.mode.name().into(),
         jobs,
         wall_s: 0.0,
-        stopped,
+        failed: Vec::new(),
         faults,
         false_alarms,
         runs_with_false_alarms: diag.iter().filter(|d| d.false_alarms > 0).count(),
@@ -262,6 +303,11 @@ pub fn gather(s: &Scenario, opts: &SweepOptions, jobs: usize, runs: &[Summary]) 
 }
 
 impl SweepSummary {
+    /// The sweep's failure, if it is one: interrupted, a realisation failed or diverged.
+    pub fn verdict(&self) -> Option<LaunchError> {
+        outcome::verdict(&self.scenario, self.requested, self.finished, &self.failed, self.interrupted_by)
+    }
+
     /// Writes `<out>/<name>.sweep.json` (atomically).
     pub fn write(&self, out: &Path) -> Result<PathBuf, String> {
         let path = out.join(format!("{}.sweep.json", self.scenario));
@@ -274,15 +320,21 @@ impl SweepSummary {
     /// The table printed after a sweep.
     pub fn table(&self) -> String {
         let f = |s: &Option<Spread>| s.as_ref().map_or_else(|| "—".to_string(), |s| format!("{:.4} / {:.4} / {:.4} / {:.4}", s.min, s.median, s.p95, s.max));
-        let mut t = format!("{} sweep: {} realisations (seeds {}–{}), {}, {} job(s), {:.1} s wall\n", self.scenario, self.runs, self.seeds[0], self.seeds[1], self.mode, self.jobs, self.wall_s);
+        let mut t = format!("{} sweep: {} realisations (seeds {}–{}), {}, {} job(s), {:.1} s wall\n", self.scenario, self.requested, self.seeds[0], self.seeds[1], self.mode, self.jobs, self.wall_s);
+        if self.partial {
+            t += &format!("  PARTIAL: interrupted after {} of {} realisations\n", self.finished, self.requested);
+        }
+        if self.runs != self.requested {
+            t += &format!("  statistics of {} completed realisation(s); {} failed\n", self.runs, self.failed.len());
+        }
         for x in &self.faults {
             t += &format!(
-                "  fault {:<18} detected {}/{}  delay min/median/p95/max {} s  isolated correctly {:.1} %\n",
+                "  fault {:<18} detected {}/{}  delay min/median/p95/max {} s  isolated correctly {}\n",
                 x.name,
                 x.detected,
                 self.runs,
                 f(&x.detection_delay),
-                100.0 * x.isolation_accuracy
+                x.isolation_accuracy.map_or_else(|| "—".to_string(), |a| format!("{:.1} %", 100.0 * a))
             );
         }
         t += &format!(
@@ -300,8 +352,8 @@ impl SweepSummary {
         for (name, s) in &self.tail_max_abs_error {
             t += &format!("  observer {:<12} tail max|e| min/median/p95/max {}\n", name, f(s));
         }
-        for (seed, why) in &self.stopped {
-            t += &format!("  seed {seed} stopped: {why}\n");
+        for x in &self.failed {
+            t += &format!("  seed {} {}: {}\n", x.seed, x.kind, x.reason);
         }
         t
     }

@@ -34,6 +34,11 @@ impl Selection {
         Ok(Selection { every, globs: Some(globs) })
     }
 
+    /// N of `--record-every N`: steps 0, N, 2N, … are recorded.
+    pub fn every(&self) -> u64 {
+        self.every
+    }
+
     /// Whether step `k` is recorded.
     #[inline]
     pub fn step(&self, k: u64) -> bool {

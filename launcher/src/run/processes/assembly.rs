@@ -38,22 +38,42 @@ impl Queue {
         self.items.is_empty()
     }
 
-    /// Moves every pending sample of `reader` in; returns how many there were.
+    /// Moves every pending sample of `reader` in; returns how many there were. A sample of a
+    /// component on this host cannot have been sent after the launcher received it: its
+    /// `sent_ns` is checked against the clock read once the batch is in (another host's clock
+    /// is moved onto this one only to within half a round trip, so its samples are not).
     pub(super) fn drain(&mut self, reader: &Reader, max: usize) -> Result<usize, LaunchError> {
         let (items, free, last) = (&mut self.items, &mut self.free, &mut self.last);
-        reader
+        let mut latest: Option<(u64, u64)> = None;
+        let got = reader
             .drain_up_to(max, |h, v| {
                 let mut buf = free.pop().unwrap_or_default();
                 buf.clear();
                 buf.extend_from_slice(v);
                 *last = Some(last.map_or(h.step, |l| l.max(h.step)));
+                if latest.is_none_or(|(sent, _)| h.sent_ns > sent) {
+                    latest = Some((h.sent_ns, h.step));
+                }
                 items.push_back((*h, buf));
             })
-            .map_err(|e| LaunchError::Component(format!("{}: {e}", self.label)))
+            .map_err(|e| LaunchError::Component(format!("{}: {e}", self.label)))?;
+        if let Some((sent, step)) = latest
+            && self.host.is_none()
+        {
+            let now = lockstep::now_ns();
+            if sent > now {
+                return Err(LaunchError::Component(format!(
+                    "{} broke the protocol at step {step}: its sample says it was sent at {sent} ns, after the launcher received it ({now} ns, CLOCK_MONOTONIC)",
+                    self.label
+                )));
+            }
+        }
+        Ok(got)
     }
 
     /// Takes the sample of step `k` into `out`, checking it against the protocol (PROTOCOL.md
-    /// §6): the step, the protocol version, the number of values, and that each is finite.
+    /// §6): the step, the protocol version, its stamps (a finite sim_time, taken no later than
+    /// sent), the number of values, and that each is finite.
     pub(super) fn take(&mut self, k: u64, out: &mut [f64]) -> Result<Header, LaunchError> {
         let (h, values) = self.items.pop_front().expect("non-empty");
         let broken = |why: String| LaunchError::Component(format!("{} broke the protocol at step {k}: {why}", self.label));
@@ -62,6 +82,9 @@ impl Queue {
         }
         if h.step != k {
             return Err(broken(format!("its sample is of step {}", h.step)));
+        }
+        if let Some(why) = h.stamp_violation() {
+            return Err(broken(why));
         }
         if values.len() != out.len() {
             return Err(broken(format!("its sample has {} values, the run's configuration says {}", values.len(), out.len())));

@@ -91,8 +91,13 @@ fn run_in(s: &Scenario, space: &RunSpace, cfg: &Configs, session: &mut Session, 
     result
 }
 
-/// Waits for every component's `ready`, then tells them all `go`.
-fn handshake(procs: &mut [Proc], rx: &mpsc::Receiver<(usize, String)>) -> Result<(), LaunchError> {
+/// How long a component whose stdout ended before `ready` is given to exit, so that its exit
+/// status and last words can be quoted.
+const EXIT_GRACE: Duration = Duration::from_millis(100);
+
+/// Waits for every component's `ready`, then tells them all `go`. A component whose stdout ends
+/// before `ready` cannot report it: it failed to start, and is named at once.
+fn handshake(procs: &mut [Proc], rx: &mpsc::Receiver<(usize, Option<String>)>) -> Result<(), LaunchError> {
     let deadline = Instant::now() + READY_TIMEOUT;
     let mut ready = vec![false; procs.len()];
     while !ready.iter().all(|&r| r) {
@@ -110,7 +115,8 @@ fn handshake(procs: &mut [Proc], rx: &mpsc::Receiver<(usize, String)>) -> Result
             }
         }
         match rx.recv_timeout(Duration::from_millis(20)) {
-            Ok((i, line)) if line.trim() == "ready" => ready[i] = true,
+            Ok((i, Some(line))) if line.trim() == "ready" => ready[i] = true,
+            Ok((i, None)) if !ready[i] => return Err(closed_before_ready(&mut procs[i])),
             Ok(_) | Err(mpsc::RecvTimeoutError::Timeout) => {}
             Err(mpsc::RecvTimeoutError::Disconnected) => {}
         }
@@ -124,6 +130,22 @@ fn handshake(procs: &mut [Proc], rx: &mpsc::Receiver<(usize, String)>) -> Result
         stdin.write_all(b"go\n").and_then(|_| stdin.flush()).map_err(|e| LaunchError::Component(format!("{}: {e}", p.label)))?;
     }
     Ok(())
+}
+
+/// The failure of a component whose stdout ended before it reported ready: its exit, when it
+/// exits within [`EXIT_GRACE`] (it usually closed stdout by exiting), else the closed pipe.
+fn closed_before_ready(p: &mut Proc) -> LaunchError {
+    let until = Instant::now() + EXIT_GRACE;
+    while Instant::now() < until {
+        if let Ok(Some(st)) = p.child.try_wait() {
+            p.status = Some(st);
+            // Give its stderr reader a moment to collect the message.
+            std::thread::sleep(Duration::from_millis(20));
+            return LaunchError::Component(format!("{} before the run began", p.describe_exit()));
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    LaunchError::Component(format!("{} (pid {}) closed its stdout before it reported ready: it failed to start", p.label, p.child.id()))
 }
 
 fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: &Readers, asm: &mut Assembly) -> Result<Stop, LaunchError> {

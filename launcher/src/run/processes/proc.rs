@@ -122,7 +122,7 @@ fn program_path(program: &str, workdir: &Path) -> std::path::PathBuf {
 
 /// Starts a component (PROTOCOL.md §1): our binary, or the scenario's command in the scenario
 /// file's folder; either way with the protocol's environment, in its own process group.
-pub(super) fn spawn(c: &Launchable, workdir: &Path, space: &RunSpace, cpu: Option<usize>, tx: &mpsc::Sender<(usize, String)>, index: usize) -> Result<Proc, LaunchError> {
+pub(super) fn spawn(c: &Launchable, workdir: &Path, space: &RunSpace, cpu: Option<usize>, tx: &mpsc::Sender<(usize, Option<String>)>, index: usize) -> Result<Proc, LaunchError> {
     let label = c.label.clone();
     let mut cmd = match &c.program {
         Program::Builtin(kind) => {
@@ -170,16 +170,18 @@ pub(super) fn spawn(c: &Launchable, workdir: &Path, space: &RunSpace, cpu: Optio
     let out = child.stdout.take().expect("piped");
     let tx = tx.clone();
     std::thread::spawn(move || {
-        // Until `ready` the lines go to the handshake; after it a component's stdout is read
+        // Until `ready` the lines go to the handshake, and the end of stdout before it (`None`)
+        // says at once that the component cannot start; after it a component's stdout is read
         // and dropped, so a chatty component neither blocks on a full pipe nor fills memory.
         let mut lines = BufReader::new(out).lines().map_while(Result::ok);
         for line in lines.by_ref() {
             let ready = line.trim() == "ready";
-            if tx.send((index, line)).is_err() || ready {
-                break;
+            if tx.send((index, Some(line))).is_err() || ready {
+                lines.for_each(drop);
+                return;
             }
         }
-        lines.for_each(drop);
+        let _ = tx.send((index, None));
     });
     let mut err = child.stderr.take().expect("piped");
     let stderr = Arc::new(Mutex::new(String::new()));

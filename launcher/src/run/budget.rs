@@ -1,0 +1,167 @@
+//! What a run will take of the machine, estimated from the scenario before anything starts and
+//! checked against what the machine has: the recording against the free space of the output
+//! directory's file system, the buffers that grow with the scenario against available memory,
+//! and the run's shared memory against the free space of `/dev/shm`. A run that cannot fit is
+//! bad input (exit 2) — not a full disk or an abort halfway through.
+
+use std::ffi::CString;
+use std::os::unix::ffi::OsStrExt;
+use std::path::Path;
+
+use diagnosis::Evaluation;
+use recording::signals as sig;
+use scenario::Scenario;
+
+use super::{Mode, Options};
+use crate::error::LaunchError;
+use crate::plan::Plan;
+
+/// Bytes a recorded scalar takes in the `.rrd`: its value, its step and sim_time stamps and
+/// Rerun's row id (8 + 8 + 8 + 16), and its share of the chunks' headers. Measured: 44.9 bytes
+/// per scalar and step for seed002-sine (33 signals) and seed002-actuator-faults (55).
+pub const BYTES_PER_SCALAR: u64 = 46;
+
+/// The entity paths a run records, before `--record` filters them: the series
+/// [`super::Session::new`] creates, in no particular order.
+pub fn recorded_paths(s: &Scenario, plan: &Plan, paced: bool) -> Vec<String> {
+    let m = &s.model;
+    let mut p: Vec<String> = Vec::new();
+    p.extend((0..m.n()).map(sig::state));
+    p.extend((0..m.p()).map(sig::output));
+    p.extend((0..m.e.ncols()).map(sig::disturbance));
+    p.extend((0..m.d.ncols()).map(sig::measurement_disturbance));
+    p.extend((0..m.l()).map(sig::input));
+    if s.controller.is_some() {
+        p.extend((0..m.l()).map(sig::control));
+    }
+    for o in s.observers.iter().filter(|o| o.member.is_none()) {
+        p.extend((0..m.n()).map(|i| sig::estimate(&o.name, i)));
+        p.extend((0..m.n()).map(|i| sig::error(&o.name, i)));
+        p.extend((0..m.p()).map(|j| sig::residual(&o.name, j)));
+        p.push(sig::log_error(&o.name));
+    }
+    for b in &plan.banks {
+        let d = &b.spec.name;
+        for (i, mb) in b.members.iter().enumerate() {
+            p.extend(mb.outputs.iter().map(|&j| sig::member_residual(d, i, j)));
+            p.extend([sig::evaluation(d, i), sig::threshold(d, i), sig::alarm(d, i)]);
+        }
+        p.push(sig::isolated(d));
+    }
+    for f in &s.faults {
+        p.extend([sig::fault_active(&f.name), sig::fault_value(&f.name)]);
+    }
+    p.push("/latency/step".into());
+    if paced {
+        p.push("/latency/overrun".into());
+    }
+    p.extend(super::hop_names(s).iter().map(|h| super::hop_entity(h)));
+    p
+}
+
+/// Bytes the run's recording will take, about: recorded steps × recorded scalars × [`BYTES_PER_SCALAR`].
+pub fn recording_bytes(s: &Scenario, plan: &Plan, opts: &Options) -> (u64, u64, u64) {
+    let scalars = recorded_paths(s, plan, opts.realtime.is_some()).iter().filter(|p| opts.select.entity(p)).count() as u64;
+    let steps = s.steps.div_ceil(opts.select.every());
+    (steps, scalars, steps.saturating_mul(scalars).saturating_mul(BYTES_PER_SCALAR))
+}
+
+/// Memory one run's buffers take that grow with the scenario: each `rms` member's window and
+/// each observer's tail maxima (see `recording::write::tail`).
+pub fn memory_bytes(s: &Scenario, plan: &Plan) -> u64 {
+    let windows: u64 = plan
+        .banks
+        .iter()
+        .map(|b| match b.spec.evaluation {
+            Evaluation::Rms { window } => (window as u64) * b.members.len() as u64 * 8,
+            _ => 0,
+        })
+        .sum();
+    let blocks = s.steps.div_ceil(recording::write::tail::block_len(s.steps)).max(1);
+    windows + s.observers.len() as u64 * 2 * blocks * 8
+}
+
+/// Shared memory of a run across processes, about: every service's data segment, sized by
+/// iceoryx2 for its most subscribers, each with the largest buffer (PROTOCOL.md §4).
+pub fn shared_memory_bytes(s: &Scenario, plant_len: usize) -> u64 {
+    use lockstep::settings::{MAX_SUBSCRIBERS, SUBSCRIBER_MAX_BUFFER};
+    let n = s.model.n();
+    let lens = std::iter::once(plant_len).chain(s.observers.iter().map(|_| n)).chain(s.controller.as_ref().map(|_| s.model.l()));
+    let per_sample = |len: usize| (len as u64 * 8 + std::mem::size_of::<lockstep::WireHeader>() as u64) * (MAX_SUBSCRIBERS * SUBSCRIBER_MAX_BUFFER) as u64;
+    lens.map(per_sample).sum()
+}
+
+/// Checks a run's recording, memory and shared memory against the machine; `jobs` runs at once.
+pub fn check(s: &Scenario, plan: &Plan, opts: &Options, plant_len: usize, jobs: u64) -> Result<(), LaunchError> {
+    if opts.record {
+        let (steps, scalars, bytes) = recording_bytes(s, plan, opts);
+        if let Some(free) = free_bytes(&opts.out)
+            && bytes > free
+        {
+            return Err(LaunchError::BadInput(format!(
+                "{}: the recording would take about {} ({steps} recorded steps × {scalars} signals × {BYTES_PER_SCALAR} bytes), the file system has {} free; thin it with --record-every N or --record GLOB",
+                opts.out.display(),
+                size(bytes),
+                size(free)
+            )));
+        }
+    }
+    check_memory(s, plan, jobs)?;
+    if opts.mode == Mode::Processes {
+        let need = shared_memory_bytes(s, plant_len);
+        if let Some(free) = free_bytes(Path::new("/dev/shm"))
+            && need > free
+        {
+            return Err(LaunchError::BadInput(format!(
+                "{}: the run's shared memory would take about {} ({} values per plant sample), /dev/shm has {} free",
+                s.path.display(),
+                size(need),
+                plant_len,
+                size(free)
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Checks the memory of `jobs` runs at once against what the machine has available.
+pub fn check_memory(s: &Scenario, plan: &Plan, jobs: u64) -> Result<(), LaunchError> {
+    let need = memory_bytes(s, plan).saturating_mul(jobs);
+    match available_memory() {
+        Some(free) if need > free => Err(LaunchError::BadInput(format!(
+            "{}: {jobs} run(s) at once would need about {} for their residual windows and figures, the machine has {} available",
+            s.path.display(),
+            size(need),
+            size(free)
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// Free bytes for an unprivileged user on the file system of `dir`, or of its nearest existing
+/// ancestor (the output directory may not exist yet).
+pub fn free_bytes(dir: &Path) -> Option<u64> {
+    let abs = std::path::absolute(dir).ok()?;
+    let existing = abs.ancestors().find(|p| p.exists())?;
+    let c = CString::new(existing.as_os_str().as_bytes()).ok()?;
+    // SAFETY: statvfs(3) writes into the zeroed struct we own; the path is a valid C string.
+    let mut st: libc::statvfs = unsafe { std::mem::zeroed() };
+    if unsafe { libc::statvfs(c.as_ptr(), &mut st) } != 0 {
+        return None;
+    }
+    Some((st.f_bavail as u64).saturating_mul(st.f_frsize as u64))
+}
+
+/// `MemAvailable` of /proc/meminfo, bytes.
+fn available_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib.saturating_mul(1024))
+}
+
+/// "1.6 GB", "430 MB".
+fn size(bytes: u64) -> String {
+    let b = bytes as f64;
+    if b >= 1e9 { format!("{:.1} GB", b / 1e9) } else { format!("{:.0} MB", (b / 1e6).max(1.0)) }
+}

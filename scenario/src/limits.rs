@@ -1,0 +1,24 @@
+//! The largest counts a scenario may ask for. Each bounds something that grows with it — a
+//! process, memory, a file, or time — so that a number typed wrong is refused as bad input
+//! (exit 2, the field named) instead of aborting or filling a disk once the run has started.
+
+/// Most steps (duration / dt) a run may have: 11.6 days at 1 kHz.
+pub const MAX_STEPS: u64 = 1_000_000_000;
+
+/// Most observers a run may hold, bank members included. Each subscribes to the plant's
+/// service, which also feeds the launcher's recorder, and a service of this protocol allows
+/// [`lockstep::settings::MAX_SUBSCRIBERS`] subscribers (PROTOCOL.md §4): one for the recorder,
+/// the rest for observers.
+pub const MAX_OBSERVERS: usize = lockstep::settings::MAX_SUBSCRIBERS - 1;
+
+/// Most `[[fault]]` entries: each adds two values to every plant sample and two recorded
+/// signals per step.
+pub const MAX_FAULTS: usize = 64;
+
+/// Longest `rms` window, in samples: each bank member keeps the last `window` residual norms
+/// (8 bytes each), in every realisation a sweep runs at once.
+pub const MAX_WINDOW: i64 = 1_000_000;
+
+/// Most calibration realisations (`calibrate.runs`): each is a whole run of the scenario, made
+/// before the run itself starts.
+pub const MAX_CALIBRATION_RUNS: i64 = 10_000;
