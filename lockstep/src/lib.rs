@@ -34,6 +34,7 @@ mod layout;
 mod port;
 mod quiet;
 mod run;
+mod run_dir;
 mod sample;
 pub mod settings;
 pub mod service;
@@ -45,6 +46,6 @@ pub use handshake::{die_with_parent, parse_launch, ready_then_wait_for_go, Launc
 pub use layout::PlantLayout;
 pub use quiet::quiet_iceoryx2;
 pub use port::{Bus, Inlet, Outlet, Reader, FOLLOWER_LAG, RECORDER_BUFFER};
-pub use run::{cleanup_dead_runs, iox2_root, RunSpace, RUNS_DIR_ENV};
+pub use run::{cleanup_dead_runs, iox2_root, prepare_runs_dir, RunSpace, RUNS_DIR_ENV};
 pub use sample::{Header, WireHeader, PROTOCOL_VERSION};
 pub use wait::Wait;

@@ -1,13 +1,16 @@
 //! One run's private corner of the machine: an iceoryx2 prefix, a root directory, and the
 //! component configurations, all removed when the run ends.
 //!
-//! Layout: `$UIO_RUNS_DIR/<id>/` (default `/tmp/uio-observers/<id>/`, mode 0700) holds
-//! `owner.pid` (the launcher's pid), one `<component>.json` per component, and `iox2/`, the
-//! iceoryx2 root path; shared memory lives in `/dev/shm/uio<id>_*`.
+//! Layout: `$UIO_RUNS_DIR/<id>/` (default `$XDG_RUNTIME_DIR/uio-observers/<id>/`, else
+//! `/tmp/uio-observers/<id>/`, mode 0700) holds `owner.pid` (the launcher's pid), one
+//! `<component>.json` per component, and `iox2/`, the iceoryx2 root path; shared memory lives in
+//! `/dev/shm/uio<id>_*`. The runs directory is used only when it is private (see
+//! [`crate::run_dir`]), and nothing is removed that is not provably a dead run of ours.
 
+use std::ffi::OsStr;
 use std::fs;
-use std::io::Write;
-use std::os::unix::fs::{DirBuilderExt, PermissionsExt};
+use std::io::{Read, Write};
+use std::os::unix::fs::{DirBuilderExt, OpenOptionsExt, PermissionsExt};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU32, Ordering};
 
@@ -15,6 +18,7 @@ use iceoryx2::prelude::*;
 use iceoryx2_bb_system_types::path::Path as IoxPath;
 
 use crate::error::LockstepError;
+use crate::run_dir::{default_runs_dir, ensure_private, id_pid, open_private, Dir};
 
 /// Environment variable naming the directory that holds run directories.
 pub const RUNS_DIR_ENV: &str = "UIO_RUNS_DIR";
@@ -48,8 +52,40 @@ pub struct RunSpace {
 /// Where run directories live, made absolute: components run in other working directories (an
 /// external one in its scenario's folder) and are handed these paths.
 fn runs_dir() -> PathBuf {
-    let dir = std::env::var_os(RUNS_DIR_ENV).map_or_else(|| PathBuf::from("/tmp/uio-observers"), PathBuf::from);
+    let dir = std::env::var_os(RUNS_DIR_ENV)
+        .filter(|d| !d.is_empty())
+        .map_or_else(|| default_runs_dir(std::env::var_os("XDG_RUNTIME_DIR").as_deref()), PathBuf::from);
     std::path::absolute(&dir).unwrap_or(dir)
+}
+
+const RUNS: &str = "runs directory";
+const ROOTS: &str = "iceoryx2 root directory";
+
+/// Makes (or checks) the runs directory and, when this process's runs would need it, the short
+/// iceoryx2 roots' directory: each a real directory, ours, mode 0700. Returns the runs
+/// directory, or one line naming the path and why it is refused. The launcher calls this before
+/// any output exists, so a refused directory is bad input.
+pub fn prepare_runs_dir() -> Result<PathBuf, LockstepError> {
+    let base = runs_dir();
+    ensure_private(RUNS, &base)?;
+    // The longest id this process can make: its pid, a counter below 10⁶, a six-digit nonce.
+    let longest = format!("{}x999999x999999", std::process::id());
+    if !iox2_root(&base.join(&longest), &longest).starts_with(&base) {
+        ensure_private(ROOTS, Path::new(SHORT_ROOTS))?;
+    }
+    Ok(base)
+}
+
+/// Reads a pid from `name` in `dir`: None when it is absent, unreadable or not a number; an
+/// error when it is there but not a regular file of ours (a FIFO, a device, a symlink).
+fn read_pid(dir: &Dir, name: &str) -> Result<Option<i32>, std::io::Error> {
+    let f = match dir.open_own_file(OsStr::new(name)) {
+        Ok(f) => f,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(e),
+    };
+    let mut text = String::new();
+    Ok(f.take(32).read_to_string(&mut text).ok().and_then(|_| text.trim().parse().ok()))
 }
 
 fn io(what: &str, path: &Path, e: std::io::Error) -> LockstepError {
@@ -61,7 +97,7 @@ impl RunSpace {
     pub fn create() -> Result<Self, LockstepError> {
         static COUNTER: AtomicU32 = AtomicU32::new(0);
         let base = runs_dir();
-        fs::DirBuilder::new().recursive(true).mode(0o700).create(&base).map_err(|e| io("cannot create", &base, e))?;
+        ensure_private(RUNS, &base)?;
         let id = format!(
             "{}x{}x{}",
             std::process::id(),
@@ -73,28 +109,42 @@ impl RunSpace {
         let tmp = base.join(format!(".new-{id}"));
         fs::DirBuilder::new().mode(0o700).create(&tmp).map_err(|e| io("cannot create", &tmp, e))?;
         fs::DirBuilder::new().mode(0o700).create(tmp.join("iox2")).map_err(|e| io("cannot create", &tmp, e))?;
-        let mut f = fs::File::create(tmp.join("owner.pid")).map_err(|e| io("cannot write", &tmp, e))?;
+        let mut f = fs::OpenOptions::new().write(true).create_new(true).mode(0o600).open(tmp.join("owner.pid")).map_err(|e| io("cannot write", &tmp, e))?;
         writeln!(f, "{}", std::process::id()).map_err(|e| io("cannot write", &tmp, e))?;
         fs::set_permissions(tmp.join("owner.pid"), fs::Permissions::from_mode(0o600)).map_err(|e| io("cannot chmod", &tmp, e))?;
         let dir = base.join(&id);
         let root = iox2_root(&dir, &id);
         if !root.starts_with(&dir) {
-            fs::DirBuilder::new().recursive(true).mode(0o700).create(&root).map_err(|e| io("cannot create", &root, e))?;
+            let roots = ensure_private(ROOTS, Path::new(SHORT_ROOTS))?;
+            roots.mkdir(OsStr::new(&id)).map_err(|e| io("cannot create", &root, e))?;
         }
         fs::rename(&tmp, &dir).map_err(|e| io("cannot create", &dir, e))?;
         Self::at(id, dir)
     }
 
-    /// An existing run, as a component started by the launcher sees it.
+    /// An existing run, as a component started by the launcher sees it: the runs directory
+    /// private, the run's directory a real one of ours, its `owner.pid` a regular file of ours.
     pub fn open(id: &str) -> Result<Self, LockstepError> {
         if id.is_empty() || !id.chars().all(|c| c.is_ascii_alphanumeric()) {
             return Err(LockstepError::Io(format!("'{id}' is not a run id")));
         }
-        let dir = runs_dir().join(id);
-        if !dir.join("owner.pid").is_file() {
-            return Err(LockstepError::Io(format!("no run '{id}' in {}", runs_dir().display())));
+        let base = runs_dir();
+        let runs = open_private(RUNS, &base)?;
+        let dir = base.join(id);
+        let missing = || LockstepError::Io(format!("no run '{id}' in {}", base.display()));
+        let run = match runs.at(OsStr::new(id)) {
+            Ok(run) => run,
+            Err(e) if e.raw_os_error() == Some(libc::ENOENT) => return Err(missing()),
+            Err(e) => return Err(LockstepError::Io(format!("run directory {}: {e} (a symbolic link or not a directory?); refusing to use it", dir.display()))),
+        };
+        if !run.stat().is_ok_and(|s| s.is_ours()) {
+            return Err(LockstepError::Io(format!("run directory {}: not ours; refusing to use it", dir.display())));
         }
-        Self::at(id.to_string(), dir)
+        match read_pid(&run, "owner.pid") {
+            Ok(Some(_)) => Self::at(id.to_string(), dir),
+            Ok(None) => Err(missing()),
+            Err(e) => Err(LockstepError::Io(format!("{}: {e}; refusing to use it", dir.join("owner.pid").display()))),
+        }
     }
 
     fn at(id: String, dir: PathBuf) -> Result<Self, LockstepError> {
@@ -108,7 +158,7 @@ impl RunSpace {
 
     /// The pid of the launcher that owns the run.
     pub fn owner(&self) -> Option<i32> {
-        fs::read_to_string(self.dir.join("owner.pid")).ok().and_then(|s| s.trim().parse().ok())
+        read_pid(&Dir::open(&self.dir).ok()?, "owner.pid").ok().flatten()
     }
 
     /// The run id (alphanumeric).
@@ -160,29 +210,49 @@ impl RunSpace {
     /// counter (`…node.<version>.global_mgmt`) with global access (0666). The launcher creates
     /// that segment when it joins the bus, before any component starts, and calls this at once.
     pub fn restrict_shm(&self) -> Result<(), LockstepError> {
+        let Ok(shm) = Dir::open(Path::new(SHM_DIR)) else { return Ok(()) };
         for f in self.shm_files() {
-            fs::set_permissions(&f, fs::Permissions::from_mode(0o600)).map_err(|e| io("cannot chmod", &f, e))?;
+            // Through an O_NOFOLLOW descriptor of a regular file of ours: a name planted in
+            // /dev/shm cannot make this chmod anything else.
+            let name = f.file_name().unwrap_or_default();
+            let file = shm.open_own_file(name).map_err(|e| io("cannot chmod", &f, e))?;
+            file.set_permissions(fs::Permissions::from_mode(0o600)).map_err(|e| io("cannot chmod", &f, e))?;
         }
         Ok(())
     }
 
     /// Removes every file of the run: its shared memory and its directory.
     pub fn remove(&self) {
-        for f in self.shm_files() {
-            let _ = fs::remove_file(f);
+        remove_shm_with_prefix(&format!("uio{}_", self.id));
+        if let Some(base) = self.dir.parent()
+            && let Ok(runs) = open_private(RUNS, base)
+        {
+            let _ = runs.remove_tree(OsStr::new(&self.id));
         }
-        let _ = fs::remove_dir_all(&self.dir);
-        let _ = fs::remove_dir_all(Path::new(SHORT_ROOTS).join(&self.id));
+        if let Ok(roots) = open_private(ROOTS, Path::new(SHORT_ROOTS)) {
+            let _ = roots.remove_tree(OsStr::new(&self.id));
+        }
     }
 }
 
+/// `/dev/shm` files whose name starts with `prefix` and that are regular files of ours: what
+/// another user put there under our name is not ours to chmod or remove.
 fn shm_files_with_prefix(prefix: &str) -> Vec<PathBuf> {
-    let Ok(entries) = fs::read_dir(SHM_DIR) else { return Vec::new() };
-    entries
-        .flatten()
-        .filter(|e| e.file_name().to_string_lossy().starts_with(prefix))
-        .map(|e| e.path())
+    let Ok(shm) = Dir::open(Path::new(SHM_DIR)) else { return Vec::new() };
+    let names = shm.names().unwrap_or_default();
+    names
+        .into_iter()
+        .filter(|n| n.to_string_lossy().starts_with(prefix))
+        .filter(|n| shm.stat_at(n).is_ok_and(|s| s.is_file() && s.is_ours()))
+        .map(|n| Path::new(SHM_DIR).join(n))
         .collect()
+}
+
+fn remove_shm_with_prefix(prefix: &str) {
+    let Ok(shm) = Dir::open(Path::new(SHM_DIR)) else { return };
+    for f in shm_files_with_prefix(prefix) {
+        let _ = shm.remove_own_file(f.file_name().unwrap_or_default());
+    }
 }
 
 fn alive(pid: i32) -> bool {
@@ -192,46 +262,84 @@ fn alive(pid: i32) -> bool {
 
 /// Removes what runs whose launcher has died left behind — their directories and their shared
 /// memory, also shared memory whose directory is already gone; returns how many runs were cleaned.
+///
+/// Only what is provably a dead run of ours goes: in a private runs directory, an entry that is
+/// a real directory (not a symlink) owned by us, named like a run id, whose `owner.pid` is a
+/// regular file of ours naming a dead process (or is absent and the id's pid is dead). Anything
+/// else — a symlink, another user's directory, an `owner.pid` that is a FIFO or a device — is
+/// left alone, unread. Removal goes through directory descriptors and never follows a symlink.
 pub fn cleanup_dead_runs() -> usize {
     let mut cleaned = 0;
-    if let Ok(entries) = fs::read_dir(runs_dir()) {
-        for entry in entries.flatten() {
-            let id = entry.file_name().to_string_lossy().to_string();
-            if let Some(rest) = id.strip_prefix(".new-") {
-                // A directory still being set up; left over only if its launcher died doing it.
-                let owner = rest.split('x').next().and_then(|p| p.parse::<i32>().ok());
-                if !owner.is_some_and(alive) {
-                    let _ = fs::remove_dir_all(entry.path());
-                }
+    if let Ok(runs) = open_private(RUNS, &runs_dir()) {
+        for name in runs.names().unwrap_or_default() {
+            let name_str = name.to_string_lossy().into_owned();
+            let (id, building) = match name_str.strip_prefix(".new-") {
+                Some(rest) => (rest.to_string(), true),
+                None => (name_str.clone(), false),
+            };
+            let Some(id_owner) = id_pid(&id) else { continue };
+            let Ok(run) = runs.at(&name) else { continue };
+            if !run.stat().is_ok_and(|s| s.is_dir() && s.is_ours()) {
                 continue;
             }
-            let owner = fs::read_to_string(entry.path().join("owner.pid")).ok().and_then(|s| s.trim().parse::<i32>().ok());
-            if !owner.is_some_and(alive) {
-                for f in shm_files_with_prefix(&format!("uio{id}_")) {
-                    let _ = fs::remove_file(f);
+            let owner = if building {
+                // Still being set up; left over only if its launcher died doing it.
+                Some(id_owner)
+            } else {
+                match read_pid(&run, "owner.pid") {
+                    Ok(Some(pid)) => Some(pid),
+                    Ok(None) => Some(id_owner),
+                    Err(_) => continue,
                 }
-                let _ = fs::remove_dir_all(entry.path());
-                let _ = fs::remove_dir_all(Path::new(SHORT_ROOTS).join(&id));
+            };
+            drop(run);
+            if owner.is_some_and(alive) {
+                continue;
+            }
+            let _ = runs.remove_tree(&name);
+            if !building {
+                remove_shm_with_prefix(&format!("uio{id}_"));
+                if let Ok(roots) = open_private(ROOTS, Path::new(SHORT_ROOTS)) {
+                    let _ = roots.remove_tree(OsStr::new(&id));
+                }
                 cleaned += 1;
             }
         }
     }
     // Short iceoryx2 roots are named after their run id, <launcher pid>x…: the owner is in the name.
-    if let Ok(entries) = fs::read_dir(SHORT_ROOTS) {
-        for entry in entries.flatten() {
-            let pid = entry.file_name().to_string_lossy().split('x').next().and_then(|p| p.parse::<i32>().ok());
-            if pid.is_some_and(|p| !alive(p)) {
-                let _ = fs::remove_dir_all(entry.path());
+    if let Ok(roots) = open_private(ROOTS, Path::new(SHORT_ROOTS)) {
+        for name in roots.names().unwrap_or_default() {
+            let Some(pid) = name.to_str().and_then(id_pid) else { continue };
+            let ours = roots.stat_at(&name).is_ok_and(|s| s.is_dir() && s.is_ours());
+            if ours && !alive(pid) {
+                let _ = roots.remove_tree(&name);
             }
         }
     }
     // Shared memory is named uio<launcher pid>x<n>x<nonce>_…: the owner is in the name.
-    for f in shm_files_with_prefix("uio") {
-        let name = f.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
-        let pid = name.strip_prefix("uio").and_then(|r| r.split('x').next()).and_then(|p| p.parse::<i32>().ok());
-        if pid.is_some_and(|p| !alive(p)) {
-            let _ = fs::remove_file(f);
+    if let Ok(shm) = Dir::open(Path::new(SHM_DIR)) {
+        for f in shm_files_with_prefix("uio") {
+            let name = f.file_name().unwrap_or_default();
+            let id = name.to_str().and_then(|n| n.strip_prefix("uio")).and_then(|r| r.split('_').next()).unwrap_or_default();
+            if id_pid(id).is_some_and(|p| !alive(p)) {
+                let _ = shm.remove_own_file(name);
+            }
         }
     }
     cleaned
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::run_dir::is_run_id;
+
+    #[test]
+    fn short_roots_and_run_ids_agree() {
+        // A short root's name must be a run id, or cleanup would never recognise it.
+        let id = format!("{}x0x123456", std::process::id());
+        assert!(is_run_id(&id));
+        let root = iox2_root(&Path::new("/a/very/long/runs/directory/that/is/far/too/long/for").join(&id), &id);
+        assert_eq!(root, Path::new(SHORT_ROOTS).join(&id));
+    }
 }

@@ -164,6 +164,11 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
     {
         return Err(LaunchError::BadInput(format!("{}: {what} is an external process: --mode in-process runs only built-in components", s.path.display())));
     }
+    // A runs directory that is not private (a planted symlink, another user's) is refused
+    // before any output exists: bad input, like a scenario's.
+    if opts.mode == Mode::Processes {
+        lockstep::prepare_runs_dir().map_err(|e| LaunchError::BadInput(e.to_string()))?;
+    }
     let mut cfg = configs(s, plan);
     // What the run will take of disk, memory and shared memory, before any output exists.
     budget::check(s, plan, opts, cfg.layout.len(), 1)?;
