@@ -10,7 +10,14 @@
 #   scripts/two-hosts.sh kill-agent      B's agent is killed: the run stops within 2 s
 #   scripts/two-hosts.sh cut-link        the link goes down: the run stops within 2 s
 #   scripts/two-hosts.sh kill-local      the controller is killed on A: B removes its side too
+#   scripts/two-hosts.sh refused         peers without the user's credentials are kept out
+#   scripts/two-hosts.sh attacks         a peer with the user's own launcher credential, during
+#                                        a run, cannot read, forge, intercept or exhaust it
+#   scripts/two-hosts.sh concurrent      two runs at once through one agent
+#   scripts/two-hosts.sh insecure        plain TCP: refused unless the agent says --insecure
 #
+# Links are mutual TLS with credentials made by `launcher agent init` (one CA; the agent's and
+# the launcher's certificates), except in the insecure case.
 # Each case checks its own outcome and that neither host keeps a process, a run directory or a
 # shared-memory file; it prints "ok <case>: …" and exits 0, or says why and exits 1. Without
 # root or `ip netns` it prints "skipped: …" and exits 77.
@@ -19,7 +26,9 @@ case_name="${1:-run}"
 repo="$(cd "$(dirname "$0")/.." && pwd)"
 bin="${CARGO_TARGET_DIR:-$repo/target}/release"
 launcher="$bin/launcher"
+intruder="$bin/examples/intruder"
 [ -x "$launcher" ] && [ -x "$bin/uio-bridge" ] || { echo "two-hosts: build first (cargo build --release --workspace)"; exit 1; }
+case "$case_name" in refused|attacks) [ -x "$intruder" ] || { echo "two-hosts: build the intruder first (cargo build --release -p bridge --examples)"; exit 1; } ;; esac
 
 if [ "$(id -u)" -ne 0 ] || ! command -v ip >/dev/null || ! ip netns list >/dev/null 2>&1; then
   echo "skipped: network namespaces need root and iproute2's ip netns"; exit 77
@@ -31,6 +40,7 @@ work="$(mktemp -d /tmp/uio2h.XXXXXX)"
 agent_pid=""
 cleanup() {
   [ -n "$agent_pid" ] && kill -KILL "$agent_pid" 2>/dev/null || true
+  [ -n "${KEEP:-}" ] && cp -r "$work" "$KEEP" 2>/dev/null || true
   for ns in "$nsa" "$nsb"; do
     for p in $(ip netns pids "$ns" 2>/dev/null); do kill -KILL "$p" 2>/dev/null || true; done
   done
@@ -46,14 +56,26 @@ ip link set "$va" netns "$nsa"; ip link set "$vb" netns "$nsb"
 ip -n "$nsa" addr add 10.77.0.1/30 dev "$va"; ip -n "$nsb" addr add 10.77.0.2/30 dev "$vb"
 for ns in "$nsa" "$nsb"; do ip -n "$ns" link set lo up; done
 ip -n "$nsa" link set "$va" up; ip -n "$nsb" link set "$vb" up
-endpoint="tcp/10.77.0.2:7447"
-mkdir -p "$work/a" "$work/b" "$work/out1" "$work/out2"
+endpoint="${TWO_HOSTS_ENDPOINT:-quic/10.77.0.2:7447}"
+[ "$case_name" = insecure ] && endpoint="tcp/10.77.0.2:7447"
+mkdir -p -m 700 "$work/a" "$work/b" "$work/out1" "$work/out2" "$work/out3"
+# The user's credentials (both hosts read the same directory here), and another CA's.
+export UIO_CREDENTIALS="$work/cred"
+"$launcher" agent init >/dev/null || { echo "two-hosts: agent init failed"; exit 1; }
+"$launcher" agent init --dir "$work/other" >/dev/null
 shm_before="$(ls /dev/shm | sort)"
 
-fail() { echo "two-hosts $case_name: $*"; [ -f "$work/launcher.err" ] && tail -3 "$work/launcher.err"; [ -f "$work/agent.err" ] && tail -3 "$work/agent.err"; exit 1; }
+fail() { echo "two-hosts $case_name: $*"; for f in "$work/launcher.err" "$work"/out*/launcher.err; do [ -f "$f" ] && tail -3 "$f"; done; [ -f "$work/agent.err" ] && tail -3 "$work/agent.err"; exit 1; }
 
 # The agent on B: listens on B's address only.
-ip netns exec "$nsb" env UIO_RUNS_DIR="$work/b" "$launcher" agent --host rig --listen "$endpoint" 2>"$work/agent.err" &
+agent_args=(--host rig --listen "$endpoint" --max-workers 8)
+if [ "$case_name" = insecure ]; then
+  # Plain TCP without --insecure is refused before anything listens.
+  rc=0; "$launcher" agent "${agent_args[@]}" 2>"$work/refusal.err" || rc=$?
+  [ "$rc" -eq 2 ] && grep -q "add --insecure" "$work/refusal.err" || { echo "two-hosts insecure: plain TCP without --insecure exited $rc: $(cat "$work/refusal.err")"; exit 1; }
+  agent_args+=(--insecure)
+fi
+ip netns exec "$nsb" env UIO_RUNS_DIR="$work/b" RUST_LOG="${AGENT_LOG:-error}" "$launcher" agent "${agent_args[@]}" >"$work/agent.out" 2>"$work/agent.err" &
 agent_pid=$!
 disown "$agent_pid"
 # It says so once its token and its queryable are declared.
@@ -62,8 +84,8 @@ for _ in $(seq 100); do
   sleep 0.05
 done
 grep -q "listening on" "$work/agent.err" || fail "the agent did not start"
-ip netns exec "$nsb" ss -ltn | grep -q '10.77.0.2:7447' || fail "the agent is not listening on $endpoint"
-listeners="$(ip netns exec "$nsb" ss -ltnH | awk '{print $4}' | sort -u | tr '\n' ' ')"
+ip netns exec "$nsb" ss -ltnuH | grep -q '10.77.0.2:7447' || fail "the agent is not listening on $endpoint"
+listeners="$(ip netns exec "$nsb" ss -ltnuH | awk '{print $1 " " $5}' | sort -u | tr '\n' ' ')"
 
 # The scenario: seed 002 with its plant and its Luenberger observer on B (two components there,
 # one reading the other), the UIO and the controller on A.
@@ -72,6 +94,8 @@ scenario() {  # $1: duration, s
     | sed -e '/^\[plant\]/a host = "rig"' -e '/^kind = "luenberger"/a host = "rig"'
   printf '\n[hosts]\nrig = "%s"\n' "$endpoint"
 }
+# Without its [expect] table, for runs too short for it.
+bare() { sed '/^\[expect\]/,/^\[hosts\]/{/^\[hosts\]/!d}'; }
 single() {  # the same scenario on one host
   sed -e "s/^duration = .*/duration = $1/" -e '0,/^name = .*/s//name = "two-hosts"/' "$repo/scenarios/seed002-sine.toml"
 }
@@ -90,6 +114,19 @@ check_clean() {
 }
 
 now() { date +%s.%N; }
+
+# The intruder on A, with the given credentials.
+mine=(--ca "$work/cred/ca.pem" --cert "$work/cred/launcher.pem" --key "$work/cred/launcher.key")
+other=(--ca "$work/other/ca.pem" --cert "$work/other/launcher.pem" --key "$work/other/launcher.key")
+intrude() { ip netns exec "$nsa" "$intruder" "$@"; }
+
+# A run on A in the background: $1 its scenario, $2 its output folder, $3.. more arguments;
+# its pid in $started.
+start_run() {
+  local toml="$1" out="$2"; shift 2
+  ip netns exec "$nsa" env UIO_RUNS_DIR="$work/a" RUST_LOG="${AGENT_LOG:-error}" "$launcher" run "$toml" --out "$out" --force "$@" >"$out/launcher.out" 2>"$out/launcher.err" &
+  started=$!
+}
 
 case "$case_name" in
   run)
@@ -146,5 +183,107 @@ case "$case_name" in
     check_clean
     echo "ok $case_name: stopped in $took s: $why"
     ;;
-  *) echo "usage: $0 run|kill-component|kill-agent|cut-link|kill-local"; exit 2 ;;
+  insecure)
+    scenario 2.0 | bare > "$work/two.toml"; single 2.0 | bare > "$work/one.toml"
+    ip netns exec "$nsa" env UIO_RUNS_DIR="$work/a" "$launcher" run "$work/two.toml" --out "$work/out2" --force >"$work/launcher.out" 2>"$work/launcher.err" || fail "the --insecure TCP run failed"
+    "$launcher" run "$work/one.toml" --out "$work/out1" --force >/dev/null 2>&1 || fail "the single-host run failed"
+    "$launcher" compare "$work/out1/two-hosts.rrd" "$work/out2/two-hosts.rrd" >"$work/compare.out" 2>&1 || fail "$(cat "$work/compare.out")"
+    check_clean
+    echo "ok insecure: without --insecure: $(head -1 "$work/refusal.err"); with it: $(cat "$work/compare.out")"
+    ;;
+  refused)
+    anon="$(intrude --ca "$work/cred/ca.pem" "$endpoint" open)"
+    foreign="$(intrude "${other[@]}" "$endpoint" open)"
+    plain="$(intrude "tcp/${endpoint#*/}" open)"
+    tls="$(intrude "${mine[@]}" "tls/${endpoint#*/}" open)"
+    for r in "$anon" "$foreign" "$plain" "$tls"; do [[ "$r" == refused* ]] || fail "a peer without the user's credentials got in: $r"; done
+    # The launcher with another CA's credentials cannot reach the agent; with its own it runs.
+    scenario 2.0 | bare > "$work/two.toml"
+    rc=0; ip netns exec "$nsa" env UIO_RUNS_DIR="$work/a" UIO_CREDENTIALS="$work/other" "$launcher" run "$work/two.toml" --out "$work/out2" --force >/dev/null 2>"$work/foreign.err" || rc=$?
+    [ "$rc" -eq 3 ] && grep -q "cannot reach its agent" "$work/foreign.err" || fail "a launcher with another CA's certificate: exit $rc: $(tail -2 "$work/foreign.err")"
+    ip netns exec "$nsa" env UIO_RUNS_DIR="$work/a" "$launcher" run "$work/two.toml" --out "$work/out2" --force >/dev/null 2>"$work/launcher.err" || fail "the agent no longer serves its own launcher"
+    check_clean
+    echo "ok refused: no certificate: $anon; another CA's: $foreign; plain TCP: $plain; tls/ with the right certificate: $tls; launcher with another CA's: $(grep -m1 'cannot reach' "$work/foreign.err")"
+    ;;
+  attacks)
+    # A paced run (40 s) that every attack below happens during; its recording must come out as
+    # a single-host run's, bit for bit.
+    scenario 40.0 | bare > "$work/two.toml"; single 40.0 | bare > "$work/one.toml"
+    start_run "$work/two.toml" "$work/out2" --realtime; run_pid=$started
+    for _ in $(seq 200); do grep -q "worker for plant: this host" "$work/agent.err" 2>/dev/null && break; sleep 0.05; done
+    sleep 0.5
+    # 1. Subscribing to everything is refused; to a run's outputs gives only sealed bytes.
+    all="$(intrude "${mine[@]}" "$endpoint" listen 'uio/**' 1.5)"
+    outs="$(intrude "${mine[@]}" "$endpoint" listen 'uio/run/*/c/*/out' 1.5)"
+    [[ "$all" == "received 0 "* ]] || fail "a subscriber to uio/** got: $all"
+    read -r _ n _ plain _ key <<<"$outs"
+    [ "$n" -gt 0 ] && [ "$plain" -eq 0 ] || fail "a run's outputs as another launcher sees them: $outs"
+    run="$(echo "$key" | cut -d/ -f3)"
+    # 2. Forged inputs for the plant and a forged status: refused, the run goes on.
+    forged_in="$(intrude "${mine[@]}" "$endpoint" put "uio/run/$run/c/plant/in/controller" 300 1)"
+    forged_status="$(intrude "${mine[@]}" "$endpoint" put "uio/run/$run/c/plant/status" 5 0)"
+    # 3. A start request for run '**', and one for the running run's plant: refused by name.
+    cp "$(ls -d "$work"/a/*/ | head -1)plant.json" "$work/plant.json"
+    wild="$(intrude "${mine[@]}" "$endpoint" start rig '**' "$work/plant.json")"
+    again="$(intrude "${mine[@]}" "$endpoint" start rig "$run" "$work/plant.json")"
+    [[ "$wild" == "reply err: "*"not a run id"* ]] || fail "a start for run '**': $wild"
+    [[ "$again" == "reply err: "*"already has"* ]] || fail "a second start for the running plant: $again"
+    # 4. A queryable that would intercept start requests: refused, so it sees none.
+    intrude "${mine[@]}" "$endpoint" queryable 'uio/agent/rig/start' 2 >"$work/queryable.out" &
+    qpid=$!
+    sleep 0.5
+    after="$(intrude "${mine[@]}" "$endpoint" start rig 'x' "$work/plant.json")"
+    wait "$qpid"
+    [ "$(cat "$work/queryable.out")" = "intercepted 0" ] || fail "a queryable on the agent's key: $(cat "$work/queryable.out")"
+    # 5. One 200 MB query: dropped (the limit is 128 MiB); the agent stays small.
+    big="$(intrude "${mine[@]}" "$endpoint" big rig 200)"
+    rss_kb="$(awk '/VmRSS/ {print $2}' "/proc/$agent_pid/status")"
+    [ "$rss_kb" -lt 262144 ] || fail "the agent holds $rss_kb kB after a 200 MB query"
+    # 6. Twenty start requests: at most --max-workers (8) components at once.
+    for i in $(seq 20); do intrude "${mine[@]}" "$endpoint" start rig "flood$i" "$work/plant.json"; done >"$work/flood.out"
+    workers="$(ip netns pids "$nsb" | xargs -r ps -o args= -p | grep -c 'uio-bridge worker' || true)"
+    [ "$workers" -le 8 ] || fail "$workers workers after a flood of start requests (the limit is 8)"
+    grep -q "already has" "$work/flood.out" && fail "unexpected: $(cat "$work/flood.out")"
+    refused_flood="$(grep -c 'runs 8 components already' "$work/flood.out" || true)"
+    [ "$refused_flood" -ge 12 ] || fail "only $refused_flood of 20 start requests refused at the limit: $(sort "$work/flood.out" | uniq -c)"
+    sleep 5.5  # the flood's workers give up waiting for proxies that never come (5 s)
+    # 7. 200 peers that open a connection and say nothing more (junk QUIC datagrams from 200
+    # ports, again and again): a second run started meanwhile still gets through.
+    ip netns exec "$nsa" python3 -c '
+import os, socket, time
+s = [socket.socket(socket.AF_INET, socket.SOCK_DGRAM) for _ in range(200)]
+end = time.time() + 6
+while time.time() < end:
+    for x in s: x.sendto(bytes([0xc3]) + os.urandom(1199), ("10.77.0.2", 7447))
+    time.sleep(0.05)' >"$work/idle.out" &
+    idle_pid=$!
+    sleep 1
+    scenario 1.0 | bare | sed '0,/^name = .*/s//name = "during-flood"/' > "$work/flood.toml"
+    rc=0; ip netns exec "$nsa" env UIO_RUNS_DIR="$work/a" "$launcher" run "$work/flood.toml" --out "$work/out3" --force >/dev/null 2>"$work/flood-run.err" || rc=$?
+    kill "$idle_pid" 2>/dev/null || true; wait "$idle_pid" 2>/dev/null || true
+    kill -0 "$run_pid" 2>/dev/null || fail "the attacked run ended before the last attack"
+    [ "$rc" -eq 0 ] || fail "a run during 200 junk peers exited $rc: $(tail -2 "$work/flood-run.err")"
+    rc=0; wait "$run_pid" || rc=$?
+    [ "$rc" -eq 0 ] || { tail -3 "$work/out2/launcher.err"; fail "the attacked run exited $rc"; }
+    "$launcher" run "$work/one.toml" --out "$work/out1" --force >/dev/null 2>&1 || fail "the single-host run failed"
+    "$launcher" compare "$work/out1/two-hosts.rrd" "$work/out2/two-hosts.rrd" >"$work/compare.out" 2>&1 || fail "the attacked run differs: $(cat "$work/compare.out")"
+    check_clean
+    ignored="$(grep -c 'ignored a message' "$work/agent.err" || true)"
+    echo "ok attacks: uio/**: $all; outputs: $outs; forged: $forged_in, $forged_status (ignored-message reports on B: $ignored); start '**': $wild; start again: $again; queryable: $(cat "$work/queryable.out") (start meanwhile: $after); 200 MB query: $big, agent RSS $((rss_kb / 1024)) MB; flood of 20 starts: $refused_flood refused, $workers workers; during 200 junk QUIC peers a run passed; the attacked run: $(cat "$work/compare.out")"
+    ;;
+  concurrent)
+    scenario 10.0 | bare > "$work/two.toml"
+    scenario 10.0 | bare | sed '0,/^name = .*/s//name = "two-hosts-b"/' > "$work/two-b.toml"
+    start_run "$work/two.toml" "$work/out2"; p1=$started
+    start_run "$work/two-b.toml" "$work/out3" --wait block; p2=$started
+    r1=0; wait "$p1" || r1=$?
+    r2=0; wait "$p2" || r2=$?
+    [ "$r1" -eq 0 ] && [ "$r2" -eq 0 ] || fail "two runs at once exited $r1 and $r2: $(tail -2 "$work/out2/launcher.err") / $(tail -2 "$work/out3/launcher.err")"
+    single 10.0 | bare > "$work/one.toml"
+    "$launcher" run "$work/one.toml" --out "$work/out1" --force >/dev/null 2>&1 || fail "the single-host run failed"
+    "$launcher" compare "$work/out1/two-hosts.rrd" "$work/out2/two-hosts.rrd" >"$work/compare.out" 2>&1 || fail "run A differs: $(cat "$work/compare.out")"
+    check_clean
+    echo "ok concurrent: both runs passed (A: the default wait, B: --wait block); run A: $(cat "$work/compare.out")"
+    ;;
+  *) echo "usage: $0 run|kill-component|kill-agent|cut-link|kill-local|refused|attacks|concurrent|insecure"; exit 2 ;;
 esac

@@ -49,10 +49,31 @@ pub fn alive(run: &str, name: &str, side: &str) -> String {
     format!("uio/run/{run}/c/{name}/{side}")
 }
 
+/// 1–64 letters, digits, `-` and `_`: one key chunk, never a wildcard or a separator.
+fn chunk(s: &str) -> bool {
+    !s.is_empty() && s.len() <= 64 && s.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+}
+
 /// A host name is one key chunk: letters, digits, `-` and `_`.
 pub fn check_host(host: &str) -> Result<(), String> {
-    if host.is_empty() || host.len() > 64 || !host.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_') {
+    if !chunk(host) {
         return Err(format!("'{}' is not a host name (1–64 letters, digits, - and _)", host.escape_debug()));
+    }
+    Ok(())
+}
+
+/// A component's name is one key chunk (as scenario names are).
+pub fn check_component(name: &str) -> Result<(), String> {
+    if !chunk(name) {
+        return Err(format!("'{}' is not a component name (1–64 letters, digits, - and _)", name.escape_debug()));
+    }
+    Ok(())
+}
+
+/// A run id is what `RunSpace` makes: 1–64 letters and digits.
+pub fn check_run(run: &str) -> Result<(), String> {
+    if run.is_empty() || run.len() > 64 || !run.chars().all(|c| c.is_ascii_alphanumeric()) {
+        return Err(format!("'{}' is not a run id (1–64 letters and digits)", run.escape_debug()));
     }
     Ok(())
 }

@@ -12,9 +12,12 @@ use zenoh::sample::SampleKind;
 use zenoh::Wait as _;
 
 use crate::clock::{estimate, Offset};
+use crate::credentials::{self, Side};
 use crate::keys;
-use crate::pump::{publisher, Exports, Idle, Imports};
-use crate::session::{open, Role};
+use crate::pump::{Exports, Idle, Imports};
+use crate::seal::Secret;
+use crate::sealed::{SealedPublisher, SealedSubscriber};
+use crate::session::{open, secured, Role, MAX_MESSAGE};
 
 /// What the agent is asked to start.
 #[derive(serde::Serialize, serde::Deserialize)]
@@ -25,6 +28,8 @@ pub struct StartRequest {
     pub builtin: String,
     /// The component's configuration, as the launcher wrote it.
     pub config: String,
+    /// The secret that seals this component's messages ([`crate::seal`]), hex.
+    pub secret: String,
 }
 
 /// Exit code for everything that is not the component's own exit.
@@ -50,18 +55,23 @@ fn proxy(host: &str, connect: &str, builtin: &str) -> Result<i32, String> {
     let space = RunSpace::open(&cfg.run).map_err(|e| e.to_string())?;
     let bus = Bus::join(&space, &format!("bridge-{}", cfg.name), wait).map_err(|e| e.to_string())?;
 
-    let z = open(Role::Client { connect }).map_err(|e| format!("cannot reach its agent at {e}"))?;
+    let tls = if secured(connect) { Some(credentials::load(&credentials::default_dir(), Side::Launcher)?) } else { None };
+    let z = connect_to(connect, tls.as_ref())?;
     wait_for_agent(&z, host, connect)?;
     let (run, name) = (cfg.run.as_str(), cfg.name.as_str());
+    let secret = Secret::draw()?;
     let _token = z.liveliness().declare_token(keys::alive(run, name, "proxy")).wait().map_err(|e| e.to_string())?;
     let worker = z.liveliness().declare_subscriber(keys::alive(run, name, "worker")).wait().map_err(|e| e.to_string())?;
-    let status = z.declare_subscriber(keys::status(run, name)).wait().map_err(|e| e.to_string())?;
-    let go = publisher(&z, keys::go(run, name))?;
-    let mut imports = Imports::new(&bus, &z, &[(cfg.publishes.service.clone(), cfg.publishes.len, keys::from_component(run, name))])?;
+    let mut status = SealedSubscriber::new(&z, &secret, keys::status(run, name))?;
+    let mut go = SealedPublisher::new(&z, &secret, keys::go(run, name))?;
+    let mut imports = Imports::new(&bus, &z, &secret, &[(cfg.publishes.service.clone(), cfg.publishes.len, keys::from_component(run, name))])?;
     let reads: Vec<(String, String)> = cfg.reads.iter().map(|r| (r.service.clone(), keys::to_component(run, name, &r.service))).collect();
-    let mut exports = Exports::new(&bus, &z, &reads)?;
+    let mut exports = Exports::new(&bus, &z, &secret, &reads)?;
 
-    let request = serde_json::to_string(&StartRequest { run: run.to_string(), builtin: builtin.to_string(), config: text.clone() }).expect("serialises");
+    let request = serde_json::to_string(&StartRequest { run: run.to_string(), builtin: builtin.to_string(), config: text.clone(), secret: secret.to_hex() }).expect("serialises");
+    if request.len() > MAX_MESSAGE {
+        return Err(format!("{name}'s configuration is {} bytes; a start request carries at most {MAX_MESSAGE}", request.len()));
+    }
     let replies = z.get(keys::start(host)).payload(request).timeout(Duration::from_secs(10)).wait().map_err(|e| e.to_string())?;
     match replies.recv() {
         Ok(reply) => {
@@ -79,8 +89,7 @@ fn proxy(host: &str, connect: &str, builtin: &str) -> Result<i32, String> {
         {
             return Err(format!("its worker for {name} stopped before the component was ready"));
         }
-        if let Ok(Some(s)) = status.try_recv() {
-            let line = s.payload().try_to_string().unwrap_or_default().to_string();
+        if let Some(line) = status.try_recv_text() {
             if line == "ready" {
                 break;
             }
@@ -92,10 +101,10 @@ fn proxy(host: &str, connect: &str, builtin: &str) -> Result<i32, String> {
         std::thread::sleep(Duration::from_millis(2));
     }
     // The hosts' clocks, before the run: the worker's samples then carry this host's times.
-    let offset = probe_clock(&z, run, name)?;
+    let offset = probe_clock(&z, &secret, run, name)?;
     imports.shift_ns = -offset.theta_ns;
     lockstep::ready_then_wait_for_go().map_err(|e| e.to_string())?;
-    go.put(format!("go {} {}", offset.theta_ns, offset.rtt_ns)).wait().map_err(|e| e.to_string())?;
+    go.put(format!("go {} {}", offset.theta_ns, offset.rtt_ns).as_bytes())?;
 
     let mut idle = Idle::new();
     loop {
@@ -105,8 +114,7 @@ fn proxy(host: &str, connect: &str, builtin: &str) -> Result<i32, String> {
         {
             return Err(format!("lost its agent while {name} ran (the link was cut, or the agent or the host stopped)"));
         }
-        if let Ok(Some(s)) = status.try_recv() {
-            let line = s.payload().try_to_string().unwrap_or_default().to_string();
+        if let Some(line) = status.try_recv_text() {
             return finish(name, host, &line, &mut imports);
         }
         idle.after(worked);
@@ -152,19 +160,32 @@ fn wait_for_agent(z: &zenoh::Session, host: &str, connect: &str) -> Result<(), S
     }
 }
 
+/// Opens the client session to the agent. A flood of idle connections can hold the agent's
+/// handshake slots for up to its accept timeout: the session is retried for 10 s before the
+/// agent is called unreachable.
+fn connect_to(connect: &str, tls: Option<&credentials::Credentials>) -> Result<zenoh::Session, String> {
+    let deadline = Instant::now() + Duration::from_secs(10);
+    loop {
+        match open(Role::Client { connect }, tls) {
+            Ok(z) => return Ok(z),
+            Err(e) if Instant::now() >= deadline => return Err(format!("cannot reach its agent at {e}")),
+            Err(_) => std::thread::sleep(Duration::from_millis(250)),
+        }
+    }
+}
+
 /// Round trips with the worker ([`crate::clock`]): 16 exchanges, the shortest one's offset.
-fn probe_clock(z: &zenoh::Session, run: &str, name: &str) -> Result<Offset, String> {
-    let pongs = z.declare_subscriber(keys::pong(run, name)).wait().map_err(|e| e.to_string())?;
-    let ping = publisher(z, keys::ping(run, name))?;
+fn probe_clock(z: &zenoh::Session, secret: &Secret, run: &str, name: &str) -> Result<Offset, String> {
+    let mut pongs = SealedSubscriber::new(z, secret, keys::pong(run, name))?;
+    let mut ping = SealedPublisher::new(z, secret, keys::ping(run, name))?;
     let mut exchanges = Vec::new();
     for _ in 0..16 {
         let t1 = lockstep::now_ns();
-        ping.put(t1.to_le_bytes().to_vec()).wait().map_err(|e| e.to_string())?;
+        ping.put(&t1.to_le_bytes())?;
         let deadline = Instant::now() + Duration::from_secs(1);
         while Instant::now() < deadline {
-            let Ok(Some(s)) = pongs.recv_timeout(Duration::from_millis(100)) else { continue };
+            let Some(b) = pongs.recv_timeout(Duration::from_millis(100)) else { continue };
             let t3 = lockstep::now_ns();
-            let b = s.payload().to_bytes();
             if b.len() == 16 && b[..8] == t1.to_le_bytes() {
                 exchanges.push((t1, u64::from_le_bytes(b[8..].try_into().expect("8 bytes")), t3));
                 break;

@@ -1,21 +1,20 @@
 //! The samples that cross a host boundary: [`Exports`] read local services and put them on
 //! Zenoh, [`Imports`] take them from Zenoh and publish them on the local services. Zenoh's
-//! reliable, blocking-congestion publishers and FIFO subscribers keep every sample, in order;
+//! reliable, blocking-congestion publishers and FIFO subscribers keep every sample, in order,
+//! each sealed with the run's secret ([`crate::sealed`]);
 //! the lockstep step checks of the receiving components and the launcher stay end to end.
 
 use lockstep::{Bus, Outlet, Reader};
-use zenoh::handlers::FifoChannelHandler;
-use zenoh::pubsub::{Publisher, Subscriber};
-use zenoh::qos::{CongestionControl, Priority};
-use zenoh::sample::Sample;
-use zenoh::{Session, Wait};
+use zenoh::Session;
 
 use crate::clock::shift;
+use crate::seal::Secret;
+use crate::sealed::{SealedPublisher, SealedSubscriber};
 use crate::wire::{decode, encode};
 
 /// Local services read and sent to the other host.
 pub struct Exports {
-    list: Vec<(Reader, Publisher<'static>)>,
+    list: Vec<(Reader, SealedPublisher)>,
     buf: Vec<u8>,
     /// Samples sent so far.
     pub sent: u64,
@@ -23,7 +22,7 @@ pub struct Exports {
 
 /// Samples of the other host published on local services.
 pub struct Imports {
-    list: Vec<(Subscriber<FifoChannelHandler<Sample>>, Outlet, String)>,
+    list: Vec<(SealedSubscriber, Outlet, String)>,
     values: Vec<f64>,
     /// Samples published so far.
     pub received: u64,
@@ -31,24 +30,13 @@ pub struct Imports {
     pub shift_ns: i64,
 }
 
-/// A publisher that never drops (the lockstep's no-loss rule, across the link): Zenoh's
-/// default reliable delivery, and blocking congestion control instead of dropping.
-pub fn publisher(z: &Session, key: String) -> Result<Publisher<'static>, String> {
-    z.declare_publisher(key.clone())
-        .congestion_control(CongestionControl::Block)
-        .priority(Priority::RealTime)
-        .express(true)
-        .wait()
-        .map_err(|e| format!("zenoh publisher {key}: {e}"))
-}
-
 impl Exports {
-    /// Reads each (service, key) on `bus` and sends it under its key.
-    pub fn new(bus: &Bus, z: &Session, services: &[(String, String)]) -> Result<Self, String> {
+    /// Reads each (service, key) on `bus` and sends it, sealed, under its key.
+    pub fn new(bus: &Bus, z: &Session, secret: &Secret, services: &[(String, String)]) -> Result<Self, String> {
         let mut list = Vec::new();
         for (s, key) in services {
             let reader = bus.reader(s).map_err(|e| format!("{s}: {e}"))?;
-            list.push((reader, publisher(z, key.clone())?));
+            list.push((reader, SealedPublisher::new(z, secret, key.clone())?));
         }
         Ok(Exports { list, buf: Vec::new(), sent: 0 })
     }
@@ -56,18 +44,18 @@ impl Exports {
     /// Sends what has arrived; returns how many samples.
     pub fn pump(&mut self) -> Result<usize, String> {
         let mut n = 0;
-        for (reader, publisher) in &self.list {
+        for (reader, publisher) in &mut self.list {
             let mut failed = None;
             n += reader
                 .drain_up_to(64, |h, v| {
                     encode(h, v, &mut self.buf);
-                    if let Err(e) = publisher.put(self.buf.as_slice()).wait() {
-                        failed = Some(e.to_string());
+                    if let Err(e) = publisher.put(&self.buf) {
+                        failed = Some(e);
                     }
                 })
                 .map_err(|e| e.to_string())?;
             if let Some(e) = failed {
-                return Err(format!("sending to the other host: {e}"));
+                return Err(e);
             }
         }
         self.sent += n as u64;
@@ -76,25 +64,24 @@ impl Exports {
 }
 
 impl Imports {
-    /// Publishes each (service, values per sample, key) on `bus` from its key.
-    pub fn new(bus: &Bus, z: &Session, services: &[(String, usize, String)]) -> Result<Self, String> {
+    /// Publishes each (service, values per sample, key) on `bus` from its key's sealed samples.
+    pub fn new(bus: &Bus, z: &Session, secret: &Secret, services: &[(String, usize, String)]) -> Result<Self, String> {
         let mut list = Vec::new();
         for (s, len, key) in services {
             let outlet = bus.outlet(s, *len).map_err(|e| format!("{s}: {e}"))?;
-            let sub = z.declare_subscriber(key.clone()).wait().map_err(|e| format!("zenoh subscriber {key}: {e}"))?;
-            list.push((sub, outlet, s.clone()));
+            list.push((SealedSubscriber::new(z, secret, key.clone())?, outlet, s.clone()));
         }
         Ok(Imports { list, values: Vec::new(), received: 0, shift_ns: 0 })
     }
 
-    /// Publishes what has arrived; returns how many samples. A sample of the wrong size is the
-    /// other side breaking the protocol.
+    /// Publishes what has arrived; returns how many samples. A sample of the wrong size from
+    /// the run's other side is that side breaking the protocol.
     pub fn pump(&mut self) -> Result<usize, String> {
         let mut n = 0;
-        for (sub, outlet, service) in &self.list {
+        for (sub, outlet, service) in &mut self.list {
             for _ in 0..64 {
-                let Ok(Some(sample)) = sub.try_recv() else { break };
-                let mut h = decode(&sample.payload().to_bytes(), &mut self.values).map_err(|e| format!("{service}: {e}"))?;
+                let Some(bytes) = sub.try_recv() else { break };
+                let mut h = decode(bytes, &mut self.values).map_err(|e| format!("{service}: {e}"))?;
                 h.sent_ns = shift(h.sent_ns, self.shift_ns);
                 h.taken_ns = shift(h.taken_ns, self.shift_ns);
                 if self.values.len() != outlet.len() {

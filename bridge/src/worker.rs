@@ -17,9 +17,12 @@ use lockstep::{Bus, RunSpace, Wait};
 use zenoh::sample::SampleKind;
 use zenoh::Wait as _;
 
+use crate::credentials::{self, Side};
 use crate::keys;
 use crate::proxy::StartRequest;
-use crate::pump::{publisher, Exports, Idle, Imports};
+use crate::pump::{Exports, Idle, Imports};
+use crate::seal::Secret;
+use crate::sealed::{SealedPublisher, SealedSubscriber};
 use crate::session::{open, Role};
 
 static STOP: AtomicBool = AtomicBool::new(false);
@@ -28,8 +31,9 @@ extern "C" fn on_term(_: libc::c_int) {
     STOP.store(true, Ordering::Relaxed);
 }
 
-/// Runs the worker for the request on stdin; returns the exit code.
-pub fn run(connect: &str) -> i32 {
+/// Runs the worker for the request on stdin, connecting with the agent's credentials in
+/// `credentials` (none: a plain TCP agent); returns the exit code.
+pub fn run(connect: &str, credentials: Option<&std::path::Path>) -> i32 {
     // The agent's death (SIGTERM, set by the agent at spawn) or a stop: tear down, then exit.
     // SAFETY: the handler only stores to an atomic.
     unsafe {
@@ -55,7 +59,7 @@ pub fn run(connect: &str) -> i32 {
             return 3;
         }
     };
-    let code = match serve(connect, &req, &space) {
+    let code = match serve(connect, credentials, &req, &space) {
         Ok(()) => 0,
         Err(e) => {
             eprintln!("worker for {}: {e}", req.run);
@@ -66,8 +70,12 @@ pub fn run(connect: &str) -> i32 {
     code
 }
 
-fn serve(connect: &str, req: &StartRequest, space: &RunSpace) -> Result<(), String> {
+fn serve(connect: &str, credentials: Option<&std::path::Path>, req: &StartRequest, space: &RunSpace) -> Result<(), String> {
     let mut cfg: ComponentConfig = serde_json::from_str(&req.config).map_err(|e| format!("configuration: {e}"))?;
+    keys::check_run(&req.run)?;
+    keys::check_component(&cfg.name)?;
+    let secret = Secret::from_hex(&req.secret)?;
+    let tls = credentials.map(|d| credentials::load(d, Side::Agent)).transpose()?;
     let (run, name) = (req.run.clone(), cfg.name.clone());
     let wait: Wait = cfg.wait.parse().map_err(|e| format!("wait: {e}"))?;
     // The component's world is this host's run space.
@@ -76,17 +84,17 @@ fn serve(connect: &str, req: &StartRequest, space: &RunSpace) -> Result<(), Stri
     space.write_config(&cfg.file(), &serde_json::to_string_pretty(&cfg).expect("serialises")).map_err(|e| e.to_string())?;
     let bus = Bus::join(space, "bridge", wait).map_err(|e| e.to_string())?;
 
-    let z = open(Role::Client { connect })?;
+    let z = open(Role::Client { connect }, tls.as_ref())?;
     let _token = z.liveliness().declare_token(keys::alive(&run, &name, "worker")).wait().map_err(|e| e.to_string())?;
     let proxy = z.liveliness().declare_subscriber(keys::alive(&run, &name, "proxy")).history(true).wait().map_err(|e| e.to_string())?;
-    let status = publisher(&z, keys::status(&run, &name))?;
-    let go = z.declare_subscriber(keys::go(&run, &name)).wait().map_err(|e| e.to_string())?;
-    let pings = z.declare_subscriber(keys::ping(&run, &name)).wait().map_err(|e| e.to_string())?;
-    let pong = publisher(&z, keys::pong(&run, &name))?;
+    let status = std::cell::RefCell::new(SealedPublisher::new(&z, &secret, keys::status(&run, &name))?);
+    let mut go = SealedSubscriber::new(&z, &secret, keys::go(&run, &name))?;
+    let mut pings = SealedSubscriber::new(&z, &secret, keys::ping(&run, &name))?;
+    let mut pong = SealedPublisher::new(&z, &secret, keys::pong(&run, &name))?;
     let reads: Vec<(String, usize, String)> = cfg.reads.iter().map(|r| (r.service.clone(), r.len, keys::to_component(&run, &name, &r.service))).collect();
-    let mut imports = Imports::new(&bus, &z, &reads)?;
-    let mut exports = Exports::new(&bus, &z, &[(cfg.publishes.service.clone(), keys::from_component(&run, &name))])?;
-    let report = |line: String| status.put(line).wait().map_err(|e| e.to_string());
+    let mut imports = Imports::new(&bus, &z, &secret, &reads)?;
+    let mut exports = Exports::new(&bus, &z, &secret, &[(cfg.publishes.service.clone(), keys::from_component(&run, &name))])?;
+    let report = |line: String| status.borrow_mut().put(line.as_bytes());
 
     let mut child = spawn(&req.builtin, space, &cfg, wait).inspect_err(|e| {
         let _ = report(format!("exit 3 0 {e}"));
@@ -127,19 +135,18 @@ fn serve(connect: &str, req: &StartRequest, space: &RunSpace) -> Result<(), Stri
             return Err(format!("no launcher-side proxy for {name}"));
         }
         // The proxy's clock probes: answer at once with this host's time.
-        while let Ok(Some(p)) = pings.try_recv() {
-            let mut answer = p.payload().to_bytes().to_vec();
+        while let Some(p) = pings.try_recv() {
+            let mut answer = p.to_vec();
             answer.extend(lockstep::now_ns().to_le_bytes());
-            pong.put(answer).wait().map_err(|e| e.to_string())?;
+            pong.put(&answer)?;
         }
         match phase {
             Phase::Starting if rx.try_recv().is_ok() => {
                 report("ready".into())?;
                 phase = Phase::Ready;
             }
-            Phase::Ready if let Ok(Some(g)) = go.try_recv() => {
+            Phase::Ready if let Some(text) = go.try_recv_text() => {
                 // `go <θ> <round trip>`: the launcher's host's times onto this one's.
-                let text = g.payload().try_to_string().map(|t| t.to_string()).unwrap_or_default();
                 let mut words = text.split(' ');
                 let (Some("go"), Some(Ok(theta)), Some(Ok(rtt))) = (words.next(), words.next().map(str::parse::<i64>), words.next().map(str::parse::<u64>)) else {
                     return Err(format!("{name}: a malformed go from the proxy: '{}'", text.escape_debug()));

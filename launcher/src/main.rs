@@ -136,14 +136,14 @@ enum Command {
         wait: Wait,
     },
     /// Take part in runs from another host: start the components a launcher places on this
-    /// host (`host = NAME` and `[hosts]` in its scenario). Runs `uio-bridge agent`.
+    /// host (`host = NAME` and `[hosts]` in its scenario). Runs `uio-bridge agent` with these
+    /// arguments: `agent init` makes the credentials, `agent --host NAME --listen quic/ADDR:PORT`
+    /// serves (`launcher agent --help` for all).
+    #[command(disable_help_flag = true)]
     Agent {
-        /// This host's name, as the scenarios' `[hosts]` tables call it.
-        #[arg(long)]
-        host: String,
-        /// The one Zenoh endpoint to listen on, e.g. tcp/10.0.0.2:7447 (never a wildcard by default).
-        #[arg(long)]
-        listen: String,
+        /// Passed to `uio-bridge agent`.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
     },
     /// List the shipped scenarios.
     List {
@@ -382,10 +382,10 @@ fn main() -> ExitCode {
                 Err(e) => fail(&e),
             }
         }
-        Command::Agent { host, listen } => {
+        Command::Agent { args } => {
             use std::os::unix::process::CommandExt;
             let bridge = launcher::run::bridge_path();
-            let e = std::process::Command::new(&bridge).args(["agent", "--host", &host, "--listen", &listen]).exec();
+            let e = std::process::Command::new(&bridge).arg("agent").args(&args).exec();
             eprintln!("error: cannot run {}: {e} (build it with `cargo build --release --workspace`)", bridge.display());
             ExitCode::from(3)
         }

@@ -34,8 +34,8 @@ fn parse(host_line: &str, tail: &str) -> Result<Scenario, String> {
 
 #[test]
 fn a_plant_on_a_named_host() {
-    let s = parse("host = \"rig\"", "[hosts]\nrig = \"tcp/10.77.0.2:7447\"\n").unwrap();
-    assert_eq!(s.remote.get("plant"), Some(&Remote { host: "rig".into(), endpoint: "tcp/10.77.0.2:7447".into() }));
+    let s = parse("host = \"rig\"", "[hosts]\nrig = \"quic/10.77.0.2:7447\"\n").unwrap();
+    assert_eq!(s.remote.get("plant"), Some(&Remote { host: "rig".into(), endpoint: "quic/10.77.0.2:7447".into() }));
     assert!(!s.remote.contains_key("luenberger"));
     assert!(parse("", "").unwrap().remote.is_empty());
 }
@@ -44,7 +44,7 @@ fn a_plant_on_a_named_host() {
 fn bad_placements_are_named() {
     let unknown = parse("host = \"rig\"", "").unwrap_err();
     assert!(unknown.contains("plant.host") && unknown.contains("'rig' is not in [hosts]"), "{unknown}");
-    for (endpoint, why) in [("udp/10.0.0.1:7447", "tcp/"), ("tcp/10.0.0.1", "port"), ("tcp/0.0.0.0:7447", "wildcard"), ("tcp/:7447", "missing")] {
+    for (endpoint, why) in [("udp/10.0.0.1:7447", "quic/"), ("tcp/10.0.0.1", "port"), ("quic/0.0.0.0:7447", "wildcard"), ("tcp/:7447", "missing"), ("tls/10.0.0.1:7447", "use quic/")] {
         let e = parse("host = \"rig\"", &format!("[hosts]\nrig = \"{endpoint}\"\n")).unwrap_err();
         assert!(e.contains("hosts.rig") && e.contains(why), "{endpoint}: {e}");
     }

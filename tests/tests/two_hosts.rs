@@ -5,7 +5,15 @@
 //! - a killed plant, a killed agent and a cut link each stop the run within 2 s, naming a
 //!   component on the other host;
 //! - a killed local controller stops the other host's side too;
-//! - nothing is left in either namespace.
+//! - nothing is left in either namespace;
+//! - links are mutual TLS: a peer without a certificate, with another CA's, or on plain TCP is
+//!   refused, and so is a launcher with another CA's credentials;
+//! - a peer with the user's own launcher credential, during a run, cannot subscribe to `uio/**`,
+//!   reads only sealed bytes, cannot forge inputs or a status, start run `**` or the running
+//!   plant again, intercept start requests, exhaust the agent with a 200 MB query or 20 start
+//!   requests, or keep a second run out with 200 idle connections — and the run's recording
+//!   equals a single-host run's;
+//! - two runs at once through one agent both pass; plain TCP only with `--insecure`.
 //!
 //! Where network namespaces are not allowed the script says "skipped" (exit 77), and so does this
 //! test.
@@ -34,7 +42,7 @@ fn case(name: &str) {
 // two cores with the runs.
 #[test]
 fn two_hosts() {
-    for c in ["run", "kill-component", "kill-agent", "cut-link", "kill-local"] {
+    for c in ["run", "kill-component", "kill-agent", "cut-link", "kill-local", "refused", "attacks", "concurrent", "insecure"] {
         case(c);
     }
 }
