@@ -74,6 +74,8 @@ if [ "$case_name" = insecure ]; then
   rc=0; "$launcher" agent "${agent_args[@]}" 2>"$work/refusal.err" || rc=$?
   [ "$rc" -eq 2 ] && grep -q "add --insecure" "$work/refusal.err" || { echo "two-hosts insecure: plain TCP without --insecure exited $rc: $(cat "$work/refusal.err")"; exit 1; }
   agent_args+=(--insecure)
+elif [ "${endpoint%%/*}" = tcp ]; then
+  agent_args+=(--insecure)  # TWO_HOSTS_ENDPOINT=tcp/…: the same cases over plain TCP, to compare
 fi
 ip netns exec "$nsb" env UIO_RUNS_DIR="$work/b" RUST_LOG="${AGENT_LOG:-error}" "$launcher" agent "${agent_args[@]}" >"$work/agent.out" 2>"$work/agent.err" &
 agent_pid=$!

@@ -234,6 +234,21 @@ def test_a_parent_that_is_not_the_launcher_exits_2(run_space):
     assert "is not the launcher of run" in stderr and len(stderr.strip().splitlines()) == 1
 
 
+def test_a_fifo_or_symlink_as_owner_pid_is_refused_without_blocking(run_space):
+    # Issue 19: a planted FIFO made readers hang in open(); a symlink could point anywhere.
+    owner = os.path.join(run_space["dir"], "owner.pid")
+    elsewhere = os.path.join(run_space["dir"], "elsewhere")
+    with open(elsewhere, "w") as f:
+        f.write(f"{os.getpid()}\n")
+    for plant in (lambda: os.mkfifo(owner), lambda: os.symlink(elsewhere, owner)):
+        os.remove(owner)
+        plant()
+        t0 = time.monotonic()
+        code, _, stderr = start_echo(run_space).finish()
+        assert time.monotonic() - t0 < 10
+        assert code == 2 and "owner.pid is missing or not a regular file" in stderr, stderr
+
+
 def test_a_configuration_of_another_version_exits_2(run_space):
     cfg = base_config(run_space, "echo", "observer", {"service": "observer/echo", "len": 4},
                       [{"service": "plant", "len": 10}], 1)

@@ -14,6 +14,7 @@ import math
 import os
 import re
 import signal
+import stat
 import sys
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Tuple
@@ -29,8 +30,36 @@ EXIT_USAGE = 2
 EXIT_FAILED = 3
 EXIT_DIVERGED = 4
 
-#: Where run directories live when `$UIO_RUNS_DIR` is not set.
+#: Where run directories live when `$UIO_RUNS_DIR` is not set and there is no usable
+#: `$XDG_RUNTIME_DIR` (the launcher's rule: see `default_runs_dir`).
 DEFAULT_RUNS_DIR = "/tmp/uio-observers"
+
+
+def default_runs_dir(env):
+    """`$XDG_RUNTIME_DIR/uio-observers` when that is an absolute real directory of ours, else
+    `DEFAULT_RUNS_DIR` — the launcher's own rule (lockstep's run_dir.rs)."""
+    xdg = env.get("XDG_RUNTIME_DIR")
+    if xdg and os.path.isabs(xdg):
+        try:
+            st = os.lstat(xdg)
+            if stat.S_ISDIR(st.st_mode) and st.st_uid == os.geteuid():
+                return os.path.join(xdg, "uio-observers")
+        except OSError:
+            pass
+    return DEFAULT_RUNS_DIR
+
+
+def read_owner(path):
+    """The pid in a run's `owner.pid`, opened without following a symlink and without blocking
+    (a FIFO planted there is refused, not waited on); only a regular file of ours counts."""
+    fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode) or st.st_uid != os.geteuid():
+            raise ValueError("not a regular file of this user")
+        return int(os.read(fd, 64).decode("ascii").strip())
+    finally:
+        os.close(fd)
 
 
 class ComponentExit(Exception):
@@ -275,12 +304,11 @@ def launch(environ: Optional[Dict[str, str]] = None) -> Config:
         raise ComponentExit(EXIT_USAGE, f"{how} (UIO_RUN or UIO_CONFIG is not set)")
     if not re.fullmatch(r"[A-Za-z0-9]+", run):
         raise ComponentExit(EXIT_USAGE, f"{how} (run id {run!r} is not letters and digits)")
-    owner_file = os.path.join(env.get("UIO_RUNS_DIR") or DEFAULT_RUNS_DIR, run, "owner.pid")
+    owner_file = os.path.join(env.get("UIO_RUNS_DIR") or default_runs_dir(env), run, "owner.pid")
     try:
-        with open(owner_file, encoding="ascii") as f:
-            owner = int(f.read().strip())
+        owner = read_owner(owner_file)
     except (OSError, ValueError):
-        raise ComponentExit(EXIT_USAGE, f"{how} (no run '{run}': {owner_file} is missing)") from None
+        raise ComponentExit(EXIT_USAGE, f"{how} (no run '{run}': {owner_file} is missing or not a regular file of this user)") from None
     parent = os.getppid()
     if parent != owner:
         raise ComponentExit(EXIT_USAGE, f"{how} (its parent, pid {parent}, is not the launcher of run '{run}')")

@@ -196,6 +196,19 @@ fn mount_tmpfs(dir: &std::path::Path, size: &str) -> Result<(), String> {
     }
 }
 
+/// Fills the file system of `dir` with one file until `leave` bytes are free.
+fn fill(dir: &std::path::Path, leave: u64) {
+    let c = std::ffi::CString::new(dir.as_os_str().as_encoded_bytes()).unwrap();
+    // SAFETY: statvfs writes into the struct we own.
+    let mut st: libc::statvfs = unsafe { std::mem::zeroed() };
+    assert_eq!(unsafe { libc::statvfs(c.as_ptr(), &mut st) }, 0);
+    let free = st.f_bavail as u64 * st.f_frsize as u64;
+    let f = std::fs::File::create(dir.join("filler")).unwrap();
+    use std::os::fd::AsRawFd;
+    // SAFETY: allocates blocks for our own open file.
+    assert_eq!(unsafe { libc::posix_fallocate(f.as_raw_fd(), 0, free.saturating_sub(leave) as libc::off_t) }, 0);
+}
+
 /// Issue 10, item 21: a full disk stops the run cleanly, naming the file and saying what of
 /// the recording was kept.
 #[test]
@@ -205,16 +218,22 @@ fn a_full_disk_stops_the_run_and_says_what_was_kept() {
         eprintln!("skipped: mounting a tmpfs needs root");
         return;
     }
-    // 200 kB holds no whole step (the partial file is removed), 3 MB a few thousand (kept).
-    for (mode, size) in [("processes", "200k"), ("in-process", "200k"), ("processes", "3m"), ("in-process", "3m")] {
+    // The run's recording must fit the disk when it starts (the launcher refuses one that
+    // cannot, exit 2), so the disk fills while it runs: a 128 MB tmpfs, a paced run, and after
+    // 0.7 s — before its first batch of 4096 steps reaches the file — a filler leaves 200 kB
+    // (no whole step: the partial file is removed) or 3 MB (a few thousand steps: kept).
+    for (mode, leave) in [("processes", 200u64 << 10), ("in-process", 200 << 10), ("processes", 3 << 20), ("in-process", 3 << 20)] {
+        let size = if leave < 1 << 20 { "200k" } else { "3m" };
         let s = Scratch::new(&format!("disk-full-{mode}-{size}"));
         let full = s.join("full");
-        if let Err(why) = mount_tmpfs(&full, size) {
+        if let Err(why) = mount_tmpfs(&full, "128m") {
             panic!("{mode}, {size}: {why}");
         }
         let path = long_scenario(&s, 60);
-        let child = launcher(&s).arg("run").arg(&path).args(["--mode", mode, "--out"]).arg(&full).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+        let child = launcher(&s).arg("run").arg(&path).args(["--mode", mode, "--realtime", "--speed", "2", "--out"]).arg(&full).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
         let lpid = child.id();
+        std::thread::sleep(Duration::from_millis(700));
+        fill(&full, leave);
         let out = child.wait_with_output().unwrap();
         let (_, err) = text(&out);
         let listing: Vec<String> = std::fs::read_dir(&full).unwrap().flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect();
