@@ -68,7 +68,7 @@ shm_before="$(ls /dev/shm | sort)"
 fail() { echo "two-hosts $case_name: $*"; for f in "$work/launcher.err" "$work"/out*/launcher.err; do [ -f "$f" ] && tail -3 "$f"; done; [ -f "$work/agent.err" ] && tail -3 "$work/agent.err"; exit 1; }
 
 # The agent on B: listens on B's address only.
-agent_args=(--host rig --listen "$endpoint" --max-workers 8)
+agent_args=(--host rig --listen "$endpoint" --max-workers 4)
 if [ "$case_name" = insecure ]; then
   # Plain TCP without --insecure is refused before anything listens.
   rc=0; "$launcher" agent "${agent_args[@]}" 2>"$work/refusal.err" || rc=$?
@@ -241,13 +241,14 @@ case "$case_name" in
     big="$(intrude "${mine[@]}" "$endpoint" big rig 200)"
     rss_kb="$(awk '/VmRSS/ {print $2}' "/proc/$agent_pid/status")"
     [ "$rss_kb" -lt 262144 ] || fail "the agent holds $rss_kb kB after a 200 MB query"
-    # 6. Twenty start requests: at most --max-workers (8) components at once.
-    for i in $(seq 20); do intrude "${mine[@]}" "$endpoint" start rig "flood$i" "$work/plant.json"; done >"$work/flood.out"
+    # 6. Twelve start requests: at most --max-workers (4) components at once, the run's two
+    # included.
+    for i in $(seq 12); do intrude "${mine[@]}" "$endpoint" start rig "flood$i" "$work/plant.json"; done >"$work/flood.out"
     workers="$(ip netns pids "$nsb" | xargs -r ps -o args= -p | grep -c 'uio-bridge worker' || true)"
-    [ "$workers" -le 8 ] || fail "$workers workers after a flood of start requests (the limit is 8)"
+    [ "$workers" -le 4 ] || fail "$workers workers after a flood of start requests (the limit is 4)"
     grep -q "already has" "$work/flood.out" && fail "unexpected: $(cat "$work/flood.out")"
-    refused_flood="$(grep -c 'runs 8 components already' "$work/flood.out" || true)"
-    [ "$refused_flood" -ge 12 ] || fail "only $refused_flood of 20 start requests refused at the limit: $(sort "$work/flood.out" | uniq -c)"
+    refused_flood="$(grep -c 'runs 4 components already' "$work/flood.out" || true)"
+    [ "$refused_flood" -ge 9 ] || fail "only $refused_flood of 12 start requests refused at the limit: $(sort "$work/flood.out" | uniq -c)"
     sleep 5.5  # the flood's workers give up waiting for proxies that never come (5 s)
     # 7. 200 peers that open a connection and say nothing more (junk QUIC datagrams from 200
     # ports, again and again): a second run started meanwhile still gets through.
@@ -271,7 +272,7 @@ while time.time() < end:
     "$launcher" compare "$work/out1/two-hosts.rrd" "$work/out2/two-hosts.rrd" >"$work/compare.out" 2>&1 || fail "the attacked run differs: $(cat "$work/compare.out")"
     check_clean
     ignored="$(grep -c 'ignored a message' "$work/agent.err" || true)"
-    echo "ok attacks: uio/**: $all; outputs: $outs; forged: $forged_in, $forged_status (ignored-message reports on B: $ignored); start '**': $wild; start again: $again; queryable: $(cat "$work/queryable.out") (start meanwhile: $after); 200 MB query: $big, agent RSS $((rss_kb / 1024)) MB; flood of 20 starts: $refused_flood refused, $workers workers; during 200 junk QUIC peers a run passed; the attacked run: $(cat "$work/compare.out")"
+    echo "ok attacks: uio/**: $all; outputs: $outs; forged: $forged_in, $forged_status (ignored-message reports on B: $ignored); start '**': $wild; start again: $again; queryable: $(cat "$work/queryable.out") (start meanwhile: $after); 200 MB query: $big, agent RSS $((rss_kb / 1024)) MB; flood of 12 starts: $refused_flood refused, $workers workers; during 200 junk QUIC peers a run passed; the attacked run: $(cat "$work/compare.out")"
     ;;
   concurrent)
     scenario 10.0 | bare > "$work/two.toml"

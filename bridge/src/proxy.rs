@@ -107,11 +107,16 @@ fn proxy(host: &str, connect: &str, builtin: &str) -> Result<i32, String> {
     go.put(format!("go {} {}", offset.theta_ns, offset.rtt_ns).as_bytes())?;
 
     let mut idle = Idle::new();
+    let mut checked = Instant::now();
     loop {
         let worked = exports.pump()? + imports.pump()? > 0;
-        if let Ok(Some(s)) = worker.try_recv()
-            && s.kind() == SampleKind::Delete
-        {
+        // The worker's token goes when its session does; the agent's own link is watched too:
+        // over QUIC a killed agent sends nothing, and only the lease (1 s) ends the session.
+        let agent_gone = checked.elapsed() > Duration::from_millis(100) && {
+            checked = Instant::now();
+            z.info().routers_zid().wait().next().is_none()
+        };
+        if agent_gone || matches!(worker.try_recv(), Ok(Some(s)) if s.kind() == SampleKind::Delete) {
             return Err(format!("lost its agent while {name} ran (the link was cut, or the agent or the host stopped)"));
         }
         if let Some(line) = status.try_recv_text() {

@@ -10,7 +10,7 @@
 //!   refused, and so is a launcher with another CA's credentials;
 //! - a peer with the user's own launcher credential, during a run, cannot subscribe to `uio/**`,
 //!   reads only sealed bytes, cannot forge inputs or a status, start run `**` or the running
-//!   plant again, intercept start requests, exhaust the agent with a 200 MB query or 20 start
+//!   plant again, intercept start requests, exhaust the agent with a 200 MB query or 12 start
 //!   requests, or keep a second run out with 200 idle connections — and the run's recording
 //!   equals a single-host run's;
 //! - two runs at once through one agent both pass; plain TCP only with `--insecure`.
