@@ -28,11 +28,11 @@ bin="${CARGO_TARGET_DIR:-$repo/target}/release"
 launcher="$bin/launcher"
 intruder="$bin/examples/intruder"
 [ -x "$launcher" ] && [ -x "$bin/uio-bridge" ] || { echo "two-hosts: build first (cargo build --release --workspace)"; exit 1; }
-case "$case_name" in refused|attacks) [ -x "$intruder" ] || { echo "two-hosts: build the intruder first (cargo build --release -p bridge --examples)"; exit 1; } ;; esac
 
 if [ "$(id -u)" -ne 0 ] || ! command -v ip >/dev/null || ! ip netns list >/dev/null 2>&1; then
   echo "skipped: network namespaces need root and iproute2's ip netns"; exit 77
 fi
+case "$case_name" in refused|attacks) [ -x "$intruder" ] || { echo "two-hosts: build the intruder first (cargo build --release -p bridge --examples)"; exit 1; } ;; esac
 tag="$$"
 nsa="uioa$tag"; nsb="uiob$tag"; va="uva$tag"; vb="uvb$tag"
 if ! ip netns add "$nsa" 2>/dev/null; then echo "skipped: ip netns add is not allowed here"; exit 77; fi
@@ -272,6 +272,7 @@ while time.time() < end:
     "$launcher" compare "$work/out1/two-hosts.rrd" "$work/out2/two-hosts.rrd" >"$work/compare.out" 2>&1 || fail "the attacked run differs: $(cat "$work/compare.out")"
     check_clean
     ignored="$(grep -c 'ignored a message' "$work/agent.err" || true)"
+    [ "$ignored" -ge 1 ] || fail "the forged inputs were not refused by the plant's worker (no 'ignored a message' on B)"
     echo "ok attacks: uio/**: $all; outputs: $outs; forged: $forged_in, $forged_status (ignored-message reports on B: $ignored); start '**': $wild; start again: $again; queryable: $(cat "$work/queryable.out") (start meanwhile: $after); 200 MB query: $big, agent RSS $((rss_kb / 1024)) MB; flood of 12 starts: $refused_flood refused, $workers workers; during 200 junk QUIC peers a run passed; the attacked run: $(cat "$work/compare.out")"
     ;;
   concurrent)

@@ -7,9 +7,11 @@
 //! start request) or an agent's liveliness token (so none can stand in for an agent), and
 //! neither side may hold the other side's liveliness token.
 //!
-//! Within those rules a peer with a credential can still address another run's keys; what it
-//! would read there is sealed with that run's secret, and what it sends is refused by the run's
-//! receivers ([`crate::seal`]).
+//! Zenoh's rules cannot forbid a wildcard within what a rule admits: a launcher's credential may
+//! subscribe to `uio/run/*/c/*/out` and so learn run ids, component names and message sizes
+//! and times. What it reads there is sealed with each run's secret, and what it sends is
+//! refused by the run's receivers ([`crate::seal`]); liveliness tokens, which cannot be sealed,
+//! are backed by sealed heartbeats ([`crate::beat`]).
 
 use serde_json::{json, Value};
 
@@ -28,14 +30,14 @@ fn run_keys(ends: &[&str]) -> Vec<String> {
 /// The rules of a proxy (launcher side) and of a worker (agent side).
 fn rules() -> Vec<Value> {
     vec![
-        rule("proxy-put", &["put"], &run_keys(&["in/**", "go", "ping"])),
-        rule("proxy-sub", &["declare_subscriber"], &run_keys(&["out", "status", "pong"])),
+        rule("proxy-put", &["put"], &run_keys(&["in/**", "go", "ping", "beat/proxy"])),
+        rule("proxy-sub", &["declare_subscriber"], &run_keys(&["out", "status", "pong", "beat/worker"])),
         rule("proxy-start", &["query"], &["uio/agent/*/start".into()]),
         rule("proxy-token", &["liveliness_token"], &run_keys(&["proxy"])),
         rule("proxy-watch", &["declare_liveliness_subscriber"], &run_keys(&["worker"])),
         rule("proxy-find", &["liveliness_query"], &["uio/agent/*".into()]),
-        rule("worker-put", &["put"], &run_keys(&["out", "status", "pong"])),
-        rule("worker-sub", &["declare_subscriber"], &run_keys(&["in/**", "go", "ping"])),
+        rule("worker-put", &["put"], &run_keys(&["out", "status", "pong", "beat/worker"])),
+        rule("worker-sub", &["declare_subscriber"], &run_keys(&["in/**", "go", "ping", "beat/proxy"])),
         rule("worker-token", &["liveliness_token"], &run_keys(&["worker"])),
         rule("worker-watch", &["declare_liveliness_subscriber"], &run_keys(&["proxy"])),
         // What the router forwards to a peer is what that peer was allowed to ask for.

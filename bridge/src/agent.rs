@@ -160,6 +160,10 @@ fn worker(o: &Options, tls: bool, request: &str) -> Result<Child, String> {
     }
     let mut child = cmd.spawn().map_err(|e| format!("cannot start a worker: {e}"))?;
     let mut stdin = child.stdin.take().expect("piped");
-    stdin.write_all(request.as_bytes()).map_err(|e| format!("worker: {e}"))?;
+    if let Err(e) = stdin.write_all(request.as_bytes()) {
+        let _ = child.kill();
+        let _ = child.wait();
+        return Err(format!("worker: {e}"));
+    }
     Ok(child)
 }

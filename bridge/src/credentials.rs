@@ -6,8 +6,11 @@
 //!
 //! A directory holds `ca.pem` (and `ca.key`, needed only to make more certificates),
 //! `agent.pem`/`agent.key` and `launcher.pem`/`launcher.key`. The agent's host needs `ca.pem`
-//! and the agent's pair, the launcher's host `ca.pem` and the launcher's pair. Keys are 0600
-//! in a 0700 directory owned by the user, and refused otherwise.
+//! and the agent's pair, the launcher's host `ca.pem` and the launcher's pair. Keys are 0600;
+//! the folder and every file must be the user's and writable by nobody else, or they are
+//! refused. Every agent has the same certificate: an agent's host that is compromised can pose
+//! as any agent (make a CA per rig where that matters). A launcher's certificate is good only
+//! for connecting, so it cannot pose as an agent.
 
 use std::fs;
 use std::io::Write;
@@ -71,17 +74,22 @@ pub fn default_dir() -> PathBuf {
 /// and readable by us only.
 pub fn load(dir: &Path, side: Side) -> Result<Credentials, String> {
     let c = Credentials { ca: dir.join("ca.pem"), cert: dir.join(format!("{}.pem", side.stem())), key: dir.join(format!("{}.key", side.stem())) };
-    for f in [&c.ca, &c.cert, &c.key] {
-        let m = fs::symlink_metadata(f).map_err(|e| format!("{}: {e} (make the credentials with `launcher agent init`)", f.display()))?;
-        if !m.file_type().is_file() {
-            return Err(format!("{}: not a regular file", f.display()));
-        }
-    }
-    let m = fs::metadata(&c.key).map_err(|e| format!("{}: {e}", c.key.display()))?;
     // SAFETY: geteuid has no preconditions.
     let me = unsafe { libc::geteuid() };
-    if m.uid() != me || m.mode() & 0o077 != 0 {
-        return Err(format!("{}: a private key must be owned by this user with mode 0600 (it is {:o}, owner {})", c.key.display(), m.mode() & 0o777, m.uid()));
+    // Whoever could write the folder or a certificate could swap in a CA of their own.
+    let d = fs::symlink_metadata(dir).map_err(|e| format!("{}: {e} (make the credentials with `launcher agent init`)", dir.display()))?;
+    if !d.file_type().is_dir() || d.uid() != me || d.mode() & 0o022 != 0 {
+        return Err(format!("{}: the credentials folder must be a real directory of this user that others cannot write (mode {:o}, owner {})", dir.display(), d.mode() & 0o777, d.uid()));
+    }
+    for f in [&c.ca, &c.cert, &c.key] {
+        let m = fs::symlink_metadata(f).map_err(|e| format!("{}: {e} (make the credentials with `launcher agent init`)", f.display()))?;
+        if !m.file_type().is_file() || m.uid() != me || m.mode() & 0o022 != 0 {
+            return Err(format!("{}: must be a regular file of this user that others cannot write (mode {:o}, owner {})", f.display(), m.mode() & 0o777, m.uid()));
+        }
+    }
+    let m = fs::symlink_metadata(&c.key).map_err(|e| format!("{}: {e}", c.key.display()))?;
+    if m.mode() & 0o077 != 0 {
+        return Err(format!("{}: a private key must be owned by this user with mode 0600 (it is {:o})", c.key.display(), m.mode() & 0o777));
     }
     Ok(c)
 }
@@ -106,10 +114,14 @@ pub fn init(dir: &Path, force: bool) -> Result<(), String> {
     write(&dir.join("ca.key"), &ca_key_pem, 0o600)?;
     write(&dir.join("ca.pem"), &issuer.pem(), 0o644)?;
     for (side, cn) in [(Side::Agent, AGENT_CN), (Side::Launcher, LAUNCHER_CN)] {
-        // Both directions of a link authenticate: every certificate is good for either end.
+        // An agent's certificate serves (the agent) and connects (its workers); a launcher's
+        // only connects, so a launcher's credential cannot pose as an agent to another launcher.
         let mut p = CertificateParams::new(vec![cn.to_string()]).map_err(err)?;
         p.distinguished_name.push(DnType::CommonName, cn);
-        p.extended_key_usages = vec![ExtendedKeyUsagePurpose::ServerAuth, ExtendedKeyUsagePurpose::ClientAuth];
+        p.extended_key_usages = match side {
+            Side::Agent => vec![ExtendedKeyUsagePurpose::ServerAuth, ExtendedKeyUsagePurpose::ClientAuth],
+            Side::Launcher => vec![ExtendedKeyUsagePurpose::ClientAuth],
+        };
         p.key_usages = vec![KeyUsagePurpose::DigitalSignature];
         let key = KeyPair::generate().map_err(err)?;
         let cert = p.signed_by(&key, &issuer).map_err(err)?;
@@ -149,6 +161,11 @@ mod tests {
         assert!(load(&dir, Side::Agent).unwrap_err().contains("mode 0600"));
         init(&dir, true).unwrap();
         assert!(load(&dir, Side::Agent).is_ok());
+        fs::set_permissions(dir.join("ca.pem"), fs::Permissions::from_mode(0o666)).unwrap();
+        assert!(load(&dir, Side::Launcher).unwrap_err().contains("others cannot write"));
+        fs::set_permissions(dir.join("ca.pem"), fs::Permissions::from_mode(0o644)).unwrap();
+        fs::set_permissions(&dir, fs::Permissions::from_mode(0o777)).unwrap();
+        assert!(load(&dir, Side::Launcher).unwrap_err().contains("credentials folder"));
         let _ = fs::remove_dir_all(&dir);
         assert!(load(&dir, Side::Launcher).unwrap_err().contains("launcher agent init"));
     }

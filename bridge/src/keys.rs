@@ -44,6 +44,11 @@ pub fn pong(run: &str, name: &str) -> String {
     format!("uio/run/{run}/c/{name}/pong")
 }
 
+/// The sealed heartbeat of one side (`proxy` or `worker`) of a remote component.
+pub fn beat(run: &str, name: &str, side: &str) -> String {
+    format!("uio/run/{run}/c/{name}/beat/{side}")
+}
+
 /// Liveliness of the proxy (launcher's host) and of the worker (component's host).
 pub fn alive(run: &str, name: &str, side: &str) -> String {
     format!("uio/run/{run}/c/{name}/{side}")

@@ -4,6 +4,7 @@
 
 mod access;
 mod agent;
+mod beat;
 mod clock;
 mod credentials;
 mod keys;

@@ -11,6 +11,7 @@ use lockstep::{Bus, RunSpace, Wait};
 use zenoh::sample::SampleKind;
 use zenoh::Wait as _;
 
+use crate::beat::Beat;
 use crate::clock::{estimate, Offset};
 use crate::credentials::{self, Side};
 use crate::keys;
@@ -67,6 +68,7 @@ fn proxy(host: &str, connect: &str, builtin: &str) -> Result<i32, String> {
     let mut imports = Imports::new(&bus, &z, &secret, &[(cfg.publishes.service.clone(), cfg.publishes.len, keys::from_component(run, name))])?;
     let reads: Vec<(String, String)> = cfg.reads.iter().map(|r| (r.service.clone(), keys::to_component(run, name, &r.service))).collect();
     let mut exports = Exports::new(&bus, &z, &secret, &reads)?;
+    let mut beat = Beat::new(&z, &secret, run, name, "proxy", "worker")?;
 
     let request = serde_json::to_string(&StartRequest { run: run.to_string(), builtin: builtin.to_string(), config: text.clone(), secret: secret.to_hex() }).expect("serialises");
     if request.len() > MAX_MESSAGE {
@@ -105,6 +107,7 @@ fn proxy(host: &str, connect: &str, builtin: &str) -> Result<i32, String> {
     imports.shift_ns = -offset.theta_ns;
     lockstep::ready_then_wait_for_go().map_err(|e| e.to_string())?;
     go.put(format!("go {} {}", offset.theta_ns, offset.rtt_ns).as_bytes())?;
+    beat.arm();
 
     let mut idle = Idle::new();
     let mut checked = Instant::now();
@@ -116,7 +119,7 @@ fn proxy(host: &str, connect: &str, builtin: &str) -> Result<i32, String> {
             checked = Instant::now();
             z.info().routers_zid().wait().next().is_none()
         };
-        if agent_gone || matches!(worker.try_recv(), Ok(Some(s)) if s.kind() == SampleKind::Delete) {
+        if agent_gone || !beat.alive()? || matches!(worker.try_recv(), Ok(Some(s)) if s.kind() == SampleKind::Delete) {
             return Err(format!("lost its agent while {name} ran (the link was cut, or the agent or the host stopped)"));
         }
         if let Some(line) = status.try_recv_text() {

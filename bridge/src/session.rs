@@ -29,6 +29,9 @@ pub const LEASE_MS: u64 = 1000;
 /// is the largest thing sent, and an n = 1000 observer's is ~60 MB.
 pub const MAX_MESSAGE: usize = 128 << 20;
 
+/// The largest message a proxy or a worker accepts, bytes: a sample of 131 000 values.
+pub const MAX_CLIENT_MESSAGE: usize = 1 << 20;
+
 /// Sessions an agent holds at once (two per remote component and run: proxy and worker).
 pub const MAX_SESSIONS: usize = 256;
 
@@ -97,7 +100,13 @@ pub fn open(role: Role, tls: Option<&Credentials>) -> Result<Session, String> {
     set(&mut c, "scouting/multicast/enabled", json!(false))?;
     set(&mut c, "scouting/gossip/enabled", json!(false))?;
     set(&mut c, "transport/link/tx/lease", json!(LEASE_MS))?;
-    set(&mut c, "transport/link/rx/max_message_size", json!(MAX_MESSAGE))?;
+    // Only the agent receives start requests; a proxy or a worker receives samples and short
+    // control messages, so a peer cannot fill them with large forgeries.
+    let max = if matches!(role, Role::Router { .. }) { MAX_MESSAGE } else { MAX_CLIENT_MESSAGE };
+    set(&mut c, "transport/link/rx/max_message_size", json!(max))?;
+    // A publisher blocked on a dead link (QUIC: a killed peer sends nothing) gives up with the
+    // lease, not Zenoh's default 5 s.
+    set(&mut c, "transport/link/tx/queue/congestion_control/block/wait_before_close", json!(LEASE_MS * 1000))?;
     set(&mut c, "transport/unicast/max_sessions", json!(MAX_SESSIONS))?;
     set(&mut c, "transport/unicast/accept_timeout", json!(ACCEPT_TIMEOUT_MS))?;
     set(&mut c, "transport/unicast/accept_pending", json!(ACCEPT_PENDING))?;

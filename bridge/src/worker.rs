@@ -17,6 +17,7 @@ use lockstep::{Bus, RunSpace, Wait};
 use zenoh::sample::SampleKind;
 use zenoh::Wait as _;
 
+use crate::beat::Beat;
 use crate::credentials::{self, Side};
 use crate::keys;
 use crate::proxy::StartRequest;
@@ -95,6 +96,7 @@ fn serve(connect: &str, credentials: Option<&std::path::Path>, req: &StartReques
     let mut imports = Imports::new(&bus, &z, &secret, &reads)?;
     let mut exports = Exports::new(&bus, &z, &secret, &[(cfg.publishes.service.clone(), keys::from_component(&run, &name))])?;
     let report = |line: String| status.borrow_mut().put(line.as_bytes());
+    let mut beat = Beat::new(&z, &secret, &run, &name, "worker", "proxy")?;
 
     let mut child = spawn(&req.builtin, space, &cfg, wait).inspect_err(|e| {
         let _ = report(format!("exit 3 0 {e}"));
@@ -130,6 +132,10 @@ fn serve(connect: &str, credentials: Option<&std::path::Path>, req: &StartReques
                 }
             }
         }
+        if !beat.alive()? {
+            kill(&mut child);
+            return Err(format!("the launcher's side of {name} went silent (run stopped, or the link was cut)"));
+        }
         if !proxy_seen && started.elapsed() > Duration::from_secs(5) {
             kill(&mut child);
             return Err(format!("no launcher-side proxy for {name}"));
@@ -152,6 +158,7 @@ fn serve(connect: &str, credentials: Option<&std::path::Path>, req: &StartReques
                     return Err(format!("{name}: a malformed go from the proxy: '{}'", text.escape_debug()));
                 };
                 imports.shift_ns = theta;
+                beat.arm();
                 eprintln!("worker for {name}: this host's clock reads {theta} ns ahead of the launcher's host's (± {} ns, half the shortest of 16 round trips)", rtt / 2);
                 if let Some(s) = stdin.as_mut() {
                     s.write_all(b"go\n").and_then(|_| s.flush()).map_err(|e| format!("{name}: {e}"))?;

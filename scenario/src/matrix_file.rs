@@ -63,6 +63,9 @@ pub fn read(dir: &Path, name: &str) -> Result<Vec<Vec<f64>>, String> {
         [r, c] => (r as usize, c as usize),
         ref s => return Err(format!("{shown}: has shape {s:?}; a matrix is 2-D (save a vector as (k, 1) or (1, k))")),
     };
+    if rows == 0 || cols == 0 {
+        return Err(format!("{shown}: has shape ({rows}, {cols}); a matrix has at least one row and one column"));
+    }
     // The header's shape must be what the file holds (exactly, as numpy.save writes it) before
     // anything is allocated or read for it.
     let values = len - data_at;

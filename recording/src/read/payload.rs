@@ -13,6 +13,10 @@ use rerun::external::arrow::ipc::root_as_message;
 /// LZ4's block format expands at most about 255-fold (a byte of match length for 255 bytes).
 const LZ4_MAX_RATIO: u64 = 255;
 
+/// The largest message decompressed, bytes: our writer never compresses, and Rerun's own
+/// chunks are far smaller, so a larger claim is damage (255× a large file would be an abort).
+const LZ4_MAX_BYTES: u64 = 256 << 20;
+
 /// Why the message's lengths cannot be trusted, or Ok.
 pub fn check(msg: &ArrowMsg) -> Result<(), String> {
     if msg.encoding() != Encoding::ArrowIpc {
@@ -22,7 +26,7 @@ pub fn check(msg: &ArrowMsg) -> Result<(), String> {
         Compression::None | Compression::Unspecified => Cow::Borrowed(&msg.payload[..]),
         Compression::Lz4 => {
             let size = msg.uncompressed_size;
-            if size > (msg.payload.len() as u64).saturating_mul(LZ4_MAX_RATIO) + 64 {
+            if size > (msg.payload.len() as u64).saturating_mul(LZ4_MAX_RATIO) + 64 || size > LZ4_MAX_BYTES {
                 return Err(format!("it claims {size} bytes once uncompressed from {}, more than LZ4 can give", msg.payload.len()));
             }
             Cow::Owned(lz4_flex::block::decompress(&msg.payload, size as usize).map_err(|e| format!("its LZ4 data is damaged ({e})"))?)
