@@ -128,5 +128,10 @@ fn a_header_is_checked_before_it_is_read() {
     std::fs::write(d.join("model/tail.npy"), long_tail).unwrap();
     let tail = err("\"model/tail.npy\"");
     assert!(tail.contains("3×3") && tail.contains("80 bytes follow"), "{tail}");
+    // A shape with no values at all matches an empty data part: (2⁶², 0) would otherwise build
+    // 2⁶² empty rows.
+    npy(&d.join("model/empty.npy"), "<f8", false, &[1 << 62, 0], &[]);
+    let empty = err("\"model/empty.npy\"");
+    assert!(empty.contains("at least one row and one column"), "{empty}");
     let _ = std::fs::remove_dir_all(&d);
 }
