@@ -66,7 +66,7 @@ impl SealedSubscriber {
                 let len = self.buf.len() - 16;
                 return Some(&self.buf[8..len]);
             }
-            if refused % 1000 == 0 {
+            if refused.is_multiple_of(1000) {
                 eprintln!("ignored a message on {} that is not from this run's other side ({} so far)", self.key, refused + 1);
             }
         }
