@@ -230,6 +230,13 @@ case "$case_name" in
     again="$(intrude "${mine[@]}" "$endpoint" start rig "$run" "$work/plant.json")"
     [[ "$wild" == "reply err: "*"not a run id"* ]] || fail "a start for run '**': $wild"
     [[ "$again" == "reply err: "*"already has"* ]] || fail "a second start for the running plant: $again"
+    # … and one whose plant would publish 10⁹ values a sample, or read a service named '**'.
+    python3 -c 'import json,sys; c=json.load(open(sys.argv[1])); c["publishes"]["len"]=10**9; json.dump(c,open(sys.argv[2],"w"))' "$work/plant.json" "$work/huge.json"
+    python3 -c 'import json,sys; c=json.load(open(sys.argv[1])); c["reads"][0]["service"]="**"; json.dump(c,open(sys.argv[2],"w"))' "$work/plant.json" "$work/wildsvc.json"
+    huge="$(intrude "${mine[@]}" "$endpoint" start rig huge1 "$work/huge.json")"
+    wildsvc="$(intrude "${mine[@]}" "$endpoint" start rig wild1 "$work/wildsvc.json")"
+    [[ "$huge" == "reply err: "*"at most"* ]] || fail "a start with 10⁹ values a sample: $huge"
+    [[ "$wildsvc" == "reply err: "*"not a service name"* ]] || fail "a start reading service '**': $wildsvc"
     # 4. A queryable that would intercept start requests: refused, so it sees none.
     intrude "${mine[@]}" "$endpoint" queryable 'uio/agent/rig/start' 2 >"$work/queryable.out" &
     qpid=$!
@@ -273,7 +280,7 @@ while time.time() < end:
     check_clean
     ignored="$(grep -c 'ignored a message' "$work/agent.err" || true)"
     [ "$ignored" -ge 1 ] || fail "the forged inputs were not refused by the plant's worker (no 'ignored a message' on B)"
-    echo "ok attacks: uio/**: $all; outputs: $outs; forged: $forged_in, $forged_status (ignored-message reports on B: $ignored); start '**': $wild; start again: $again; queryable: $(cat "$work/queryable.out") (start meanwhile: $after); 200 MB query: $big, agent RSS $((rss_kb / 1024)) MB; flood of 12 starts: $refused_flood refused, $workers workers; during 200 junk QUIC peers a run passed; the attacked run: $(cat "$work/compare.out")"
+    echo "ok attacks: uio/**: $all; outputs: $outs; forged: $forged_in, $forged_status (ignored-message reports on B: $ignored); start '**': $wild; start again: $again; 10⁹ values: $huge; service '**': $wildsvc; queryable: $(cat "$work/queryable.out") (start meanwhile: $after); 200 MB query: $big, agent RSS $((rss_kb / 1024)) MB; flood of 12 starts: $refused_flood refused, $workers workers; during 200 junk QUIC peers a run passed; the attacked run: $(cat "$work/compare.out")"
     ;;
   concurrent)
     scenario 10.0 | bare > "$work/two.toml"

@@ -134,6 +134,18 @@ fn admit(text: &str, workers: &[(Child, String, String)], max: usize) -> Result<
     Secret::from_hex(&req.secret)?;
     let cfg: ComponentConfig = serde_json::from_str(&req.config).map_err(|e| format!("bad component configuration: {e}"))?;
     keys::check_component(&cfg.name)?;
+    // What the worker will make here from the request: services (Zenoh keys and shared memory)
+    // of plain names and of samples no larger than a proxy or a worker accepts.
+    let max_len = (session::MAX_CLIENT_MESSAGE - 64) / 8;
+    for (service, len) in std::iter::once((&cfg.publishes.service, cfg.publishes.len)).chain(cfg.reads.iter().map(|r| (&r.service, r.len))) {
+        keys::check_service(service)?;
+        if len == 0 || len > max_len {
+            return Err(format!("service '{}' has samples of {len} values; at most {max_len} cross hosts", service.escape_debug()));
+        }
+    }
+    if cfg.reads.len() > 64 {
+        return Err(format!("{} reads {} services; at most 64", cfg.name, cfg.reads.len()));
+    }
     if workers.iter().any(|(_, r, n)| *r == req.run && *n == cfg.name) {
         return Err(format!("run {} already has its {} here", req.run, cfg.name.escape_debug()));
     }

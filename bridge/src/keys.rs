@@ -75,6 +75,14 @@ pub fn check_component(name: &str) -> Result<(), String> {
     Ok(())
 }
 
+/// A service name is key chunks joined by `/` (`plant`, `observer/uio`): no wildcards.
+pub fn check_service(service: &str) -> Result<(), String> {
+    if service.len() > 200 || !service.split('/').all(chunk) {
+        return Err(format!("'{}' is not a service name (chunks of letters, digits, - and _ joined by /)", service.escape_debug()));
+    }
+    Ok(())
+}
+
 /// A run id is what `RunSpace` makes: 1–64 letters and digits.
 pub fn check_run(run: &str) -> Result<(), String> {
     if run.is_empty() || run.len() > 64 || !run.chars().all(|c| c.is_ascii_alphanumeric()) {

@@ -247,6 +247,19 @@ def test_a_fifo_or_symlink_as_owner_pid_is_refused_without_blocking(run_space):
         code, _, stderr = start_echo(run_space).finish()
         assert time.monotonic() - t0 < 10
         assert code == 2 and "owner.pid is missing or not a regular file" in stderr, stderr
+    # A symlink standing in for the run directory is refused too.
+    os.remove(owner)
+    with open(owner, "w") as f:
+        f.write(f"{os.getpid()}\n")
+    real, link = run_space["dir"], run_space["dir"] + "-link"
+    os.rename(real, link + "-real")
+    os.symlink(link + "-real", real)
+    try:
+        code, _, stderr = start_echo(run_space).finish()
+        assert code == 2 and "owner.pid is missing or not a regular file" in stderr, stderr
+    finally:
+        os.remove(real)
+        os.rename(link + "-real", real)
 
 
 def test_a_configuration_of_another_version_exits_2(run_space):

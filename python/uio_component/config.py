@@ -51,7 +51,13 @@ def default_runs_dir(env):
 
 def read_owner(path):
     """The pid in a run's `owner.pid`, opened without following a symlink and without blocking
-    (a FIFO planted there is refused, not waited on); only a regular file of ours counts."""
+    (a FIFO planted there is refused, not waited on); only a regular file of ours, in a run
+    directory and a runs directory that are real directories of ours (not symlinks), counts."""
+    run_dir = os.path.dirname(path)
+    for d in (run_dir, os.path.dirname(run_dir)):
+        st = os.lstat(d)
+        if not stat.S_ISDIR(st.st_mode) or st.st_uid != os.geteuid():
+            raise ValueError(f"{d} is not a real directory of this user")
     fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
     try:
         st = os.fstat(fd)
