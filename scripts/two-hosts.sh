@@ -233,15 +233,15 @@ case "$case_name" in
     # … and one whose plant would publish 10⁹ values a sample, or read a service named '**'.
     python3 -c 'import json,sys; c=json.load(open(sys.argv[1])); c["publishes"]["len"]=10**9; json.dump(c,open(sys.argv[2],"w"))' "$work/plant.json" "$work/huge.json"
     python3 -c 'import json,sys; c=json.load(open(sys.argv[1])); c["reads"][0]["service"]="**"; json.dump(c,open(sys.argv[2],"w"))' "$work/plant.json" "$work/wildsvc.json"
-    huge="$(intrude "${mine[@]}" "$endpoint" start rig huge1 "$work/huge.json")"
-    wildsvc="$(intrude "${mine[@]}" "$endpoint" start rig wild1 "$work/wildsvc.json")"
+    huge="$(intrude "${mine[@]}" "$endpoint" start rig 1x0x1 "$work/huge.json")"
+    wildsvc="$(intrude "${mine[@]}" "$endpoint" start rig 1x0x2 "$work/wildsvc.json")"
     [[ "$huge" == "reply err: "*"at most"* ]] || fail "a start with 10⁹ values a sample: $huge"
     [[ "$wildsvc" == "reply err: "*"not a service name"* ]] || fail "a start reading service '**': $wildsvc"
     # 4. A queryable that would intercept start requests: refused, so it sees none.
     intrude "${mine[@]}" "$endpoint" queryable 'uio/agent/rig/start' 2 >"$work/queryable.out" &
     qpid=$!
     sleep 0.5
-    after="$(intrude "${mine[@]}" "$endpoint" start rig 'x' "$work/plant.json")"
+    after="$(intrude "${mine[@]}" "$endpoint" start rig 1x0x3 "$work/plant.json")"
     wait "$qpid"
     [ "$(cat "$work/queryable.out")" = "intercepted 0" ] || fail "a queryable on the agent's key: $(cat "$work/queryable.out")"
     # 5. One 200 MB query: dropped (the limit is 128 MiB); the agent stays small.
@@ -250,7 +250,7 @@ case "$case_name" in
     [ "$rss_kb" -lt 262144 ] || fail "the agent holds $rss_kb kB after a 200 MB query"
     # 6. Twelve start requests: at most --max-workers (4) components at once, the run's two
     # included.
-    for i in $(seq 12); do intrude "${mine[@]}" "$endpoint" start rig "flood$i" "$work/plant.json"; done >"$work/flood.out"
+    for i in $(seq 12); do intrude "${mine[@]}" "$endpoint" start rig "2x${i}x1" "$work/plant.json"; done >"$work/flood.out"
     workers="$(ip netns pids "$nsb" | xargs -r ps -o args= -p | grep -c 'uio-bridge worker' || true)"
     [ "$workers" -le 4 ] || fail "$workers workers after a flood of start requests (the limit is 4)"
     grep -q "already has" "$work/flood.out" && fail "unexpected: $(cat "$work/flood.out")"

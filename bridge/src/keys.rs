@@ -83,10 +83,10 @@ pub fn check_service(service: &str) -> Result<(), String> {
     Ok(())
 }
 
-/// A run id is what `RunSpace` makes: 1–64 letters and digits.
+/// A run id is what a launcher's `RunSpace` makes ([`lockstep::is_run_id`]).
 pub fn check_run(run: &str) -> Result<(), String> {
-    if run.is_empty() || run.len() > 64 || !run.chars().all(|c| c.is_ascii_alphanumeric()) {
-        return Err(format!("'{}' is not a run id (1–64 letters and digits)", run.escape_debug()));
+    if !lockstep::is_run_id(run) {
+        return Err(format!("'{}' is not a run id (a launcher's run id is <pid>x<n>x<nonce>, in digits)", run.escape_debug()));
     }
     Ok(())
 }

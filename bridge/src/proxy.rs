@@ -113,13 +113,14 @@ fn proxy(host: &str, connect: &str, builtin: &str) -> Result<i32, String> {
     let mut checked = Instant::now();
     loop {
         let worked = exports.pump()? + imports.pump()? > 0;
-        // The worker's token goes when its session does; the agent's own link is watched too:
-        // over QUIC a killed agent sends nothing, and only the lease (1 s) ends the session.
+        // The worker's token goes when its session does; every 100 ms the agent's own link (over
+        // QUIC a killed agent sends nothing, and only the lease ends the session) and the
+        // worker's sealed heartbeat are checked too.
         let agent_gone = checked.elapsed() > Duration::from_millis(100) && {
             checked = Instant::now();
-            z.info().routers_zid().wait().next().is_none()
+            z.info().routers_zid().wait().next().is_none() || !beat.alive()?
         };
-        if agent_gone || !beat.alive()? || matches!(worker.try_recv(), Ok(Some(s)) if s.kind() == SampleKind::Delete) {
+        if agent_gone || matches!(worker.try_recv(), Ok(Some(s)) if s.kind() == SampleKind::Delete) {
             return Err(format!("lost its agent while {name} ran (the link was cut, or the agent or the host stopped)"));
         }
         if let Some(line) = status.try_recv_text() {

@@ -48,10 +48,10 @@ pub const ACCEPT_PENDING: usize = 4096;
 /// 1.3 without that.
 pub const TLS_OVER_TCP: &str = "tls/ links are not used: Zenoh 1.10's TLS link closes under concurrent reads and writes (runs lose their agent within seconds); use quic/<address>:<port>, the same mutual TLS over QUIC";
 
-/// Whether an endpoint is secured with the user's credentials: QUIC (TLS 1.3 inside) or TLS
-/// over TCP.
+/// Whether an endpoint is secured with the user's credentials: QUIC, TLS 1.3 inside (`tls/`
+/// is refused before a session is opened: [`TLS_OVER_TCP`]).
 pub fn secured(endpoint: &str) -> bool {
-    endpoint.starts_with("quic/") || endpoint.starts_with("tls/")
+    endpoint.starts_with("quic/")
 }
 
 /// How a session joins.

@@ -118,6 +118,7 @@ fn serve(connect: &str, credentials: Option<&std::path::Path>, req: &StartReques
     let mut phase = Phase::Starting;
     let started = Instant::now();
     let mut idle = Idle::new();
+    let mut checked = Instant::now();
     loop {
         if STOP.load(Ordering::Relaxed) {
             kill(&mut child);
@@ -132,7 +133,11 @@ fn serve(connect: &str, credentials: Option<&std::path::Path>, req: &StartReques
                 }
             }
         }
-        if !beat.alive()? {
+        // The proxy's sealed heartbeat, every 50 ms (it beats every 250 ms; silence counts after 1 s).
+        if checked.elapsed() > Duration::from_millis(50) && {
+            checked = Instant::now();
+            !beat.alive()?
+        } {
             kill(&mut child);
             return Err(format!("the launcher's side of {name} went silent (run stopped, or the link was cut)"));
         }

@@ -47,5 +47,6 @@ pub use layout::PlantLayout;
 pub use quiet::quiet_iceoryx2;
 pub use port::{Bus, Inlet, Outlet, Reader, FOLLOWER_LAG, RECORDER_BUFFER};
 pub use run::{cleanup_dead_runs, iox2_root, prepare_runs_dir, RunSpace, RUNS_DIR_ENV};
+pub use run_dir::is_run_id;
 pub use sample::{Header, WireHeader, PROTOCOL_VERSION};
 pub use wait::Wait;

@@ -111,7 +111,6 @@ impl RunSpace {
         fs::DirBuilder::new().mode(0o700).create(tmp.join("iox2")).map_err(|e| io("cannot create", &tmp, e))?;
         let mut f = fs::OpenOptions::new().write(true).create_new(true).mode(0o600).open(tmp.join("owner.pid")).map_err(|e| io("cannot write", &tmp, e))?;
         writeln!(f, "{}", std::process::id()).map_err(|e| io("cannot write", &tmp, e))?;
-        fs::set_permissions(tmp.join("owner.pid"), fs::Permissions::from_mode(0o600)).map_err(|e| io("cannot chmod", &tmp, e))?;
         let dir = base.join(&id);
         let root = iox2_root(&dir, &id);
         if !root.starts_with(&dir) {

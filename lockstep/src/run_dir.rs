@@ -297,7 +297,7 @@ pub(crate) fn default_runs_dir(xdg: Option<&OsStr>) -> PathBuf {
 }
 
 /// A run id as [`crate::RunSpace::create`] makes them: `<pid>x<n>x<nonce>`, all decimal.
-pub(crate) fn is_run_id(name: &str) -> bool {
+pub fn is_run_id(name: &str) -> bool {
     let parts: Vec<&str> = name.split('x').collect();
     parts.len() == 3 && parts.iter().all(|p| !p.is_empty() && p.len() <= 20 && p.bytes().all(|b| b.is_ascii_digit()))
 }
