@@ -14,8 +14,11 @@ use crate::sealed::{SealedPublisher, SealedSubscriber};
 /// How often each side beats.
 const PERIOD: Duration = Duration::from_millis(250);
 
-/// Silence after which the other side is gone: the link's lease.
-const LOST: Duration = Duration::from_millis(crate::session::LEASE_MS);
+/// Silence after which the other side is gone. The link's lease (1 s) and the liveliness
+/// tokens notice a lost peer first; beats only stop a token held up by someone else from
+/// keeping a run's side alive, so they may wait out a loop starved of CPU for a while (two
+/// runs at once on two cores once went 1 s without a beat).
+const LOST: Duration = Duration::from_secs(3);
 
 /// One side's beats out and the other side's in.
 pub struct Beat {

@@ -133,7 +133,7 @@ fn serve(connect: &str, credentials: Option<&std::path::Path>, req: &StartReques
                 }
             }
         }
-        // The proxy's sealed heartbeat, every 50 ms (it beats every 250 ms; silence counts after 1 s).
+        // The proxy's sealed heartbeat, every 50 ms (it beats every 250 ms; silence counts after 3 s).
         if checked.elapsed() > Duration::from_millis(50) && {
             checked = Instant::now();
             !beat.alive()?
