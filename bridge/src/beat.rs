@@ -75,6 +75,25 @@ impl Beat {
 
     /// False once an armed beat has heard nothing for [`LOST_NS`].
     pub fn alive(&self) -> bool {
+        self.pulse().alive()
+    }
+
+    /// What another thread needs to tell whether the other side is alive.
+    pub fn pulse(&self) -> Pulse {
+        Pulse { heard: self.heard.clone(), armed: self.armed.clone() }
+    }
+}
+
+/// A [`Beat`]'s verdict, for another thread (a watchdog that must not wait for a blocked loop).
+#[derive(Clone)]
+pub struct Pulse {
+    heard: Arc<AtomicU64>,
+    armed: Arc<AtomicBool>,
+}
+
+impl Pulse {
+    /// False once the armed beat has heard nothing for [`LOST_NS`].
+    pub fn alive(&self) -> bool {
         let heard = self.heard.load(Ordering::Relaxed);
         !self.armed.load(Ordering::Relaxed) || lockstep::now_ns().saturating_sub(heard) < LOST_NS
     }

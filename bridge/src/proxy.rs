@@ -11,7 +11,7 @@ use lockstep::{Bus, RunSpace, Wait};
 use zenoh::sample::SampleKind;
 use zenoh::Wait as _;
 
-use crate::beat::Beat;
+use crate::beat::{Beat, Pulse};
 use crate::clock::{estimate, Offset};
 use crate::credentials::{self, Side};
 use crate::keys;
@@ -108,20 +108,14 @@ fn proxy(host: &str, connect: &str, builtin: &str) -> Result<i32, String> {
     lockstep::ready_then_wait_for_go().map_err(|e| e.to_string())?;
     go.put(format!("go {} {}", offset.theta_ns, offset.rtt_ns).as_bytes())?;
     beat.arm();
+    watchdog(&z, beat.pulse(), host, name);
 
     let mut idle = Idle::new();
-    let mut checked = Instant::now();
     loop {
         let worked = exports.pump()? + imports.pump()? > 0;
-        // The worker's token goes when its session does; every 100 ms the agent's own link (over
-        // QUIC a killed agent sends nothing, and only the lease ends the session) and the
-        // worker's sealed heartbeat are checked too.
-        let agent_gone = checked.elapsed() > Duration::from_millis(100) && {
-            checked = Instant::now();
-            z.info().routers_zid().wait().next().is_none() || !beat.alive()
-        };
-        if agent_gone || matches!(worker.try_recv(), Ok(Some(s)) if s.kind() == SampleKind::Delete) {
-            return Err(format!("lost its agent while {name} ran (the link was cut, or the agent or the host stopped)"));
+        // The worker's token goes when its session does (the watchdog covers what it misses).
+        if matches!(worker.try_recv(), Ok(Some(s)) if s.kind() == SampleKind::Delete) {
+            return Err(lost(name));
         }
         if let Some(line) = status.try_recv_text() {
             return finish(name, host, &line, &mut imports);
@@ -167,6 +161,25 @@ fn wait_for_agent(z: &zenoh::Session, host: &str, connect: &str) -> Result<(), S
         }
         std::thread::sleep(Duration::from_millis(50));
     }
+}
+
+fn lost(name: &str) -> String {
+    format!("lost its agent while {name} ran (the link was cut, or the agent or the host stopped)")
+}
+
+/// Ends the proxy (exit 3, naming the host) when the agent's link is gone or the worker's
+/// sealed heartbeat stops — from a thread of its own, every 100 ms, since the loop may be
+/// blocked in a publish on that dead link: over QUIC a killed agent sends nothing, and Zenoh's
+/// lease alone let such a run go on past the launcher's 5 s hang rule.
+fn watchdog(z: &zenoh::Session, pulse: Pulse, host: &str, name: &str) {
+    let (z, host, name) = (z.clone(), host.to_string(), name.to_string());
+    std::thread::spawn(move || loop {
+        std::thread::sleep(Duration::from_millis(100));
+        if z.info().routers_zid().wait().next().is_none() || !pulse.alive() {
+            eprintln!("host {host}: {}", lost(&name));
+            std::process::exit(FAILED);
+        }
+    });
 }
 
 /// Opens the client session to the agent. A flood of idle connections can hold the agent's
