@@ -14,6 +14,7 @@
 
 use lti::{Mat, Model};
 use nalgebra::DVector;
+use observer::design::Gain;
 use observer::{design, Designed, Spec};
 
 use crate::covariance::residual_covariance;
@@ -125,8 +126,8 @@ pub fn design_bank(spec: &DiagnoserSpec, model: &Model, ff: &Mat, dt: f64, noise
         };
         let fail = |key: &'static str, reason: String| BankError { member: Some(i), key, reason };
         let observer_spec = match &spec.member {
-            MemberKind::ChenPatton { poles, placement } => Spec::ChenPatton { poles: poles.clone(), placement: *placement },
-            MemberKind::Luenberger { poles, placement } => Spec::Luenberger { poles: poles.clone(), placement: *placement },
+            MemberKind::ChenPatton { poles, placement } => Spec::ChenPatton { gain: Gain::place(poles.clone(), *placement) },
+            MemberKind::Luenberger { poles, placement } => Spec::Luenberger { gain: Gain::place(poles.clone(), *placement) },
             MemberKind::Kalman => {
                 let (qd, r) = noise.ok_or_else(|| fail("observer", "a kalman member needs [noise]".into()))?;
                 Spec::Kalman { qd: qd.clone(), r: r.select_rows(&outputs).select_columns(&outputs) }

@@ -9,7 +9,7 @@
 use lti::eig::{eigenvalues, match_error};
 use lti::place::Method;
 use lti::{Mat, Model, PoleSpec, Poles, C64};
-use observer::design::{design, Path, Spec};
+use observer::design::{design, Gain, Path, Spec};
 
 #[path = "../../fixtures/zero_plants.rs"]
 mod zero_plants;
@@ -38,7 +38,7 @@ fn dc_motor() -> Model {
 #[test]
 fn dc_motor_chen_patton_takes_the_free_poles_and_keeps_the_zero() {
     let dt = 1e-3;
-    let spec = Spec::ChenPatton { poles: real(&[-20.0, -30.0]), placement: Method::YangTits };
+    let spec = Spec::ChenPatton { gain: Gain::place(real(&[-20.0, -30.0]), Method::YangTits) };
     let d = design(&dc_motor(), &spec, dt).unwrap_or_else(|e| panic!("{e}"));
     let want = [C64::new(-2.0, 0.0), C64::new(-20.0, 0.0), C64::new(-30.0, 0.0)];
     assert!(match_error(&want, &d.report.poles) < 1e-8, "{:?}", d.report.poles);
@@ -51,7 +51,7 @@ fn dc_motor_chen_patton_takes_the_free_poles_and_keeps_the_zero() {
 
 #[test]
 fn dc_motor_refuses_three_poles_and_says_how_many() {
-    let spec = Spec::ChenPatton { poles: real(&[-20.0, -30.0, -40.0]), placement: Method::YangTits };
+    let spec = Spec::ChenPatton { gain: Gain::place(real(&[-20.0, -30.0, -40.0]), Method::YangTits) };
     let e = design(&dc_motor(), &spec, 1e-3).unwrap_err();
     assert!(e.detail.contains("give 2 pole(s)"), "{e}");
     assert!(!e.condition.contains("sampled"), "the continuous design refuses, not the sampled one: {e}");
@@ -60,7 +60,7 @@ fn dc_motor_refuses_three_poles_and_says_how_many() {
 #[test]
 fn dc_motor_hui_zak_designs_with_default_poles() {
     let dt = 1e-3;
-    let spec = Spec::HuiZak { decay: 1.0, poles: None, placement: Method::YangTits, path: Path::Placement };
+    let spec = Spec::HuiZak { decay: 1.0, gain: None, placement: Method::YangTits, path: Path::Placement };
     let d = design(&dc_motor(), &spec, dt).unwrap_or_else(|e| panic!("{e}"));
     assert!(match_error(&[C64::new(-2.0, 0.0)], &d.report.fixed_modes) < 1e-9);
     assert!(match_error(&images(&d.report.poles, dt), &d.report.discrete_poles) < 1e-10);
@@ -76,8 +76,8 @@ fn random_plants_with_invariant_zeros_design_the_same_spectrum_in_both_domains()
         let i = format!("{seed}/{i}");
         let free: Vec<f64> = (0..m.n() - zeros.len()).map(|j| -5.0 - 3.0 * j as f64).collect();
         for (kind, spec) in [
-            ("chen-patton", Spec::ChenPatton { poles: real(&free), placement: Method::YangTits }),
-            ("hui-zak", Spec::HuiZak { decay: 0.0, poles: Some(real(&free)), placement: Method::YangTits, path: Path::Placement }),
+            ("chen-patton", Spec::ChenPatton { gain: Gain::place(real(&free), Method::YangTits) }),
+            ("hui-zak", Spec::HuiZak { decay: 0.0, gain: Some(Gain::place(real(&free), Method::YangTits)), placement: Method::YangTits, path: Path::Placement }),
         ] {
             let d = design(&m, &spec, dt).unwrap_or_else(|e| panic!("case {i} {kind}: {e}"));
             let mut want: Vec<C64> = free.iter().map(|&p| C64::new(p, 0.0)).collect();
@@ -102,10 +102,10 @@ fn empty_pole_list_for_a_pair_with_only_fixed_modes() {
         d: Mat::zeros(2, 0),
     };
     let none = Poles::new([]).unwrap();
-    let d = design(&m, &Spec::DasGhosalUio { h: None, poles: Some(none), placement: Method::YangTits }, 1e-3);
+    let d = design(&m, &Spec::DasGhosalUio { h: None, gain: Some(Gain::place(none, Method::YangTits)) }, 1e-3);
     let d = d.unwrap_or_else(|e| panic!("{e}"));
     assert!(match_error(&[C64::new(-1.0, 0.0)], &d.report.poles) < 1e-9, "{:?}", d.report.poles);
     // One pole where none fits: the message says what to write.
-    let e = design(&m, &Spec::DasGhosalUio { h: None, poles: Some(real(&[-5.0])), placement: Method::YangTits }, 1e-3).unwrap_err();
+    let e = design(&m, &Spec::DasGhosalUio { h: None, gain: Some(Gain::place(real(&[-5.0]), Method::YangTits)) }, 1e-3).unwrap_err();
     assert!(e.detail.contains("give 0 pole(s)") && e.detail.contains("poles = []"), "{e}");
 }

@@ -3,7 +3,7 @@
 
 use lti::place::Method;
 use lti::{Mat, Model, PoleSpec, Poles, C64};
-use observer::design::{design, Path, Spec};
+use observer::design::{design, Gain, Path, Spec};
 use serde_json::Value;
 
 #[path = "../../fixtures/reader.rs"]
@@ -34,7 +34,7 @@ fn seed002() -> Model {
 #[test]
 fn seed002_chen_patton_matlab_mode() {
     let s = &seeds()["seed_002"];
-    let spec = Spec::ChenPatton { poles: real(&[-1.0, -2.0, -3.0]), placement: Method::Matlab };
+    let spec = Spec::ChenPatton { gain: Gain::place(real(&[-1.0, -2.0, -3.0]), Method::Matlab) };
     let d = design(&seed002(), &spec, 1e-3).unwrap();
     let r = &d.report;
     let h = Mat::from_row_slice(3, 2, &[16.0, 4.0, 0.0, 0.0, 4.0, 1.0]) / 17.0;
@@ -61,7 +61,7 @@ fn seed002_sampled_observer_rejects_held_disturbance_exactly() {
     // T_d E_d = 0: run the sampled plant with a held disturbance and check ‖e_k‖ = ‖F_d^k e_0‖.
     let model = seed002();
     let dt = 1e-2;
-    let spec = Spec::ChenPatton { poles: real(&[-1.0, -2.0, -3.0]), placement: Method::YangTits };
+    let spec = Spec::ChenPatton { gain: Gain::place(real(&[-1.0, -2.0, -3.0]), Method::YangTits) };
     let obs = design(&model, &spec, dt).unwrap().runtime;
     let dm = model.discretize(dt);
     let mut state = obs.instantiate();
@@ -90,7 +90,7 @@ fn seed001_gi_full_order_matlab_gain() {
     let s = &seeds()["seed_001"];
     let m = &s["model"];
     let model = Model { a: mat(&m["A"]), b: mat(&m["B"]), c: mat(&m["C"]), e: Mat::zeros(4, 0), d: Mat::zeros(2, 0) };
-    let spec = Spec::GiFullOrder { poles: real(&[-47.0, -52.0, -600.0, -700.0]), placement: Method::Matlab };
+    let spec = Spec::GiFullOrder { gain: Gain::place(real(&[-47.0, -52.0, -600.0, -700.0]), Method::Matlab) };
     let r = design(&model, &spec, 1e-4).unwrap().report;
     let k = matrix(&r, "K");
     let printed = [[13.0, 510.0, 445.0, 79934.0], [3.0, 23.0, 20.0, 95.0]];
@@ -110,8 +110,8 @@ fn seed003_dgo_and_cumming_coincide_with_the_reference() {
     let m = &s["model"];
     let model = Model { a: mat(&m["A"]), b: mat(&m["B"]), c: mat(&m["C"]), e: Mat::zeros(4, 0), d: Mat::zeros(2, 0) };
     let poles = real(&[-8.0, -9.0]);
-    let dgo = design(&model, &Spec::DasGhosal { poles: poles.clone(), placement: Method::YangTits }, 1e-3).unwrap();
-    let cum = design(&model, &Spec::Cumming { poles, placement: Method::YangTits, h: None }, 1e-3).unwrap();
+    let dgo = design(&model, &Spec::DasGhosal { gain: Gain::place(poles.clone(), Method::YangTits) }, 1e-3).unwrap();
+    let cum = design(&model, &Spec::Cumming { gain: Gain::place(poles, Method::YangTits), h: None }, 1e-3).unwrap();
     let dg = &s["DGO"];
     assert!(close(matrix(&dgo.report, "L"), &mat(&dg["L"]), 0.0));
     assert!(close(matrix(&dgo.report, "Lg"), &mat(&dg["Lg"]), 1e-15));
@@ -145,7 +145,7 @@ fn seed000() -> (Model, Value) {
 fn seed000_das_ghosal_uio_with_printed_h() {
     let (model, s) = seed000();
     let h = Mat::from_row_slice(2, 2, &[0.8, 1.0, 1.0, 0.8]);
-    let spec = Spec::DasGhosalUio { h: Some(h), poles: None, placement: Method::YangTits };
+    let spec = Spec::DasGhosalUio { h: Some(h), gain: None };
     let r = design(&model, &spec, 1e-4).unwrap().report;
     assert!(close(matrix(&r, "K"), &Mat::from_row_slice(2, 2, &[-0.1, 0.1, 0.1, -0.1]), 1e-15));
     assert!(close(matrix(&r, "F"), &mat(&s["design"]["F = LgAL - KCAL"]), 1e-9));
@@ -158,7 +158,7 @@ fn seed000_das_ghosal_uio_with_printed_h() {
 #[test]
 fn seed000_das_ghosal_uio_h_by_placement() {
     let (model, _) = seed000();
-    let spec = Spec::DasGhosalUio { h: None, poles: Some(real(&[-100.0, -120.0])), placement: Method::YangTits };
+    let spec = Spec::DasGhosalUio { h: None, gain: Some(Gain::place(real(&[-100.0, -120.0]), Method::YangTits)) };
     let d = design(&model, &spec, 1e-4).unwrap();
     let want = [C64::new(-120.0, 0.0), C64::new(-100.0, 0.0)];
     assert!(eig_close(&d.report.poles, &want, 1e-9), "{:?}", d.report.poles);
@@ -185,14 +185,14 @@ fn seed004_hui_zak_lmi_path() {
 #[cfg(not(feature = "lmi"))]
 #[test]
 fn seed004_lmi_path_needs_the_feature() {
-    let spec = Spec::HuiZak { decay: 0.05, poles: None, placement: Method::YangTits, path: Path::Lmi };
+    let spec = Spec::HuiZak { decay: 0.05, gain: None, placement: Method::YangTits, path: Path::Lmi };
     let err = design(&seed004(), &spec, 1e-3).unwrap_err();
     assert!(err.detail.contains("lmi"), "{err}");
 }
 
 fn seed004_hui_zak(path: Path) {
     let s = &seeds()["seed_004"];
-    let spec = Spec::HuiZak { decay: 0.05, poles: None, placement: Method::YangTits, path };
+    let spec = Spec::HuiZak { decay: 0.05, gain: None, placement: Method::YangTits, path };
     let r = design(&seed004(), &spec, 1e-3).unwrap().report;
     assert!(close(matrix(&r, "M"), &mat(&s["design"]["M"]), 1e-12));
     assert!(close(matrix(&r, "A1"), &mat(&s["design"]["A1=(I-MC)A"]), 1e-12));
@@ -220,7 +220,7 @@ fn existence_conditions_refuse_with_the_condition_named() {
     let mut m = seed002();
     m.e = Mat::from_row_slice(3, 2, &[1.0, 0.0, 0.0, 1.0, 0.0, 0.0]);
     m.c = Mat::from_row_slice(1, 3, &[1.0, 0.0, 0.0]);
-    let err = design(&m, &Spec::ChenPatton { poles: real(&[-1.0, -2.0, -3.0]), placement: Method::YangTits }, 1e-3).unwrap_err();
+    let err = design(&m, &Spec::ChenPatton { gain: Gain::place(real(&[-1.0, -2.0, -3.0]), Method::YangTits) }, 1e-3).unwrap_err();
     assert_eq!(err.condition, "rank(CE) = rank(E)");
     // An unstable invariant zero (+1) of (A, E, C).
     let m = Model {
@@ -230,7 +230,7 @@ fn existence_conditions_refuse_with_the_condition_named() {
         e: Mat::from_row_slice(2, 1, &[0.0, 1.0]),
         d: Mat::zeros(1, 0),
     };
-    let err = design(&m, &Spec::ChenPatton { poles: real(&[-1.0]), placement: Method::YangTits }, 1e-3).unwrap_err();
+    let err = design(&m, &Spec::ChenPatton { gain: Gain::place(real(&[-1.0]), Method::YangTits) }, 1e-3).unwrap_err();
     assert_eq!(err.condition, "invariant zeros of (A, E, C) stable");
     assert!(err.detail.contains('1') && err.detail.contains("(TA, C) is not detectable"), "{}", err.detail);
     // (A, CA) with an unobservable unstable mode: the generalized-inverse observer is refused.
@@ -241,7 +241,7 @@ fn existence_conditions_refuse_with_the_condition_named() {
         e: Mat::zeros(2, 0),
         d: Mat::zeros(1, 0),
     };
-    let err = design(&m, &Spec::GiFullOrder { poles: real(&[-1.0, -2.0]), placement: Method::YangTits }, 1e-3).unwrap_err();
+    let err = design(&m, &Spec::GiFullOrder { gain: Gain::place(real(&[-1.0, -2.0]), Method::YangTits) }, 1e-3).unwrap_err();
     assert_eq!(err.condition, "(A, CA) detectable");
 }
 
@@ -250,7 +250,7 @@ fn seed004_sampled_observer_rejects_held_disturbances_exactly() {
     // x_{k+1} = A_d x_k + B2d w_k, y_k = C x_k + D v_k with w, v arbitrary but held.
     let model = seed004();
     let dt = 1e-3;
-    let spec = Spec::HuiZak { decay: 0.05, poles: None, placement: Method::YangTits, path: Path::Placement };
+    let spec = Spec::HuiZak { decay: 0.05, gain: None, placement: Method::YangTits, path: Path::Placement };
     let obs = design(&model, &spec, dt).unwrap().runtime;
     let dm = model.discretize(dt);
     let mut state = obs.instantiate();

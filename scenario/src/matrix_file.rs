@@ -25,7 +25,9 @@ pub(crate) fn load_all(raw: &mut RawScenario, dir: &Path) -> Result<(), Bad> {
         }
     }
     for (i, o) in raw.observer.iter_mut().enumerate() {
-        fields.extend(o.h.as_mut().map(|m| (format!("observer[{}].H", i + 1), m)));
+        for (name, m) in [("H", &mut o.h), ("Q", &mut o.q), ("R", &mut o.r)] {
+            fields.extend(m.as_mut().map(|m| (format!("observer[{}].{name}", i + 1), m)));
+        }
     }
     if let Some(c) = raw.controller.as_mut() {
         for (name, m) in [("controller.gain", &mut c.gain), ("controller.track", &mut c.track)] {

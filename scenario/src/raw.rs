@@ -202,6 +202,14 @@ pub struct RawObserver {
     pub h: Option<Rows>,
     pub decay: Option<f64>,
     pub path: Option<String>,
+    /// `gain = "lqe"`: the free gain from the DARE of the sampled error pair, instead of poles.
+    pub gain: Option<String>,
+    /// LQE process weight (n×n, or the reduced order's size).
+    #[serde(rename = "Q")]
+    pub q: Option<Rows>,
+    /// LQE measurement weight (p×p).
+    #[serde(rename = "R")]
+    pub r: Option<Rows>,
     /// `kind = "process"`: the command and its parameters.
     pub command: Option<Vec<String>>,
     pub params: Option<toml::Table>,

@@ -8,6 +8,7 @@ use lti::place::Method;
 use lti::signal::Signal;
 use lti::{Mat, Model, PoleSpec, Poles};
 use observer::design::Path as HuiZakPath;
+use observer::design::{Gain, Weights};
 use observer::Spec;
 
 use super::limits::{MAX_FAULTS, MAX_OBSERVERS, MAX_STEPS};
@@ -277,7 +278,16 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
         }
         observers.push(if o.kind == "process" {
             let process = process_spec(&f, &o.command, &o.params)?;
-            for (key, given) in [("poles", o.poles.is_some()), ("placement", o.placement.is_some()), ("H", o.h.is_some()), ("decay", o.decay.is_some()), ("path", o.path.is_some())] {
+            for (key, given) in [
+                ("poles", o.poles.is_some()),
+                ("placement", o.placement.is_some()),
+                ("H", o.h.is_some()),
+                ("decay", o.decay.is_some()),
+                ("path", o.path.is_some()),
+                ("gain", o.gain.is_some()),
+                ("Q", o.q.is_some()),
+                ("R", o.r.is_some()),
+            ] {
                 if given {
                     return Err(bad(format!("{f}.{key}"), "a process observer takes no design keys (only command and params)"));
                 }
@@ -373,11 +383,6 @@ fn observer_spec(f: &str, o: &RawObserver, model: &Model, noise: Option<&super::
         return Err(bad(format!("{f}.kind"), format!("{} is not an observer kind ({}, process)", quoted(&o.kind), KINDS.join(", "))));
     }
     let method = placement(&format!("{f}.placement"), &o.placement)?;
-    let needs_poles = || match &o.poles {
-        Some(p) => poles(&format!("{f}.poles"), p),
-        None => Err(bad(format!("{f}.poles"), format!("a {} observer needs poles", o.kind))),
-    };
-    let opt_poles = || o.poles.as_ref().map(|p| poles(&format!("{f}.poles"), p)).transpose();
     let refuse = |key: &str, given: bool| {
         if given { Err(bad(format!("{f}.{key}"), format!("a {} observer takes no {key}", o.kind))) } else { Ok(()) }
     };
@@ -390,29 +395,43 @@ fn observer_spec(f: &str, o: &RawObserver, model: &Model, noise: Option<&super::
         refuse("H", o.h.is_some())?;
     }
     if o.kind == "kalman" {
-        for (key, given) in [("poles", o.poles.is_some()), ("placement", o.placement.is_some())] {
+        for (key, given) in [("poles", o.poles.is_some()), ("placement", o.placement.is_some()), ("gain", o.gain.is_some()), ("Q", o.q.is_some()), ("R", o.r.is_some())] {
             refuse(key, given)?;
         }
         let z = noise.ok_or_else(|| bad(format!("{f}.kind"), "a kalman observer needs [noise]: its covariances are the filter's"))?;
         return Ok(Spec::Kalman { qd: z.qd.clone(), r: z.r.clone() });
     }
+    let lqe = lqe_weights(f, o, model, noise)?;
+    if lqe.is_some() && o.poles.is_some() {
+        return Err(bad(format!("{f}.gain"), "give poles or gain = \"lqe\", not both (the DARE chooses the poles)"));
+    }
+    let gain = |required: bool| -> Result<Option<Gain>, Bad> {
+        match (&lqe, &o.poles) {
+            (Some(w), _) => Ok(Some(Gain::Lqe(w.clone()))),
+            (None, Some(ps)) => Ok(Some(Gain::place(poles(&format!("{f}.poles"), ps)?, method))),
+            (None, None) if required => Err(bad(format!("{f}.poles"), format!("a {} observer needs poles (or gain = \"lqe\")", o.kind))),
+            (None, None) => Ok(None),
+        }
+    };
+    let needs_gain = || gain(true).map(|g| g.expect("required"));
     Ok(match o.kind.as_str() {
-        "luenberger" => Spec::Luenberger { poles: needs_poles()?, placement: method },
-        "chen-patton-uio" => Spec::ChenPatton { poles: needs_poles()?, placement: method },
-        "das-ghosal" => Spec::DasGhosal { poles: needs_poles()?, placement: method },
-        "gi-full-order" => Spec::GiFullOrder { poles: needs_poles()?, placement: method },
+        "luenberger" => Spec::Luenberger { gain: needs_gain()? },
+        "chen-patton-uio" => Spec::ChenPatton { gain: needs_gain()? },
+        "das-ghosal" => Spec::DasGhosal { gain: needs_gain()? },
+        "gi-full-order" => Spec::GiFullOrder { gain: needs_gain()? },
         "das-ghosal-uio" => {
             let h = o.h.as_ref().map(|h| matrix(&format!("{f}.H"), h, (Some(n - p.min(n)), Some(p)), "(n − p)×p, the free matrix of eq. 22")).transpose()?;
-            if h.is_some() && o.poles.is_some() {
-                return Err(bad(format!("{f}.poles"), "give H or poles, not both (H fixes the poles)"));
+            if h.is_some() && (o.poles.is_some() || lqe.is_some()) {
+                let key = if lqe.is_some() { "gain" } else { "poles" };
+                return Err(bad(format!("{f}.{key}"), format!("give H or {key}, not both (H fixes the poles)")));
             }
-            // Neither given: no free poles (poles = []), right when every mode of the pair is fixed.
-            let poles = if h.is_none() { Some(opt_poles()?.unwrap_or_else(|| Poles::new([]).expect("empty"))) } else { None };
-            Spec::DasGhosalUio { h, poles, placement: method }
+            // None given: no free poles (poles = []), right when every mode of the pair is fixed.
+            let gain = if h.is_none() { Some(gain(false)?.unwrap_or_else(|| Gain::place(Poles::new([]).expect("empty"), method))) } else { None };
+            Spec::DasGhosalUio { h, gain }
         }
         "cumming" => {
             let h = o.h.as_ref().map(|h| matrix(&format!("{f}.H"), h, (Some(n - p.min(n)), Some(n)), "(n − p)×n, completing C to an invertible [C; H]")).transpose()?;
-            Spec::Cumming { poles: needs_poles()?, placement: method, h }
+            Spec::Cumming { gain: needs_gain()?, h }
         }
         "hui-zak-uio" => {
             let decay = finite(&format!("{f}.decay"), o.decay.unwrap_or(0.0))?;
@@ -424,9 +443,75 @@ fn observer_spec(f: &str, o: &RawObserver, model: &Model, noise: Option<&super::
                 Some("lmi") => HuiZakPath::Lmi,
                 Some(other) => return Err(bad(format!("{f}.path"), format!("{} is not a design path (placement, lmi)", quoted(other)))),
             };
-            Spec::HuiZak { decay, poles: opt_poles()?, placement: method, path }
+            if path == HuiZakPath::Lmi && lqe.is_some() {
+                return Err(bad(format!("{f}.path"), "gain = \"lqe\" takes L from a DARE, not from the LMI: drop path = \"lmi\""));
+            }
+            Spec::HuiZak { decay, gain: gain(false)?, placement: method, path }
         }
         _ => unreachable!("kind checked above"),
+    })
+}
+
+/// `gain = "lqe"` with its weights: Q (n×n, or the reduced order r = n − rank C of a reduced-order
+/// family) symmetric ⪰ 0, R (p×p) symmetric ≻ 0. Not given, they default to `[noise]`'s Q_d and R
+/// where those are non-zero (the filter's own statistics), else to identities at the design.
+fn lqe_weights(f: &str, o: &RawObserver, model: &Model, noise: Option<&super::NoiseSpec>) -> Result<Option<Weights>, Bad> {
+    match o.gain.as_deref() {
+        None => {
+            for (key, given) in [("Q", o.q.is_some()), ("R", o.r.is_some())] {
+                if given {
+                    return Err(bad(format!("{f}.{key}"), "weights belong to gain = \"lqe\" (add it, or drop the weight)"));
+                }
+            }
+            return Ok(None);
+        }
+        Some("lqe") => {}
+        Some(other) => return Err(bad(format!("{f}.gain"), format!("{} is not a gain (lqe; or give poles instead)", quoted(other)))),
+    }
+    if o.placement.is_some() {
+        return Err(bad(format!("{f}.placement"), "gain = \"lqe\" places nothing: drop placement"));
+    }
+    let (n, p) = (model.n(), model.p());
+    let reduced = matches!(o.kind.as_str(), "das-ghosal" | "das-ghosal-uio" | "cumming").then(|| n - lti::pinv::rank(&model.c).min(n));
+    let sizes = match reduced {
+        Some(r) if r != n => format!("{n}×{n} (the plant's state) or {r}×{r} (the reduced order)"),
+        _ => format!("{n}×{n} (the plant's state)"),
+    };
+    let q = o
+        .q
+        .as_ref()
+        .map(|rows| {
+            let field = format!("{f}.Q");
+            let m = matrix(&field, rows, (None, None), "")?;
+            if !(m.is_square() && (m.nrows() == n || Some(m.nrows()) == reduced)) {
+                return Err(bad(&field, format!("is {}×{}, must be {sizes}", m.nrows(), m.ncols())));
+            }
+            definite(&field, "Q", &m, lti::dare::Definite::Semi)
+        })
+        .transpose()?;
+    let r = o
+        .r
+        .as_ref()
+        .map(|rows| {
+            let field = format!("{f}.R");
+            let m = matrix(&field, rows, (Some(p), Some(p)), "one row and column per output")?;
+            definite(&field, "R", &m, lti::dare::Definite::Positive)
+        })
+        .transpose()?;
+    let nonzero = |m: &Mat| m.iter().any(|&v| v != 0.0);
+    let q = q.or_else(|| noise.map(|z| z.qd.clone()).filter(nonzero));
+    let r = r.or_else(|| noise.map(|z| z.r.clone()).filter(|m| nonzero(m) && lti::dare::symmetric("R", m, lti::dare::Definite::Positive).is_ok()));
+    Ok(Some(Weights { q, r }))
+}
+
+/// A weight that must be symmetric and (semi-)definite, by the DARE's own rule.
+fn definite(field: &str, symbol: &str, m: &Mat, how: lti::dare::Definite) -> Result<Mat, Bad> {
+    lti::dare::symmetric(symbol, m, how).map_err(|e| {
+        let reason = match e {
+            lti::LtiError::InvalidInput(r) => r,
+            other => other.to_string(),
+        };
+        bad(field, reason)
     })
 }
 

@@ -33,7 +33,7 @@ kind = "das-ghosal-uio"
 "#;
 
 fn empty_poles(s: &Scenario) -> bool {
-    matches!(&s.observers[0].spec, Some(observer::Spec::DasGhosalUio { h: None, poles: Some(p), .. }) if p.is_empty())
+    matches!(&s.observers[0].spec, Some(observer::Spec::DasGhosalUio { h: None, gain: Some(observer::design::Gain::Place { poles: p, .. }) }) if p.is_empty())
 }
 
 #[test]

@@ -13,12 +13,11 @@
 //! T_d E_d = 0 exactly, so a disturbance held over each step is rejected at every sample.
 
 use lti::eig::format_list;
-use lti::place::Method;
 use lti::pinv::{pinv, rank};
 use lti::zeros::decoupling;
-use lti::{Mat, Model, Poles, C64};
+use lti::{Mat, Model, C64};
 
-use super::{eig, eq_detail, place_detectable, require_stable, Checks, Designed, DesignError, Domain, Report};
+use super::{eig, eq_detail, free_gain, require_stable, sampled_report, Checks, Designed, DesignError, Domain, Gain, Pair, Report};
 use crate::runtime::LinearObserver;
 
 const KIND: &str = "chen-patton-uio";
@@ -38,9 +37,8 @@ pub(super) fn core(
     a: &Mat,
     c: &Mat,
     e: &Mat,
-    poles: &Poles,
+    gain: &Gain,
     carried: &[C64],
-    method: Method,
     domain: Domain,
     checks: &mut Checks,
 ) -> Result<Core, DesignError> {
@@ -67,37 +65,35 @@ pub(super) fn core(
     let h = e * pinv(&ce);
     let t = Mat::identity(n, n) - &h * c;
     let ta = &t * a;
-    let (k1, fixed) = place_detectable(checks, &ta, c, poles, carried, method, "(TA, C)", domain)?;
+    let (k1, fixed) = free_gain(checks, &Pair::full(&ta, c, "(TA, C)"), gain, carried, domain)?;
     let f = &ta - &k1 * c;
     require_stable(checks, "F = TA − K1C stable", &eig(&f), domain)?;
     let k2 = &f * &h;
     Ok(Core { h, t, k1, k2, f, fixed })
 }
 
-pub(super) fn design(model: &Model, poles: &Poles, method: Method, dt: f64) -> Result<Designed, DesignError> {
+pub(super) fn design(model: &Model, gain: &Gain, dt: f64) -> Result<Designed, DesignError> {
     let mut checks = Checks::new(KIND);
-    let ct = core(&model.a, &model.c, &model.e, poles, &[], method, Domain::Continuous, &mut checks)?;
+    let ct = if gain.is_lqe() { None } else { Some(core(&model.a, &model.c, &model.e, gain, &[], Domain::Continuous, &mut checks)?) };
+    let carried = ct.as_ref().map(|c| c.fixed.clone()).unwrap_or_default();
     let dm = model.discretize(dt);
     let mut sampled = Checks::sampled(KIND, dt);
-    let d = core(&dm.a, &dm.c, &dm.e, poles, &ct.fixed, method, Domain::Discrete(dt), &mut sampled)?;
+    let d = core(&dm.a, &dm.c, &dm.e, gain, &carried, Domain::Discrete(dt), &mut sampled)?;
     let n = model.n();
     let runtime = LinearObserver::new(&d.f, &(&d.t * &dm.b), &(&d.k1 + &d.k2), &Mat::identity(n, n), &d.h);
-    Ok(Designed {
-        report: Report {
+    let matrices = |c: &Core| vec![("H".into(), c.h.clone()), ("T".into(), c.t.clone()), ("K1".into(), c.k1.clone()), ("K2".into(), c.k2.clone()), ("F".into(), c.f.clone())];
+    let report = match ct {
+        Some(ct) => Report {
             kind: KIND,
             conditions: checks.into_list(),
             poles: eig(&ct.f),
             discrete_poles: eig(&d.f),
+            matrices: matrices(&ct),
             fixed_modes: ct.fixed,
-            matrices: vec![
-                ("H".into(), ct.h),
-                ("T".into(), ct.t),
-                ("K1".into(), ct.k1),
-                ("K2".into(), ct.k2),
-                ("F".into(), ct.f),
-            ],
             notes: vec![],
+            sampled_only: false,
         },
-        runtime,
-    })
+        None => sampled_report(KIND, sampled, &d.f, d.fixed.clone(), matrices(&d), vec![], dt),
+    };
+    Ok(Designed { report, runtime })
 }

@@ -12,12 +12,11 @@
 //!
 //! Sampled counterpart: the same equations with A_d, B_d (as for Das–Ghosal).
 
-use lti::place::Method;
 use lti::pinv::rank;
-use lti::{Mat, Model, Poles, C64};
+use lti::{Mat, Model, C64};
 
 use super::das_ghosal::independent_columns_of_complement;
-use super::{eig, eq_detail, place_detectable, require_stable, Checks, Designed, DesignError, Domain, Report};
+use super::{eig, eq_detail, free_gain, require_stable, sampled_report, Checks, Designed, DesignError, Domain, Gain, Pair, Report};
 use crate::runtime::LinearObserver;
 
 const KIND: &str = "cumming";
@@ -33,7 +32,7 @@ struct Core {
 }
 
 #[allow(clippy::too_many_arguments)]
-fn core(a: &Mat, b: &Mat, c: &Mat, h: &Mat, poles: &Poles, carried: &[C64], method: Method, domain: Domain, checks: &mut Checks) -> Result<Core, DesignError> {
+fn core(a: &Mat, b: &Mat, c: &Mat, h: &Mat, gain: &Gain, carried: &[C64], domain: Domain, checks: &mut Checks) -> Result<Core, DesignError> {
     let n = a.nrows();
     let p = c.nrows();
     let mut ch = Mat::zeros(n, n);
@@ -46,7 +45,9 @@ fn core(a: &Mat, b: &Mat, c: &Mat, h: &Mat, poles: &Poles, carried: &[C64], meth
     let f = inv.columns(p, n - p).into_owned();
     let haf = h * a * &f;
     let caf = c * a * &f;
-    let (k, fixed) = place_detectable(checks, &haf, &caf, poles, carried, method, "(HAF, CAF)", domain)?;
+    // The pair's state is z = Hx; its output CAF·z is the part of ẏ (y_{k+1}) that z drives.
+    let pair = Pair { a: &haf, c: &caf, name: "(HAF, CAF)", state_map: Some(h), output_map: None };
+    let (k, fixed) = free_gain(checks, &pair, gain, carried, domain)?;
     let fo = &haf - &k * &caf;
     require_stable(checks, "HAF − KCAF stable", &eig(&fo), domain)?;
     let ky = &fo * &k + h * a * &e - &k * c * a * &e;
@@ -54,7 +55,7 @@ fn core(a: &Mat, b: &Mat, c: &Mat, h: &Mat, poles: &Poles, carried: &[C64], meth
     Ok(Core { e, f, k, fo, ky, ku, fixed })
 }
 
-pub(super) fn design(model: &Model, poles: &Poles, method: Method, h: Option<&Mat>, dt: f64) -> Result<Designed, DesignError> {
+pub(super) fn design(model: &Model, gain: &Gain, h: Option<&Mat>, dt: f64) -> Result<Designed, DesignError> {
     let mut checks = Checks::new(KIND);
     let (n, p) = (model.n(), model.p());
     let h = match h {
@@ -67,28 +68,28 @@ pub(super) fn design(model: &Model, poles: &Poles, method: Method, h: Option<&Ma
     if h.nrows() != n - p {
         return Err(checks.error("C", format!("must have full row rank {p} for Cumming's observer")));
     }
-    let ct = core(&model.a, &model.b, &model.c, &h, poles, &[], method, Domain::Continuous, &mut checks)?;
+    let ct = if gain.is_lqe() { None } else { Some(core(&model.a, &model.b, &model.c, &h, gain, &[], Domain::Continuous, &mut checks)?) };
+    let carried = ct.as_ref().map(|c| c.fixed.clone()).unwrap_or_default();
     let dm = model.discretize(dt);
     let mut sampled = Checks::sampled(KIND, dt);
-    let d = core(&dm.a, &dm.b, &dm.c, &h, poles, &ct.fixed, method, Domain::Discrete(dt), &mut sampled)?;
+    let d = core(&dm.a, &dm.b, &dm.c, &h, gain, &carried, Domain::Discrete(dt), &mut sampled)?;
     let q = &d.e + &d.f * &d.k;
     let runtime = LinearObserver::new(&d.fo, &d.ku, &d.ky, &d.f, &q);
-    Ok(Designed {
-        report: Report {
+    let matrices = |c: &Core| {
+        vec![("H".into(), h.clone()), ("E".into(), c.e.clone()), ("F".into(), c.f.clone()), ("K".into(), c.k.clone()), ("HAF-KCAF".into(), c.fo.clone())]
+    };
+    let report = match ct {
+        Some(ct) => Report {
             kind: KIND,
             conditions: checks.into_list(),
             poles: eig(&ct.fo),
             discrete_poles: eig(&d.fo),
+            matrices: matrices(&ct),
             fixed_modes: ct.fixed,
-            matrices: vec![
-                ("H".into(), h),
-                ("E".into(), ct.e),
-                ("F".into(), ct.f),
-                ("K".into(), ct.k),
-                ("HAF-KCAF".into(), ct.fo),
-            ],
             notes: vec![],
+            sampled_only: false,
         },
-        runtime,
-    })
+        None => sampled_report(KIND, sampled, &d.fo, d.fixed.clone(), matrices(&d), vec![], dt),
+    };
+    Ok(Designed { report, runtime })
 }

@@ -22,20 +22,19 @@
 //! plays the role of ẏ, and the same equations hold with (A_d, B_d, E_d): q_{k+1} = F_d q_k + …,
 //! x̂_k = Lq_k + (Cᵍ + LK_d)y_k.
 
-use lti::place::Method;
 use lti::pinv::{pinv, rank};
-use lti::{Mat, Model, Poles, C64};
+use lti::{Mat, Model, C64};
 
-use super::{eig, place_detectable, require_stable, Checks, Designed, DesignError, Domain, Report};
+use super::{eig, free_gain, require_stable, sampled_report, Checks, Designed, DesignError, Domain, Gain, Pair, Report};
 use crate::runtime::LinearObserver;
 
 /// How K is chosen.
 #[derive(Debug, Clone)]
-pub(super) enum Gain {
-    /// Place eig(F) at these (continuous) poles.
-    Poles(Poles, Method),
+pub(super) enum Free {
+    /// Placed poles or an LQE gain on the error pair.
+    Gain(Gain),
     /// The UIO's free matrix H of eq. 22.
-    Free(Mat),
+    H(Mat),
 }
 
 /// The independent columns of I − CᵍC, left to right: a basis L of ker C with LLᵍ = I − CᵍC.
@@ -74,7 +73,7 @@ pub(super) fn core(
     b: &Mat,
     c: &Mat,
     e: &Mat,
-    gain: &Gain,
+    gain: &Free,
     uio: bool,
     carried: &[C64],
     domain: Domain,
@@ -101,17 +100,29 @@ pub(super) fn core(
         let k0 = &lge * &ced_g;
         let pi = Mat::identity(c.nrows(), c.nrows()) - &ced * &ced_g;
         let (h, fixed) = match gain {
-            Gain::Free(h) => {
+            Free::H(h) => {
                 if h.shape() != (r, c.nrows()) {
                     return Err(checks.error("H", format!("is {}×{}, must be {}×{}", h.nrows(), h.ncols(), r, c.nrows())));
                 }
                 (h.clone(), Vec::new())
             }
-            Gain::Poles(poles, method) => {
+            Free::Gain(g @ Gain::Place { .. }) => {
                 let at = &lgal - &k0 * &cal;
                 let ct = &pi * &cal;
                 notes.push("H placed on the pair (LgAL − K0·CAL, Π·CAL)".to_string());
-                place_detectable(checks, &at, &ct, poles, carried, *method, "(LgAL − K0CAL, ΠCAL)", domain)?
+                let pair = Pair { a: &at, c: &ct, name: "(LgAL − K0CAL, ΠCAL)", state_map: Some(&lg), output_map: None };
+                free_gain(checks, &pair, g, carried, domain)?
+            }
+            Free::Gain(g @ Gain::Lqe(_)) => {
+                // Π = UUᵀ (an orthogonal projector): the DARE needs independent outputs, so the
+                // pair's output is UᵀCAL, and H = H̃Uᵀ gives HΠ = H̃Uᵀ as placement's H does.
+                let at = &lgal - &k0 * &cal;
+                let ut = lti::subspace::range(&pi).transpose();
+                let ct = &ut * &cal;
+                notes.push("H from the DARE of the pair (LgAL − K0·CAL, Uᵀ·CAL), Π = UUᵀ".to_string());
+                let pair = Pair { a: &at, c: &ct, name: "(LgAL − K0CAL, UᵀCAL)", state_map: Some(&lg), output_map: Some(&ut) };
+                let (ht, fixed) = free_gain(checks, &pair, g, carried, domain)?;
+                (ht * &ut, fixed)
             }
         };
         let k = k0 + h * pi;
@@ -120,8 +131,11 @@ pub(super) fn core(
         (k, fixed)
     } else {
         match gain {
-            Gain::Poles(poles, method) => place_detectable(checks, &lgal, &cal, poles, carried, *method, "(LgAL, CAL)", domain)?,
-            Gain::Free(_) => return Err(checks.error("H", "only the unknown-input form takes H")),
+            Free::Gain(g) => {
+                let pair = Pair { a: &lgal, c: &cal, name: "(LgAL, CAL)", state_map: Some(&lg), output_map: None };
+                free_gain(checks, &pair, g, carried, domain)?
+            }
+            Free::H(_) => return Err(checks.error("H", "only the unknown-input form takes H")),
         }
     };
     let f = &lgal - &k * &cal;
@@ -131,29 +145,36 @@ pub(super) fn core(
     Ok(Core { cg, l, lg, k, f, ky, ku, fixed, notes })
 }
 
-pub(super) fn design(model: &Model, gain: Gain, uio: bool, dt: f64) -> Result<Designed, DesignError> {
+pub(super) fn design(model: &Model, gain: Free, uio: bool, dt: f64) -> Result<Designed, DesignError> {
     let kind = if uio { "das-ghosal-uio" } else { "das-ghosal" };
     let mut checks = Checks::new(kind);
-    let ct = core(&model.a, &model.b, &model.c, &model.e, &gain, uio, &[], Domain::Continuous, &mut checks)?;
+    let lqe = matches!(&gain, Free::Gain(g) if g.is_lqe());
+    let ct = if lqe { None } else { Some(core(&model.a, &model.b, &model.c, &model.e, &gain, uio, &[], Domain::Continuous, &mut checks)?) };
+    let carried = ct.as_ref().map(|c| c.fixed.clone()).unwrap_or_default();
     let dm = model.discretize(dt);
     let mut sampled = Checks::sampled(kind, dt);
-    let d = core(&dm.a, &dm.b, &dm.c, &dm.e, &gain, uio, &ct.fixed, Domain::Discrete(dt), &mut sampled)?;
+    let d = core(&dm.a, &dm.b, &dm.c, &dm.e, &gain, uio, &carried, Domain::Discrete(dt), &mut sampled)?;
     let q = &d.cg + &d.l * &d.k;
     let runtime = LinearObserver::new(&d.f, &d.ku, &d.ky, &d.l, &q);
-    let mut notes = ct.notes;
-    if let Gain::Free(_) = gain {
-        notes.push("H given: the sampled observer uses the same H, so its poles are close to, not equal to, e^{p·dt}".into());
-    }
-    Ok(Designed {
-        report: Report {
-            kind,
-            conditions: checks.into_list(),
-            poles: eig(&ct.f),
-            discrete_poles: eig(&d.f),
-            fixed_modes: ct.fixed,
-            matrices: vec![("L".into(), ct.l), ("Lg".into(), ct.lg), ("K".into(), ct.k), ("F".into(), ct.f)],
-            notes,
-        },
-        runtime,
-    })
+    let matrices = |c: &Core| vec![("L".into(), c.l.clone()), ("Lg".into(), c.lg.clone()), ("K".into(), c.k.clone()), ("F".into(), c.f.clone())];
+    let report = match ct {
+        Some(ct) => {
+            let mut notes = ct.notes.clone();
+            if let Free::H(_) = gain {
+                notes.push("H given: the sampled observer uses the same H, so its poles are close to, not equal to, e^{p·dt}".into());
+            }
+            Report {
+                kind,
+                conditions: checks.into_list(),
+                poles: eig(&ct.f),
+                discrete_poles: eig(&d.f),
+                matrices: matrices(&ct),
+                fixed_modes: ct.fixed,
+                notes,
+                sampled_only: false,
+            }
+        }
+        None => sampled_report(kind, sampled, &d.f, d.fixed.clone(), matrices(&d), d.notes.clone(), dt),
+    };
+    Ok(Designed { report, runtime })
 }

@@ -12,45 +12,49 @@
 //! ξ_{k+1} = A_dξ_k + B_du_k + K(y_{k+1} − CB_du_k − CA_dξ_k) and q_k = ξ_k − Ky_k give the same
 //! equations with A_d, B_d: q_{k+1} = (A_d − KCA_d)q_k + (B_d − KCB_d)u_k + (A_d − KCA_d)K y_k.
 
-use lti::place::Method;
 use lti::pinv::rank;
-use lti::{Mat, Model, Poles};
+use lti::{Mat, Model};
 
-use super::{eig, place_detectable, require_stable, Checks, Designed, DesignError, Domain, Report};
+use super::{eig, free_gain, require_stable, sampled_report, Checks, Designed, DesignError, Domain, Gain, Pair, Report};
 use crate::runtime::LinearObserver;
 
 const KIND: &str = "gi-full-order";
 
-fn core(a: &Mat, c: &Mat, poles: &Poles, carried: &[lti::C64], method: Method, domain: Domain, checks: &mut Checks) -> Result<(Mat, Mat, Vec<lti::C64>), DesignError> {
+fn core(a: &Mat, c: &Mat, gain: &Gain, carried: &[lti::C64], domain: Domain, checks: &mut Checks) -> Result<(Mat, Mat, Vec<lti::C64>), DesignError> {
     let ca = c * a;
-    let (k, fixed) = place_detectable(checks, a, &ca, poles, carried, method, "(A, CA)", domain)?;
+    // The pair's output is CA·x = ẏ − CBu (or y_{k+1} − CB_du_k): an R given for y weights it.
+    let (k, fixed) = free_gain(checks, &Pair::full(a, &ca, "(A, CA)"), gain, carried, domain)?;
     let f = a - &k * &ca;
     require_stable(checks, "F = A − KCA stable", &eig(&f), domain)?;
     Ok((k, f, fixed))
 }
 
-pub(super) fn design(model: &Model, poles: &Poles, method: Method, dt: f64) -> Result<Designed, DesignError> {
+pub(super) fn design(model: &Model, gain: &Gain, dt: f64) -> Result<Designed, DesignError> {
     let mut checks = Checks::new(KIND);
     let n = model.n();
     let ra = rank(&model.a);
-    let (k, f, fixed) = core(&model.a, &model.c, poles, &[], method, Domain::Continuous, &mut checks)?;
+    let continuous = if gain.is_lqe() { None } else { Some(core(&model.a, &model.c, gain, &[], Domain::Continuous, &mut checks)?) };
+    let carried = continuous.as_ref().map(|c| c.2.clone()).unwrap_or_default();
     let dm = model.discretize(dt);
     let mut sampled = Checks::sampled(KIND, dt);
-    let (kd, fd, _) = core(&dm.a, &dm.c, poles, &fixed, method, Domain::Discrete(dt), &mut sampled)?;
+    let (kd, fd, fixed_d) = core(&dm.a, &dm.c, gain, &carried, Domain::Discrete(dt), &mut sampled)?;
     let g = &dm.b - &kd * &dm.c * &dm.b;
     let ky = &fd * &kd;
     let runtime = LinearObserver::new(&fd, &g, &ky, &Mat::identity(n, n), &kd);
-    Ok(Designed {
-        report: Report {
+    // The paper's lemma: (A, C) observable and A non-singular imply (A, CA) observable.
+    let notes = vec![format!("rank(A) = {ra} of {n}{}", if ra == n { " (A non-singular)" } else { " (A singular: (A, CA) checked directly)" })];
+    let report = match continuous {
+        Some((k, f, fixed)) => Report {
             kind: KIND,
             conditions: checks.into_list(),
             poles: eig(&f),
             discrete_poles: eig(&fd),
             fixed_modes: fixed,
             matrices: vec![("K".into(), k), ("F".into(), f)],
-            // The paper's lemma: (A, C) observable and A non-singular imply (A, CA) observable.
-            notes: vec![format!("rank(A) = {ra} of {n}{}", if ra == n { " (A non-singular)" } else { " (A singular: (A, CA) checked directly)" })],
+            notes,
+            sampled_only: false,
         },
-        runtime,
-    })
+        None => sampled_report(KIND, sampled, &fd, fixed_d, vec![("K".into(), kd.clone()), ("F".into(), fd.clone())], notes, dt),
+    };
+    Ok(Designed { report, runtime })
 }

@@ -29,7 +29,7 @@ use lti::place::Method;
 use lti::zeros::decoupling;
 use lti::{Mat, Model, PoleSpec, Poles, C64};
 
-use super::{eig, eq_detail, place_detectable, require_stable, Checks, Designed, DesignError, Domain, Report};
+use super::{eig, eq_detail, free_gain, require_stable, sampled_report, Checks, Designed, DesignError, Domain, Gain, Pair, Report};
 use crate::runtime::LinearObserver;
 
 const KIND: &str = "hui-zak-uio";
@@ -79,9 +79,8 @@ fn core(
     c: &Mat,
     b2: &Mat,
     d: &Mat,
-    poles: Option<&Poles>,
+    gain: Option<&Gain>,
     carried: &[C64],
-    method: Method,
     lmi_l: Option<&Mat>,
     domain: Domain,
     checks: &mut Checks,
@@ -111,10 +110,12 @@ fn core(
         },
     )?;
     let nc = &dec.n * c;
-    let l = match (lmi_l, poles) {
+    let l = match (lmi_l, gain) {
         (Some(l), _) => l.clone(),
-        (None, Some(p)) => {
-            let (lt, _) = place_detectable(checks, &dec.a1, &nc, p, carried, method, "(A1, NC)", domain)?;
+        (None, Some(g)) => {
+            // The pair's output is N·y (N spans the left null space of D): R given for y is NRNᵀ.
+            let pair = Pair { a: &dec.a1, c: &nc, name: "(A1, NC)", state_map: None, output_map: Some(&dec.n) };
+            let (lt, _) = free_gain(checks, &pair, g, carried, domain)?;
             lt * &dec.n
         }
         (None, None) => return Err(checks.error("poles", "no free poles given (a design bug: the caller supplies the default)")),
@@ -154,11 +155,23 @@ fn discrete_certificate(acl_d: &Mat, decay: f64, dt: f64) -> Result<(f64, f64), 
     Ok((rho, lhs.symmetric_eigen().eigenvalues.max()))
 }
 
-pub(super) fn design(model: &Model, decay: f64, poles: Option<&Poles>, method: Method, path: Path, dt: f64) -> Result<Designed, DesignError> {
+pub(super) fn design(model: &Model, decay: f64, gain: Option<&Gain>, method: Method, path: Path, dt: f64) -> Result<Designed, DesignError> {
     let mut checks = Checks::new(KIND);
     if !(decay >= 0.0 && decay.is_finite()) {
         return Err(checks.error("decay", format!("{decay} must be finite and ≥ 0")));
     }
+    if let Some(g @ Gain::Lqe(_)) = gain {
+        if path == Path::Lmi {
+            return Err(checks.error("path", "gain = lqe computes L from a DARE: it takes no LMI path"));
+        }
+        return design_lqe(model, decay, g, dt);
+    }
+    let poles = match gain {
+        Some(Gain::Place { poles, method: m }) => Some((poles, *m)),
+        _ => None,
+    };
+    let method = poles.map_or(method, |p| p.1);
+    let poles = poles.map(|p| p.0);
     let (b2, d) = (&model.e, &model.d);
     let mut notes = Vec::new();
     let lmi = match path {
@@ -178,7 +191,7 @@ pub(super) fn design(model: &Model, decay: f64, poles: Option<&Poles>, method: M
         }
         None => None,
     };
-    let ct = core(&model.a, &model.c, b2, d, poles, &[], method, lmi_l.as_ref(), Domain::Continuous, &mut checks)?;
+    let ct = core(&model.a, &model.c, b2, d, poles.map(|p| Gain::place(p.clone(), method)).as_ref(), &[], lmi_l.as_ref(), Domain::Continuous, &mut checks)?;
     let poles_c = eig(&ct.acl);
     let slowest = poles_c.iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
     checks.require(
@@ -212,7 +225,8 @@ pub(super) fn design(model: &Model, decay: f64, poles: Option<&Poles>, method: M
         }
         (None, p) => p.cloned(),
     };
-    let d_core = core(&dm.a, &dm.c, &dm.e, d, free_poles.as_ref(), &ct.fixed, method, None, Domain::Discrete(dt), &mut sampled)?;
+    let free = free_poles.map(|p| Gain::place(p, method));
+    let d_core = core(&dm.a, &dm.c, &dm.e, d, free.as_ref(), &ct.fixed, None, Domain::Discrete(dt), &mut sampled)?;
     let (rho, worst_d) = discrete_certificate(&d_core.acl, decay, dt).map_err(|e| sampled.error("Lyapunov certificate", e))?;
     notes.push(format!("sampled decay certificate: ρ = e^(−α·dt/2) = {}, λmax(AᵀPA − ρ²P) = {}", sig(rho), sig(worst_d)));
     let n = model.n();
@@ -230,9 +244,31 @@ pub(super) fn design(model: &Model, decay: f64, poles: Option<&Poles>, method: M
             fixed_modes: ct.fixed,
             matrices: vec![("M".into(), ct.m), ("A1".into(), ct.a1), ("L".into(), ct.l), ("P".into(), p)],
             notes,
+            sampled_only: false,
         },
         runtime,
     })
+}
+
+/// `gain = "lqe"`: L from the DARE of the sampled pair (A1d, NC); the decay rate is certified
+/// on the sampled error dynamics only (there is no continuous design).
+fn design_lqe(model: &Model, decay: f64, gain: &Gain, dt: f64) -> Result<Designed, DesignError> {
+    let dm = model.discretize(dt);
+    let mut sampled = Checks::sampled(KIND, dt);
+    let d_core = core(&dm.a, &dm.c, &dm.e, &model.d, Some(gain), &[], None, Domain::Discrete(dt), &mut sampled)?;
+    let (rho, worst_d) = discrete_certificate(&d_core.acl, decay, dt).map_err(|e| sampled.error("Lyapunov certificate", e))?;
+    sampled.require(
+        &format!("decay rate {decay}: AᵀPA − ρ²P ⪯ 0 with ρ = e^(−α·dt/2)"),
+        worst_d <= 1e-9,
+        format!("ρ = {}, λmax = {}", sig(rho), sig(worst_d)),
+    )?;
+    let n = model.n();
+    let proj = Mat::identity(n, n) - &d_core.m * &dm.c;
+    let k = &d_core.a1 * &d_core.m + &d_core.l * (Mat::identity(model.p(), model.p()) - &dm.c * &d_core.m);
+    let runtime = LinearObserver::new(&d_core.acl, &(&proj * &dm.b), &k, &Mat::identity(n, n), &d_core.m);
+    let matrices = vec![("M".into(), d_core.m.clone()), ("A1".into(), d_core.a1.clone()), ("L".into(), d_core.l.clone())];
+    let report = sampled_report(KIND, sampled, &d_core.acl, d_core.fixed.clone(), matrices, vec![], dt);
+    Ok(Designed { report, runtime })
 }
 
 #[cfg(feature = "lmi")]

@@ -12,7 +12,7 @@
 //! not modelled (they are what the unknown-input observers reject and the filter does not).
 //! There is no continuous design: the report's poles are ln(z)/dt of the filter's.
 
-use lti::{steady_state_kalman, Mat, Model, C64};
+use lti::{steady_state_kalman, Mat, Model};
 
 use super::{eig, require_stable, Checks, Designed, DesignError, Domain, Report};
 use crate::runtime::LinearObserver;
@@ -28,7 +28,7 @@ pub(super) fn design(model: &Model, qd: &Mat, r: &Mat, dt: f64) -> Result<Design
     let f = &dm.a * &p_upd;
     let discrete = eig(&f);
     require_stable(&mut checks, "Φ(I − MC) stable", &discrete, Domain::Discrete(dt))?;
-    let continuous: Vec<C64> = discrete.iter().map(|z| z.ln() / dt).collect();
+    let (continuous, _) = super::continuous_image(&discrete, dt);
     let runtime = LinearObserver::new(&f, &dm.b, &kf.predictor_gain, &p_upd, &kf.gain);
     Ok(Designed {
         report: Report {
@@ -38,6 +38,7 @@ pub(super) fn design(model: &Model, qd: &Mat, r: &Mat, dt: f64) -> Result<Design
             poles: continuous,
             discrete_poles: discrete,
             fixed_modes: vec![],
+            sampled_only: true,
             notes: vec![format!("ρ(Φ(I − MC)) = {:.6}", kf.radius)],
         },
         runtime,

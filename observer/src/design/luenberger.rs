@@ -5,41 +5,50 @@
 //! Sampled counterpart (predictor form): x̂_{k+1} = A_d x̂_k + B_d u_k + L_d(y_k − Cx̂_k),
 //! eig(A_d − L_dC) = e^{p·dt}.
 
-use lti::place::Method;
-use lti::{Mat, Model, Poles};
+use lti::{Mat, Model};
 
-use super::{eig, place_detectable, require_stable, Checks, Designed, DesignError, Domain, Report};
+use super::{eig, free_gain, require_stable, sampled_report, Checks, Designed, DesignError, Domain, Gain, Pair, Report};
 use crate::runtime::LinearObserver;
 
 const KIND: &str = "luenberger";
 
-fn gain(a: &Mat, c: &Mat, poles: &Poles, carried: &[lti::C64], method: Method, domain: Domain, checks: &mut Checks) -> Result<(Mat, Vec<lti::C64>), DesignError> {
-    place_detectable(checks, a, c, poles, carried, method, "(A, C)", domain)
-}
-
-pub(super) fn design(model: &Model, poles: &Poles, method: Method, dt: f64) -> Result<Designed, DesignError> {
+pub(super) fn design(model: &Model, gain: &Gain, dt: f64) -> Result<Designed, DesignError> {
     let mut checks = Checks::new(KIND);
-    let (l, fixed) = gain(&model.a, &model.c, poles, &[], method, Domain::Continuous, &mut checks)?;
-    let f = &model.a - &l * &model.c;
-    let poles_c = eig(&f);
-    require_stable(&mut checks, "A − LC stable", &poles_c, Domain::Continuous)?;
+    // The continuous design (placement only): the report's paper form, and the fixed modes the
+    // sampled design carries over.
+    let continuous = match gain {
+        Gain::Lqe(_) => None,
+        Gain::Place { .. } => {
+            let (l, fixed) = free_gain(&mut checks, &Pair::full(&model.a, &model.c, "(A, C)"), gain, &[], Domain::Continuous)?;
+            let f = &model.a - &l * &model.c;
+            let poles_c = eig(&f);
+            require_stable(&mut checks, "A − LC stable", &poles_c, Domain::Continuous)?;
+            Some((l, f, poles_c, fixed))
+        }
+    };
+    let carried = continuous.as_ref().map(|c| c.3.clone()).unwrap_or_default();
 
     let dm = model.discretize(dt);
     let mut sampled = Checks::sampled(KIND, dt);
-    let (ld, _) = gain(&dm.a, &dm.c, poles, &fixed, method, Domain::Discrete(dt), &mut sampled)?;
+    let (ld, fixed_d) = free_gain(&mut sampled, &Pair::full(&dm.a, &dm.c, "(Φ, C)"), gain, &carried, Domain::Discrete(dt))?;
     let fd = &dm.a - &ld * &dm.c;
     let n = model.n();
     let runtime = LinearObserver::new(&fd, &dm.b, &ld, &Mat::identity(n, n), &Mat::zeros(n, model.p()));
-    Ok(Designed {
-        report: Report {
+    let report = match continuous {
+        Some((l, f, poles, fixed)) => Report {
             kind: KIND,
             conditions: checks.into_list(),
             matrices: vec![("L".into(), l), ("F".into(), f)],
-            poles: poles_c,
+            poles,
             discrete_poles: eig(&fd),
             fixed_modes: fixed,
             notes: vec![],
+            sampled_only: false,
         },
-        runtime,
-    })
+        None => {
+            require_stable(&mut sampled, "Φ − LC stable", &eig(&fd), Domain::Discrete(dt))?;
+            sampled_report(KIND, sampled, &fd, fixed_d, vec![("L".into(), ld.clone()), ("F".into(), fd.clone())], vec![], dt)
+        }
+    };
+    Ok(Designed { report, runtime })
 }

@@ -14,6 +14,7 @@
 mod chen_patton;
 mod cumming;
 mod das_ghosal;
+mod gain;
 mod gi_full_order;
 mod hui_zak;
 mod kalman;
@@ -26,25 +27,29 @@ use lti::{Mat, Model, Poles, C64};
 
 use crate::runtime::LinearObserver;
 
+pub use gain::{Gain, Weights};
 pub use hui_zak::{lmi_available, LmiSolution, Path};
+pub(crate) use gain::{free_gain, Pair};
 
 /// Which observer, with its free parameters.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Spec {
     /// Full-order Luenberger observer: x̂˙ = Ax̂ + Bu + L(y − Cx̂).
-    Luenberger { poles: Poles, placement: Method },
+    Luenberger { gain: Gain },
     /// Chen & Patton's unknown-input decoupling observer (seed 002).
-    ChenPatton { poles: Poles, placement: Method },
+    ChenPatton { gain: Gain },
     /// Das & Ghosal reduced-order observer (seed 003).
-    DasGhosal { poles: Poles, placement: Method },
-    /// Das & Ghosal reduced-order unknown-input observer (seed 000): either H given, or poles.
-    DasGhosalUio { h: Option<Mat>, poles: Option<Poles>, placement: Method },
+    DasGhosal { gain: Gain },
+    /// Das & Ghosal reduced-order unknown-input observer (seed 000): either H given, or a gain
+    /// for its free matrix.
+    DasGhosalUio { h: Option<Mat>, gain: Option<Gain> },
     /// Full-order observer by the generalized inverse (seed 001).
-    GiFullOrder { poles: Poles, placement: Method },
+    GiFullOrder { gain: Gain },
     /// Cumming's reduced-order observer (seed 003); H completes C to an invertible [C; H].
-    Cumming { poles: Poles, placement: Method, h: Option<Mat> },
-    /// Hui & Żak's projection unknown-input observer (seed 004).
-    HuiZak { decay: f64, poles: Option<Poles>, placement: Method, path: Path },
+    Cumming { gain: Gain, h: Option<Mat> },
+    /// Hui & Żak's projection unknown-input observer (seed 004). Without a gain the free poles
+    /// default from the fixed modes and are placed with `placement`.
+    HuiZak { decay: f64, gain: Option<Gain>, placement: Method, path: Path },
     /// The steady-state Kalman filter of the sampled plant for process-noise covariance Q_d
     /// (per step, n×n) and measurement-noise covariance R (p×p).
     Kalman { qd: Mat, r: Mat },
@@ -99,6 +104,9 @@ pub struct Report {
     pub fixed_modes: Vec<C64>,
     /// Further facts worth showing (certificates, choices made).
     pub notes: Vec<String>,
+    /// True when there is no continuous design (an LQE gain, a Kalman filter): `poles` are then
+    /// ln(z)/dt of the sampled ones, and a deadbeat mode z = 0 shows as −∞.
+    pub sampled_only: bool,
 }
 
 /// A finished design: its report and the sampled observer to run.
@@ -149,16 +157,18 @@ pub(crate) struct Checks {
     kind: &'static str,
     prefix: String,
     list: Vec<Condition>,
+    /// The LQE weights (Q, R) at the pair's sizes, when the gain came from a DARE.
+    pub(crate) weights: Option<(Mat, Mat)>,
 }
 
 impl Checks {
     pub(crate) fn new(kind: &'static str) -> Self {
-        Self { kind, prefix: String::new(), list: Vec::new() }
+        Self { kind, prefix: String::new(), list: Vec::new(), weights: None }
     }
 
     /// Checks of the sampled design: names are prefixed so an error says which design failed.
     pub(crate) fn sampled(kind: &'static str, dt: f64) -> Self {
-        Self { kind, prefix: format!("sampled design (dt = {dt}): "), list: Vec::new() }
+        Self { kind, prefix: format!("sampled design (dt = {dt}): "), list: Vec::new(), weights: None }
     }
 
     /// Records a condition that must hold.
@@ -178,6 +188,48 @@ impl Checks {
     pub(crate) fn into_list(self) -> Vec<Condition> {
         self.list
     }
+
+    /// The LQE weights as report matrices (none for a placed gain).
+    pub(crate) fn weight_matrices(&self) -> Vec<(String, Mat)> {
+        self.weights.iter().flat_map(|(q, r)| [("Q (LQE)".to_string(), q.clone()), ("R (LQE)".to_string(), r.clone())]).collect()
+    }
+}
+
+/// The report of a design that has only its sampled part (an LQE gain): the sampled checks as
+/// conditions, ln(z)/dt as continuous poles and fixed modes, the sampled matrices and the weights.
+pub(crate) fn sampled_report(
+    kind: &'static str,
+    sampled: Checks,
+    f: &Mat,
+    fixed: Vec<C64>,
+    mut matrices: Vec<(String, Mat)>,
+    mut notes: Vec<String>,
+    dt: f64,
+) -> Report {
+    let discrete = eig(f);
+    matrices.extend(sampled.weight_matrices());
+    notes.insert(0, "gain = lqe: the sampled design only; matrices are the sampled observer's, poles are ln(z)/dt".into());
+    let (poles, deadbeat) = continuous_image(&discrete, dt);
+    if deadbeat > 0 {
+        notes.push(format!("{deadbeat} deadbeat mode(s) z = 0 (no continuous image, left out of the poles)"));
+    }
+    Report {
+        kind,
+        conditions: sampled.into_list(),
+        matrices,
+        poles,
+        discrete_poles: discrete,
+        fixed_modes: continuous_image(&fixed, dt).0,
+        notes,
+        sampled_only: true,
+    }
+}
+
+/// ln(z)/dt for each sampled pole, and how many were left out as deadbeat (z = 0 to rounding).
+pub(crate) fn continuous_image(discrete: &[C64], dt: f64) -> (Vec<C64>, usize) {
+    let kept: Vec<C64> = discrete.iter().filter(|z| z.norm() >= 1e-12).map(|z| z.ln() / dt).collect();
+    let dropped = discrete.len() - kept.len();
+    (kept, dropped)
 }
 
 /// An observer gain for the pair (A, C) placing the requested spectrum on its observable part;
@@ -314,22 +366,22 @@ pub(crate) fn require_stable(checks: &mut Checks, name: &str, ev: &[C64], domain
 /// Designs the observer for `model`, sampled with period `dt`.
 pub fn design(model: &Model, spec: &Spec, dt: f64) -> Result<Designed, DesignError> {
     match spec {
-        Spec::Luenberger { poles, placement } => luenberger::design(model, poles, *placement, dt),
-        Spec::ChenPatton { poles, placement } => chen_patton::design(model, poles, *placement, dt),
-        Spec::DasGhosal { poles, placement } => das_ghosal::design(model, das_ghosal::Gain::Poles(poles.clone(), *placement), false, dt),
-        Spec::DasGhosalUio { h, poles, placement } => {
-            let gain = match (h, poles) {
-                (Some(h), _) => das_ghosal::Gain::Free(h.clone()),
-                (None, Some(p)) => das_ghosal::Gain::Poles(p.clone(), *placement),
+        Spec::Luenberger { gain } => luenberger::design(model, gain, dt),
+        Spec::ChenPatton { gain } => chen_patton::design(model, gain, dt),
+        Spec::DasGhosal { gain } => das_ghosal::design(model, das_ghosal::Free::Gain(gain.clone()), false, dt),
+        Spec::DasGhosalUio { h, gain } => {
+            let free = match (h, gain) {
+                (Some(h), _) => das_ghosal::Free::H(h.clone()),
+                (None, Some(g)) => das_ghosal::Free::Gain(g.clone()),
                 (None, None) => {
-                    return Err(Checks::new("das-ghosal-uio").error("H or poles", "give H = [[…]] or poles = […]"));
+                    return Err(Checks::new("das-ghosal-uio").error("H or poles", "give H = [[…]], poles = […] or gain = \"lqe\""));
                 }
             };
-            das_ghosal::design(model, gain, true, dt)
+            das_ghosal::design(model, free, true, dt)
         }
-        Spec::GiFullOrder { poles, placement } => gi_full_order::design(model, poles, *placement, dt),
-        Spec::Cumming { poles, placement, h } => cumming::design(model, poles, *placement, h.as_ref(), dt),
-        Spec::HuiZak { decay, poles, placement, path } => hui_zak::design(model, *decay, poles.as_ref(), *placement, *path, dt),
+        Spec::GiFullOrder { gain } => gi_full_order::design(model, gain, dt),
+        Spec::Cumming { gain, h } => cumming::design(model, gain, h.as_ref(), dt),
+        Spec::HuiZak { decay, gain, placement, path } => hui_zak::design(model, *decay, gain.as_ref(), *placement, *path, dt),
         Spec::Kalman { qd, r } => kalman::design(model, qd, r, dt),
     }
 }

@@ -1,0 +1,141 @@
+//! How an observer family's free gain is chosen: by pole placement, or as the steady-state
+//! Kalman (LQE) gain of the family's own sampled error pair.
+//!
+//! Every family ends its design with an error recursion e⁺ = (Φ₁ − K C₁) e on a pair (Φ₁, C₁)
+//! it forms itself — (Φ, C) for Luenberger, (T_dΦ, C) for Chen–Patton, (LᵍΦL, CΦL) for
+//! Das–Ghosal … With `gain = "lqe"` the gain is the one-step predictor gain of that pair
+//! (Anderson & Moore, "Optimal Filtering", 1979, ch. 4):
+//!
+//! ```text
+//! P = Φ₁PΦ₁ᵀ − Φ₁PC₁ᵀ(C₁PC₁ᵀ + R)⁻¹C₁PΦ₁ᵀ + Q     (DARE(Φ₁ᵀ, C₁ᵀ, Q, R), scipy's solve_discrete_are)
+//! K = Φ₁PC₁ᵀ(C₁PC₁ᵀ + R)⁻¹,        ρ(Φ₁ − KC₁) < 1.
+//! ```
+//!
+//! It exists iff (Φ₁, C₁) is detectable and (Φ₁, Q) has no unobservable mode on the unit circle;
+//! the unobservable modes of the pair (for a UIO, the invariant zeros) stay in Φ₁ − KC₁ as they
+//! do under placement. Nothing is placed, so the design scales with the model (O(n³) per
+//! doubling step) where placing hundreds of poles with few outputs is ill-posed.
+//!
+//! Weights: Q and R default to identities of the pair's sizes. A weight given for the plant —
+//! Q n×n, R p×p, from the observer's keys or from the scenario's `[noise]` — is carried to a
+//! pair whose state is T x and whose output is M y as T Q Tᵀ and M R Mᵀ.
+
+use lti::eig::{format_list, sig};
+use lti::place::Method;
+use lti::staircase::observability_staircase;
+use lti::{steady_state_kalman, Mat, Poles, C64};
+
+use super::{place_detectable, Checks, DesignError, Domain};
+
+/// The free gain of an observer family.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Gain {
+    /// Place the error dynamics at these continuous poles (the sampled design at e^{p·dt}).
+    Place { poles: Poles, method: Method },
+    /// The steady-state Kalman gain of the family's sampled error pair.
+    Lqe(Weights),
+}
+
+/// LQE weights as given: `None` takes the identity of the pair's size.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Weights {
+    /// Process weight: the pair's order, or n×n for the plant's state.
+    pub q: Option<Mat>,
+    /// Measurement weight: the pair's output count, or p×p for the plant's outputs.
+    pub r: Option<Mat>,
+}
+
+impl Gain {
+    /// Placement at `poles` with `method`.
+    pub fn place(poles: Poles, method: Method) -> Self {
+        Gain::Place { poles, method }
+    }
+
+    /// True for `gain = "lqe"`.
+    pub fn is_lqe(&self) -> bool {
+        matches!(self, Gain::Lqe(_))
+    }
+}
+
+/// The error pair (Φ₁, C₁) a family forms, and how the plant's state and outputs map onto it.
+pub(crate) struct Pair<'a> {
+    pub a: &'a Mat,
+    pub c: &'a Mat,
+    /// As the papers write it, e.g. "(TA, C)".
+    pub name: &'a str,
+    /// T with pair state = T x; `None` when the pair's state is x itself.
+    pub state_map: Option<&'a Mat>,
+    /// M with pair output = M y; `None` when it is y itself.
+    pub output_map: Option<&'a Mat>,
+}
+
+impl<'a> Pair<'a> {
+    /// A pair on the plant's own state and outputs.
+    pub fn full(a: &'a Mat, c: &'a Mat, name: &'a str) -> Self {
+        Pair { a, c, name, state_map: None, output_map: None }
+    }
+}
+
+/// The gain K of e⁺ = (Φ₁ − KC₁)e (or ė = (A₁ − KC₁)e when placing in continuous time) and the
+/// modes it leaves fixed. `carried` are the continuous design's fixed modes (placement only).
+/// LQE gains exist only for the sampled pair: the families skip their continuous design then.
+pub(crate) fn free_gain(
+    checks: &mut Checks,
+    pair: &Pair,
+    gain: &Gain,
+    carried: &[C64],
+    domain: Domain,
+) -> Result<(Mat, Vec<C64>), DesignError> {
+    match (gain, domain) {
+        (Gain::Place { poles, method }, _) => place_detectable(checks, pair.a, pair.c, poles, carried, *method, pair.name, domain),
+        (Gain::Lqe(w), Domain::Discrete(_)) => lqe(checks, pair, w),
+        (Gain::Lqe(_), Domain::Continuous) => Err(checks.error("gain", "an LQE gain is designed on the sampled pair only (a design bug)")),
+    }
+}
+
+fn lqe(checks: &mut Checks, pair: &Pair, w: &Weights) -> Result<(Mat, Vec<C64>), DesignError> {
+    let (m, k) = (pair.a.nrows(), pair.c.nrows());
+    let q = weight(checks, "Q", w.q.as_ref(), m, pair.state_map, "the pair's order")?;
+    let r = weight(checks, "R", w.r.as_ref(), k, pair.output_map, "the pair's output count")?;
+    let fixed = if k == 0 {
+        lti::eig::eigenvalues(pair.a).unwrap_or_default()
+    } else if lti::pinv::rank(pair.c) < m {
+        observability_staircase(pair.a, pair.c).unobservable_modes().map_err(|e| checks.error(pair.name, e.to_string()))?
+    } else {
+        Vec::new()
+    };
+    let gain = if k == 0 {
+        Mat::zeros(m, 0)
+    } else {
+        let kf = steady_state_kalman(pair.a, pair.c, &q, &r).map_err(|e| {
+            checks.error(&format!("DARE(Φ1ᵀ, C1ᵀ, Q, R) on {} has a stabilising solution", pair.name), e.to_string())
+        })?;
+        checks.require(
+            &format!("DARE(Φ1ᵀ, C1ᵀ, Q, R) on {} has a stabilising solution", pair.name),
+            true,
+            format!("ρ(Φ1 − KC1) = {}{}", sig(kf.radius), if fixed.is_empty() { String::new() } else { format!(", fixed modes {}", format_list(&fixed)) }),
+        )?;
+        kf.predictor_gain
+    };
+    checks.weights = Some((q, r));
+    Ok((gain, fixed))
+}
+
+/// A weight at the pair's size: identity when not given, as given when it has the pair's size,
+/// T W Tᵀ when it has the plant's size and the pair maps it by T.
+fn weight(checks: &Checks, name: &str, given: Option<&Mat>, size: usize, map: Option<&Mat>, what: &str) -> Result<Mat, DesignError> {
+    let Some(wm) = given else { return Ok(Mat::identity(size, size)) };
+    if wm.shape() == (size, size) {
+        return Ok(wm.clone());
+    }
+    match map {
+        Some(t) if wm.shape() == (t.ncols(), t.ncols()) => {
+            let mapped = t * wm * t.transpose();
+            Ok((&mapped + mapped.transpose()) * 0.5)
+        }
+        _ => {
+            let plant = map.map(|t| format!(" or {0}×{0}", t.ncols())).unwrap_or_default();
+            Err(checks.error(name, format!("is {}×{}, must be {size}×{size} ({what}){plant}", wm.nrows(), wm.ncols())))
+        }
+    }
+}
