@@ -34,7 +34,7 @@ pub enum LtiError {
         modes: String,
     },
     /// The placement finished but the achieved eigenvalues are off.
-    #[error("placement missed: requested {requested}, achieved {achieved} (max error {error:.3e})")]
+    #[error("placement missed: requested {requested}, achieved {achieved} (max error {error:.3e}; {how})")]
     PlacementMissed {
         /// Requested eigenvalues, formatted.
         requested: String,
@@ -42,6 +42,8 @@ pub enum LtiError {
         achieved: String,
         /// Largest relative distance between matched pairs.
         error: f64,
+        /// How ill-conditioned the placement was: the gain's size, κ of the eigenvectors.
+        how: String,
     },
 }
 

@@ -123,27 +123,33 @@ fn place_pair(
     // The robust methods take the poles as scipy orders them (real ascending, then pairs).
     let ordered = if matches!(method, Method::Knv0 | Method::YangTits) { scipy_order(poles.values()) } else { poles.values().to_vec() };
     let values = &ordered[..];
-    let (gain, sweeps) = match method {
-        Method::Ackermann => (ackermann(a, &b_used, values)?, 0),
+    // κ(X) of the closed loop's eigenvectors, where the method chose them: how far the
+    // placed spectrum is from what rounding can hold (the achieved poles move by up to κ·ε·‖A‖).
+    let kappa = |x: &DMatrix<C64>| {
+        let sv = x.clone().svd(false, false).singular_values;
+        sv.max() / sv.min()
+    };
+    let (gain, sweeps, cond) = match method {
+        Method::Ackermann => (ackermann(a, &b_used, values)?, 0, None),
         // rank B = n: any X works; with X = I, K = B⁻¹(A − Λ_R), Λ_R the real block-diagonal form.
-        _ if r == n => (direct(a, &b_used, values)?, 0),
+        _ if r == n => (direct(a, &b_used, values)?, 0, None),
         Method::Matlab => {
             let es = Eigenstructure::new(a, &b_used, values)?;
             let x0 = initial_x(&es, false);
             let (x, sweeps) = knv0(&es, x0, Sweeps::Exactly(5));
-            (es.gain(a, &x)?, sweeps)
+            (es.gain(a, &x)?, sweeps, Some(kappa(&x)))
         }
         Method::Knv0 => {
             let es = Eigenstructure::new(a, &b_used, values)?;
             let x0 = initial_x(&es, true);
             let (x, sweeps) = knv0(&es, x0, Sweeps::UntilConverged { rtol: 1e-3, max: 30 });
-            (es.gain(a, &x)?, sweeps)
+            (es.gain(a, &x)?, sweeps, Some(kappa(&x)))
         }
         Method::YangTits => {
             let es = Eigenstructure::new(a, &b_used, values)?;
             let x0 = initial_x(&es, true);
             let (x, sweeps) = yang_tits(&es, x0, 1e-3, 30);
-            (es.gain(a, &x)?, sweeps)
+            (es.gain(a, &x)?, sweeps, Some(kappa(&x)))
         }
     };
     let gain = match w {
@@ -153,11 +159,11 @@ fn place_pair(
     let achieved = eigenvalues(&(a - b * &gain))?;
     let error = match_error(values, &achieved);
     if error.is_nan() || error > PLACEMENT_RTOL {
-        return Err(LtiError::PlacementMissed {
-            requested: format_list(values),
-            achieved: format_list(&achieved),
-            error,
-        });
+        let mut how = format!("max |gain entry| {}", crate::eig::sig(gain.amax()));
+        if let Some(c) = cond {
+            how.push_str(&format!(", eigenvector condition number κ(X) = {}", crate::eig::sig(c)));
+        }
+        return Err(LtiError::PlacementMissed { requested: format_list(values), achieved: format_list(&achieved), error, how });
     }
     Ok(Placed { gain, achieved, sweeps })
 }

@@ -308,7 +308,7 @@ pub(crate) fn place_detectable(
         return Err(checks.error("poles", detail));
     }
     if no == n {
-        let placed = place_observer(a, c, &target, method).map_err(|e| checks.error("pole placement", e.to_string()))?;
+        let placed = place_observer(a, c, &target, method).map_err(|e| placement_refused(checks, e))?;
         return Ok((placed.gain, Vec::new()));
     }
     if no == 0 {
@@ -316,9 +316,20 @@ pub(crate) fn place_detectable(
     }
     let stairs = stairs.expect("a staircase whenever no < n");
     let (ao, co) = stairs.observable_part();
-    let placed = place_observer(&ao, &co, &target, method).map_err(|e| checks.error("pole placement", e.to_string()))?;
+    let placed = place_observer(&ao, &co, &target, method).map_err(|e| placement_refused(checks, e))?;
     let l = stairs.q.columns(0, no) * placed.gain;
     Ok((l, fixed))
+}
+
+/// A placement that failed; one that missed its poles (ill-conditioned: many poles, few
+/// outputs, a stiff model) points to the Riccati gain, which needs no pole list.
+fn placement_refused(checks: &Checks, e: lti::LtiError) -> DesignError {
+    let hint = if matches!(e, lti::LtiError::PlacementMissed { .. }) {
+        "; the placement is ill-conditioned: gain = \"lqe\" (instead of poles) designs this pair from a Riccati equation"
+    } else {
+        ""
+    };
+    checks.error("pole placement", format!("{e}{hint}"))
 }
 
 /// The sampled design's poles: e^{p·dt} for the free poles, and e^{z·dt} for each continuous
