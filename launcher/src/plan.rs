@@ -117,6 +117,21 @@ fn warnings(s: &Scenario, observers: &[(String, Option<Designed>)], feedback: Op
             out.push(why);
         }
     }
+    // Sensor banks of Luenberger or Kalman members do not decouple w: with E ≠ 0 and a
+    // disturbance that is not zero, w drives every residual, and the thresholds (set for noise)
+    // raise alarms that no fault caused.
+    let disturbed = s.model.e.iter().any(|&v| v != 0.0) && s.disturbances.iter().any(|w| w.peak() > 0.0);
+    for d in s.diagnosers.iter().filter(|_| disturbed) {
+        let kind = match d.member {
+            diagnosis::spec::MemberKind::Luenberger { .. } => "luenberger",
+            diagnosis::spec::MemberKind::Kalman => "kalman",
+            diagnosis::spec::MemberKind::ChenPatton { .. } => continue,
+        };
+        out.push(format!(
+            "diagnoser '{}': its {kind} members do not decouple the unknown inputs: with E ≠ 0 and a non-zero disturbance, w drives every residual and can raise alarms no fault caused (a bank of chen-patton-uio members decouples w)",
+            d.name
+        ));
+    }
     for (name, d) in &observers {
         if !d.report.fixed_modes.is_empty() {
             out.push(format!("observer '{name}': fixed modes {} cannot be moved by any admissible gain", format_list(&d.report.fixed_modes)));

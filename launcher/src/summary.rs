@@ -103,6 +103,9 @@ pub struct Summary {
     /// recording, against which readers detect a damaged file.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub recording_digest: Option<BTreeMap<String, String>>,
+    /// The design's warnings (the ones `launcher design` prints), so the figures carry them.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
 
 impl Summary {
@@ -154,6 +157,7 @@ impl Summary {
             realtime: None,
             recording: rrd.map(|p| p.display().to_string()),
             recording_digest: None,
+            warnings: plan.warnings.clone(),
         };
         summary.expectations = summary.check(s, matches!(stop, Stop::Completed));
         summary
@@ -251,6 +255,9 @@ impl Summary {
             } else {
                 format!("  cannot keep up: {} of {} steps ended after their deadline (latest by {:.1} µs)\n", r.overruns, r.steps, r.max_lateness_us)
             };
+        }
+        for w in self.warnings.iter().filter(|w| w.starts_with("diagnoser ")) {
+            t += &format!("  note: {w}\n");
         }
         if let Some(d) = &self.diagnosis {
             t += &format!("  diagnosis: {} false alarm(s) over {} s fault-free ({} step(s) in alarm)\n", d.false_alarms, sig(d.fault_free_time), d.false_alarm_steps);

@@ -247,3 +247,27 @@ fn a_sweep_keeps_its_worst_realisations_as_recordings() {
     let bad = launcher(&s).arg("sweep").arg(scenario(name)).args(["--runs", "0", "--out"]).arg(s.join("out")).output().unwrap();
     assert_eq!(bad.status.code(), Some(2), "{:?}", text(&bad));
 }
+
+/// Issue 20, item 7(b): a sensor bank of Luenberger members on a plant whose unknown input is
+/// not zero is warned about at design time (its members do not decouple w), and the run's
+/// summary carries the warning; the same bank without E is not.
+#[test]
+fn non_decoupling_bank_under_a_disturbance_is_warned() {
+    let s = Scratch::new("bank-warning");
+    let from = "x0 = [1.0, 0.1, 0.05, 0.0]";
+    let gust = "E = [[0.0], [0.2], [0.0], [0.0]]\nx0 = [1.0, 0.1, 0.05, 0.0]";
+    let p = edited(&s, "seed003-sensor-faults", from, gust);
+    let text = std::fs::read_to_string(&p).unwrap().replacen("[[input]]", "[[disturbance]]\nkind = \"sine\"\namplitude = 0.5\nfrequency_hz = 0.3\n\n[[input]]", 1);
+    std::fs::write(&p, text).unwrap();
+    let warned = |path: &std::path::Path| {
+        let out = launcher(&s).arg("design").arg(path).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8_lossy(&out.stdout).contains("luenberger members do not decouple the unknown inputs")
+    };
+    assert!(warned(&p), "no warning for a Luenberger bank under a disturbance");
+    assert!(!warned(&scenario("seed003-sensor-faults")), "a warning without any unknown input");
+    let done = launcher(&s).args(["run", "--mode", "in-process", "--out"]).arg(s.join("out")).arg(&p).output().unwrap();
+    assert!(done.status.code().is_some(), "{}", String::from_utf8_lossy(&done.stderr));
+    let warnings = summary(&s, "seed003-sensor-faults")["warnings"].to_string();
+    assert!(warnings.contains("do not decouple the unknown inputs"), "summary.json's warnings: {warnings}");
+}
