@@ -47,7 +47,7 @@ pub fn plan(s: &Scenario) -> Result<Plan, PlanError> {
             observers.push((o.name.clone(), None));
             continue;
         };
-        let d = design(&s.model, spec, s.dt).map_err(|e| {
+        let mut d = design(&s.model, spec, s.dt).map_err(|e| {
             let placement = e.condition.ends_with("poles") || e.condition.ends_with("pole placement");
             let (sub, reason) = if placement {
                 (".poles", format!("{} observer '{}': {}", e.kind, o.name, e.detail))
@@ -60,6 +60,7 @@ pub fn plan(s: &Scenario) -> Result<Plan, PlanError> {
                 observer: Some(i),
             }
         })?;
+        d.runtime.xhat0 = o.xhat0.clone();
         observers.push((o.name.clone(), Some(d)));
     }
     let feedback = match s.controller.as_ref().and_then(|c| c.spec.as_ref().map(|spec| (c, spec))) {

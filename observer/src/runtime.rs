@@ -4,6 +4,12 @@
 //! z_{k+1} = F z_k + G u_k + K y_k,      x̂_k = P z_k + Q y_k,      z_0 = 0.
 //! ```
 //!
+//! With an initial estimate x̂₀ (`xhat0` in the scenario) the start is z_0 = P⁺(x̂₀ − Q y_0),
+//! formed at the first sample: x̂_0 = x̂₀ exactly for full-order observers (P = I), and its
+//! projection P P⁺(x̂₀ − Qy_0) + Qy_0 on what a reduced-order observer can hold (the part of the
+//! state the outputs give is taken from y_0). Without it z_0 = 0, so x̂_0 = Q y_0: for a UIO
+//! x̂_0 = H y_0, for a Luenberger observer 0.
+//!
 //! At step k the observer is given y_k and u_{k−1} (the input the plant held over the last
 //! step): it first advances z_{k−1} → z_k with the stored y_{k−1}, then forms x̂_k. All buffers are
 //! allocated at construction; `step` does not allocate.
@@ -26,12 +32,15 @@ pub struct LinearObserver {
     pub p: MatData,
     /// Q, n×p.
     pub q: MatData,
+    /// The initial estimate x̂₀ (n values); `None`: z_0 = 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub xhat0: Option<Vec<f64>>,
 }
 
 impl LinearObserver {
     /// From the five matrices.
     pub fn new(f: &DMatrix<f64>, g: &DMatrix<f64>, k: &DMatrix<f64>, p: &DMatrix<f64>, q: &DMatrix<f64>) -> Self {
-        Self { f: f.into(), g: g.into(), k: k.into(), p: p.into(), q: q.into() }
+        Self { f: f.into(), g: g.into(), k: k.into(), p: p.into(), q: q.into(), xhat0: None }
     }
 
     /// Observer order r (size of z).
@@ -63,7 +72,8 @@ impl LinearObserver {
             && self.p.cols == r
             && self.q.rows == self.p.rows
             && self.q.cols == self.k.cols
-            && [&self.f, &self.g, &self.k, &self.p, &self.q].iter().all(|m| m.data.len() == m.rows * m.cols);
+            && [&self.f, &self.g, &self.k, &self.p, &self.q].iter().all(|m| m.data.len() == m.rows * m.cols)
+            && self.xhat0.as_ref().is_none_or(|x| x.len() == self.p.rows && x.iter().all(|v| v.is_finite()));
         if ok { Ok(()) } else { Err("observer matrices do not conform".into()) }
     }
 
@@ -86,6 +96,7 @@ impl LinearObserver {
             y_prev: vec![0.0; self.outputs()],
             xhat: vec![0.0; self.states()],
             started: false,
+            start: self.xhat0.as_ref().map(|x0| (x0.clone(), lti::pinv::pinv(&p))),
         }
     }
 }
@@ -103,6 +114,8 @@ pub struct ObserverState {
     y_prev: Vec<f64>,
     xhat: Vec<f64>,
     started: bool,
+    /// (x̂₀, P⁺) when the scenario gives an initial estimate.
+    start: Option<(Vec<f64>, DMatrix<f64>)>,
     /// P = I (full-order observers): x̂ = z + Qy needs no product with P.
     p_identity: bool,
     /// G = 0 (no known input acts): skip G u.
@@ -121,6 +134,13 @@ impl ObserverState {
             }
             mul_acc(&mut self.z_next, &self.k, &self.y_prev);
             std::mem::swap(&mut self.z, &mut self.z_next);
+        } else if let Some((x0, p_pinv)) = &self.start {
+            // z_0 = P⁺(x̂₀ − Q y_0), with x̂ as the scratch vector.
+            mul_into(&mut self.xhat, &self.q, y);
+            for (v, x) in self.xhat.iter_mut().zip(x0) {
+                *v = x - *v;
+            }
+            mul_into(&mut self.z, p_pinv, &self.xhat);
         }
         self.started = true;
         // Exact identities and zeros are skipped: for finite values the result differs from the
@@ -150,5 +170,22 @@ mod tests {
         let mut s = obs.instantiate();
         assert_eq!(s.step(&[3.0], &[0.0]), &[6.0]); // z0 = 0
         assert_eq!(s.step(&[1.0], &[10.0]), &[15.0]); // z1 = 0 + 10 + 3 = 13, x̂ = 13 + 2
+    }
+
+    #[test]
+    fn initial_estimate_sets_the_first_sample() {
+        // Full order: x̂_0 = x̂₀ whatever y_0. Reduced (P = [1; 1], Q = [0; 1]): the projection.
+        let one = |v: f64| DMatrix::from_element(1, 1, v);
+        let mut obs = LinearObserver::new(&one(0.5), &one(1.0), &one(1.0), &one(1.0), &one(2.0));
+        obs.xhat0 = Some(vec![7.0]);
+        let mut s = obs.instantiate();
+        assert_eq!(s.step(&[3.0], &[0.0]), &[7.0]); // z0 = 7 − 6 = 1
+        assert_eq!(s.step(&[1.0], &[10.0]), &[15.5]); // z1 = 0.5 + 10 + 3, x̂ = 13.5 + 2
+        let col = |a: f64, b: f64| DMatrix::from_column_slice(2, 1, &[a, b]);
+        let mut obs = LinearObserver::new(&one(0.5), &one(0.0), &one(1.0), &col(1.0, 1.0), &col(0.0, 1.0));
+        obs.xhat0 = Some(vec![4.0, 2.0]);
+        let mut s = obs.instantiate();
+        // z0 = P⁺([4, 2] − [0, 1]) = (4 + 1)/2 = 2.5: x̂_0 = [2.5, 3.5].
+        assert_eq!(s.step(&[1.0], &[0.0]), &[2.5, 3.5]);
     }
 }

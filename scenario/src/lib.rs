@@ -131,6 +131,8 @@ pub struct ObserverEntry {
     /// (diagnoser, member), both 0-based, for a member of a `[[diagnoser]]` bank (designed with
     /// the bank; neither spec nor process).
     pub member: Option<(usize, usize)>,
+    /// The initial estimate x̂₀ (`xhat0`, n values); `None`: the design's own start.
+    pub xhat0: Option<Vec<f64>>,
 }
 
 impl ObserverEntry {

@@ -210,6 +210,8 @@ pub struct RawObserver {
     /// LQE measurement weight (p×p).
     #[serde(rename = "R")]
     pub r: Option<Rows>,
+    /// The initial estimate x̂(0), n values.
+    pub xhat0: Option<Vec<f64>>,
     /// `kind = "process"`: the command and its parameters.
     pub command: Option<Vec<String>>,
     pub params: Option<toml::Table>,

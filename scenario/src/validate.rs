@@ -287,17 +287,19 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
                 ("gain", o.gain.is_some()),
                 ("Q", o.q.is_some()),
                 ("R", o.r.is_some()),
+                ("xhat0", o.xhat0.is_some()),
             ] {
                 if given {
                     return Err(bad(format!("{f}.{key}"), "a process observer takes no design keys (only command and params)"));
                 }
             }
-            ObserverEntry { name: o.name.clone(), spec: None, process: Some(process), member: None }
+            ObserverEntry { name: o.name.clone(), spec: None, process: Some(process), member: None, xhat0: None }
         } else {
             if o.command.is_some() || o.params.is_some() {
                 return Err(bad(format!("{f}.command"), format!("only kind = \"process\" takes command and params, not {}", quoted(&o.kind))));
             }
-            ObserverEntry { name: o.name.clone(), spec: Some(observer_spec(&f, o, &model, noise.as_ref())?), process: None, member: None }
+            let xhat0 = o.xhat0.as_ref().map(|x| initial_estimate(&format!("{f}.xhat0"), x, model.n())).transpose()?;
+            ObserverEntry { name: o.name.clone(), spec: Some(observer_spec(&f, o, &model, noise.as_ref())?), process: None, member: None, xhat0 }
         });
     }
     let mut taken = seen.clone();
@@ -305,7 +307,7 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
     // Each bank member runs as an observer of its own, after the scenario's observers.
     for (di, d) in diagnosers.iter().enumerate() {
         for j in 0..diagnosis::bank::channel_labels(d.channels, &model, &ff).len() {
-            observers.push(ObserverEntry { name: format!("{}-{}", d.name, j + 1), spec: None, process: None, member: Some((di, j)) });
+            observers.push(ObserverEntry { name: format!("{}-{}", d.name, j + 1), spec: None, process: None, member: Some((di, j)), xhat0: None });
         }
     }
 
@@ -450,6 +452,17 @@ fn observer_spec(f: &str, o: &RawObserver, model: &Model, noise: Option<&super::
         }
         _ => unreachable!("kind checked above"),
     })
+}
+
+/// `xhat0`: one finite value per state.
+fn initial_estimate(field: &str, x: &[f64], n: usize) -> Result<Vec<f64>, Bad> {
+    if x.len() != n {
+        return Err(bad(field, format!("has {} value(s), must have {n} (one per state)", x.len())));
+    }
+    for (i, &v) in x.iter().enumerate() {
+        finite(&format!("{field}[{}]", i + 1), v)?;
+    }
+    Ok(x.to_vec())
 }
 
 /// `gain = "lqe"` with its weights: Q (n×n, or the reduced order r = n − rank C of a reduced-order
