@@ -27,6 +27,9 @@ pub struct ObserverSummary {
     pub max_abs_error: f64,
     /// max |x − x̂| at the last step.
     pub final_abs_error: f64,
+    /// max |w − ŵ| over the tail, for an observer that estimates the unknown inputs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tail_max_abs_input_error: Option<f64>,
     /// Continuous error-dynamics eigenvalues, [re, im].
     pub poles: Vec<[f64; 2]>,
     /// Sampled observer eigenvalues, [re, im].
@@ -124,6 +127,7 @@ impl Summary {
                 tail_max_abs_residual: f.tail_max_abs_residual,
                 max_abs_error: f.max_abs_error,
                 final_abs_error: f.final_abs_error,
+                tail_max_abs_input_error: f.tail_max_abs_input_error,
                 poles: d.as_ref().map_or_else(Vec::new, |d| lti::re_im(&d.report.poles)),
                 discrete_poles: d.as_ref().map_or_else(Vec::new, |d| lti::re_im(&d.report.discrete_poles)),
             })
@@ -239,6 +243,9 @@ impl Summary {
         t += &format!("  {:<14} {:<16} {:>14} {:>14}   ({tail})\n", "observer", "kind", "tail max|e|", "tail max|r|");
         for o in &self.observers {
             t += &format!("  {:<14} {:<16} {:>14} {:>14}\n", o.name, o.kind, figure(o.tail_max_abs_error), figure(o.tail_max_abs_residual));
+            if let Some(w) = o.tail_max_abs_input_error {
+                t += &format!("  {:<31} {:>14}   (its unknown-input estimate)\n", "", format!("max|w − ŵ| {}", figure(Some(w))));
+            }
         }
         let p = &self.latency_ns.step;
         if p.max > 0 {

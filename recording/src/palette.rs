@@ -96,6 +96,8 @@ pub fn line(path: &str, observers: &[String]) -> Line {
         // Beside w and r in their views, from the other end of the palette.
         ["measurement_disturbance", _] | ["controller", "u", _] => thin(color(PALETTE.len() - 1 - k)),
         ["observer", o, "error" | "residual", _] => thin(shade(observer(o), k)),
+        // ŵ_k beside w_k (which has the palette's k-th colour): the observer's colour, darkened.
+        ["observer", o, "what", _] => thin(shade(observer(o), 1 + k)),
         ["observer", o, ..] => thin(observer(o)),
         ["latency", "step"] => thin(TRUE_STATE),
         ["latency", hop] => {

@@ -124,6 +124,19 @@ fn views(r: &Recording, s: Option<&Scenario>, observers: &[String]) -> Vec<View>
         let units: Vec<String> = residuals.iter().map(|(_, p)| named(p).unit).collect();
         let series = residuals.iter().map(|(k, p)| (tagged(format!("r{k}"), named(&signals::output(k - 1)), format!("y{k}")), p.clone())).collect();
         out.push(View { file: format!("residual_{}.png", sanitize(o)), title: format!("residual r = y − C·xhat ({o})"), y_label: common_unit("r", &units), scale: Scale::Linear, series });
+        // A UIO's ŵ beside the true w it estimates.
+        let estimates = members(r, &format!("/observer/{o}/what"));
+        if !estimates.is_empty() {
+            let mut series = Vec::new();
+            let mut units = Vec::new();
+            for (k, p) in &estimates {
+                let w = named(&signals::disturbance(k - 1));
+                series.push((format!("{} (true)", w.name), signals::disturbance(k - 1)));
+                series.push((format!("{} estimate ({o})", w.name), p.clone()));
+                units.push(w.unit);
+            }
+            out.push(View { file: format!("input_estimate_{}.png", sanitize(o)), title: format!("unknown inputs w and their estimate ŵ ({o}; ŵ_k is known at t_(k+1))"), y_label: common_unit("w", &units), scale: Scale::Linear, series });
+        }
     }
     let group = |groups: &[&str]| -> (Vec<(String, String)>, Vec<String>) {
         let paths: Vec<String> = groups.iter().flat_map(|g| members(r, g)).map(|(_, p)| p).collect();

@@ -49,6 +49,12 @@ pub fn residual(observer: &str, j: usize) -> String {
     format!("/observer/{observer}/residual/{}", j + 1)
 }
 
+/// `/observer/<name>/what/<k>`: the observer's estimate ŵ_k of unknown input k, recorded at t_k
+/// (it completes one sample later).
+pub fn input_estimate(observer: &str, k: usize) -> String {
+    format!("/observer/{observer}/what/{}", k + 1)
+}
+
 /// `/observer/<name>/log10_max_abs_error`: log10 of max_i |e_i|, a zero error recorded as
 /// log10 of [`LOG_FLOOR`]. Derived from the errors, so that a viewer without log axes still
 /// shows rounding-level and large errors with readable numbers on one axis.

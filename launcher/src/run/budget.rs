@@ -34,11 +34,14 @@ pub fn recorded_paths(s: &Scenario, plan: &Plan, paced: bool) -> Vec<String> {
     if s.controller.is_some() {
         p.extend((0..m.l()).map(sig::control));
     }
-    for o in s.observers.iter().filter(|o| o.member.is_none()) {
+    for (o, (_, d)) in s.observers.iter().zip(&plan.observers).filter(|(o, _)| o.member.is_none()) {
         p.extend((0..m.n()).map(|i| sig::estimate(&o.name, i)));
         p.extend((0..m.n()).map(|i| sig::error(&o.name, i)));
         p.extend((0..m.p()).map(|j| sig::residual(&o.name, j)));
         p.push(sig::log_error(&o.name));
+        if d.as_ref().is_some_and(|d| d.what.is_some()) {
+            p.extend((0..m.e.ncols()).map(|k| sig::input_estimate(&o.name, k)));
+        }
     }
     for b in &plan.banks {
         let d = &b.spec.name;

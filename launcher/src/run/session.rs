@@ -6,7 +6,10 @@ use lockstep::PlantLayout;
 
 use super::progress::Progress;
 use crate::error::LaunchError;
-use diagnosis::{Bank, Diagnosis, FaultInfo, Judge, Monitor};
+use diagnosis::{Diagnosis, FaultInfo, Judge, Monitor};
+use observer::design::InputEstimator;
+
+use crate::plan::Plan;
 use recording::write::Selection;
 use recording::palette;
 use recording::signals as sig;
@@ -20,12 +23,16 @@ struct ObserverChannels {
     residual: Vec<SeriesId>,
     /// log10 max_i |e_i| (see [`sig::log_error`]).
     log_error: SeriesId,
+    /// ŵ, for an observer that estimates the unknown inputs (recorded one row late, at t_{k−1}).
+    what: Vec<SeriesId>,
 }
 
 /// The recording's series, in three groups by time stamp: the signals of step k, the hops
 /// measured at step k, and what completes one step late (the step time, controller→plant).
 struct Channels {
     signals: usize,
+    /// ŵ_{k−1}, completed by row k.
+    estimates_late: usize,
     hops_now: usize,
     hops_late: usize,
     x: Vec<SeriesId>,
@@ -155,7 +162,9 @@ pub fn hop_entity(hop: &str) -> String {
 impl Session {
     /// Starts a session; with `rrd`, opens the recording there.
     /// `select` thins and filters what is written; the figures see every step.
-    pub fn new(s: &Scenario, layout: PlantLayout, banks: &[Bank], rrd: Option<&Path>, select: &Selection, pace_s: Option<f64>) -> Result<Self, LaunchError> {
+    pub fn new(s: &Scenario, layout: PlantLayout, plan: &Plan, rrd: Option<&Path>, select: &Selection, pace_s: Option<f64>) -> Result<Self, LaunchError> {
+        let banks = &plan.banks[..];
+        let estimates: Vec<Option<&InputEstimator>> = plan.observers.iter().map(|(_, d)| d.as_ref().and_then(|d| d.what.as_ref())).collect();
         let pace = pace_s.map(|p| Pace { period_ns: (p * 1e9).round() as u64, t0: None, steps: 0, overruns: 0, max_late_ns: 0, last_end: 0 });
         let mut overrun = None;
         let monitors: Vec<Monitor> = banks
@@ -173,6 +182,7 @@ impl Session {
                 let mut sink = RrdSink::create(path, &s.name, blueprint(s), &s.source).map_err(LaunchError::BadInput)?;
                 sink.select(select.clone());
                 let (signals, hops_now, hops_late) = (sink.group(), sink.group(), sink.group());
+                let estimates_late = sink.group();
                 let overrun_group = pace.is_some().then(|| sink.group());
                 let names = &s.names;
                 let observer_names: Vec<String> = s.observers.iter().map(|o| o.name.clone()).collect();
@@ -196,13 +206,18 @@ impl Session {
                 let observers = s
                     .observers
                     .iter()
-                    .map(|o| {
+                    .enumerate()
+                    .map(|(i, o)| {
                         let name = &o.name;
                         o.member.is_none().then(|| ObserverChannels {
                             xhat: (0..layout.n).map(|i| series(signals, sig::estimate(name, i), format!("{} ({name})", names.state[i].name))).collect(),
                             error: (0..layout.n).map(|i| series(signals, sig::error(name, i), format!("e{} ({name})", i + 1))).collect(),
                             residual: (0..layout.p).map(|j| series(signals, sig::residual(name, j), format!("r{} ({name})", j + 1))).collect(),
                             log_error: series(signals, sig::log_error(name), format!("log10 max|e| ({name})")),
+                            what: match estimates[i] {
+                                Some(_) => (0..layout.q).map(|k| series(estimates_late, sig::input_estimate(name, k), format!("{} estimate ({name})", names.disturbance[k].name))).collect(),
+                                None => Vec::new(),
+                            },
                         })
                     })
                     .collect();
@@ -251,13 +266,19 @@ impl Session {
                 for p in select.unmatched(paths.iter().map(String::as_str)) {
                     eprintln!("warning: --record {}: matches no signal of this run, so records nothing", scenario::quoted(&p));
                 }
-                Some((sink, Channels { signals, hops_now, hops_late, x, y, w, v, r, u, observers, members, decisions, faults, step_latency, hops: hop_ids }))
+                Some((sink, Channels { signals, estimates_late, hops_now, hops_late, x, y, w, v, r, u, observers, members, decisions, faults, step_latency, hops: hop_ids }))
             }
             None => None,
         };
+        let mut metrics = Metrics::new(layout, s.model.c.clone(), s.observers.len(), s.steps);
+        for (o, e) in estimates.iter().enumerate() {
+            if let Some(e) = e {
+                metrics.estimate_inputs(o, e.w.clone(), &e.w_c_phi, &e.w_c_gamma_b);
+            }
+        }
         Ok(Session {
             layout,
-            metrics: Metrics::new(layout, s.model.c.clone(), s.observers.len(), s.steps),
+            metrics,
             latency: Latency::new(hops),
             sink,
             controller_observer,
@@ -402,6 +423,15 @@ impl Session {
             put(sink, &oc.residual, &self.metrics.residual[o]);
             // max_i |e_i| of this step, as the figures took it.
             sink.push(oc.log_error, sig::log10_floored(self.metrics.observers[o].final_abs_error));
+        }
+        // ŵ_{k−1}, completed by this row, at the step it estimates.
+        if k > 0 && self.metrics.what.iter().any(|w| w.as_ref().is_some_and(|w| w.ready)) {
+            sink.row(ch.estimates_late, k - 1, (k - 1) as f64 * self.dt);
+            for (oc, what) in ch.observers.iter().zip(&self.metrics.what) {
+                if let (Some(oc), Some(what)) = (oc, what) {
+                    put(sink, &oc.what, &what.value);
+                }
+            }
         }
         for ((m, members), (decisions, isolated)) in self.monitors.iter().zip(&ch.members).zip(&ch.decisions) {
             for (i, ids) in members.iter().enumerate() {

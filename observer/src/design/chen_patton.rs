@@ -95,5 +95,5 @@ pub(super) fn design(model: &Model, gain: &Gain, dt: f64) -> Result<Designed, De
         },
         None => sampled_report(KIND, sampled, &d.f, d.fixed.clone(), matrices(&d), vec![], dt),
     };
-    Ok(Designed { report, runtime })
+    Ok(Designed { report, runtime, what: None })
 }

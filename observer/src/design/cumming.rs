@@ -91,5 +91,5 @@ pub(super) fn design(model: &Model, gain: &Gain, h: Option<&Mat>, dt: f64) -> Re
         },
         None => sampled_report(KIND, sampled, &d.fo, d.fixed.clone(), matrices(&d), vec![], dt),
     };
-    Ok(Designed { report, runtime })
+    Ok(Designed { report, runtime, what: None })
 }

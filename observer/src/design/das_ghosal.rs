@@ -176,5 +176,5 @@ pub(super) fn design(model: &Model, gain: Free, uio: bool, dt: f64) -> Result<De
         }
         None => sampled_report(kind, sampled, &d.f, d.fixed.clone(), matrices(&d), d.notes.clone(), dt),
     };
-    Ok(Designed { report, runtime })
+    Ok(Designed { report, runtime, what: None })
 }

@@ -56,5 +56,5 @@ pub(super) fn design(model: &Model, gain: &Gain, dt: f64) -> Result<Designed, De
         },
         None => sampled_report(KIND, sampled, &fd, fixed_d, vec![("K".into(), kd.clone()), ("F".into(), fd.clone())], notes, dt),
     };
-    Ok(Designed { report, runtime })
+    Ok(Designed { report, runtime, what: None })
 }

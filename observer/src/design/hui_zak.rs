@@ -247,6 +247,7 @@ pub(super) fn design(model: &Model, decay: f64, gain: Option<&Gain>, method: Met
             sampled_only: false,
         },
         runtime,
+        what: None,
     })
 }
 
@@ -268,7 +269,7 @@ fn design_lqe(model: &Model, decay: f64, gain: &Gain, dt: f64) -> Result<Designe
     let runtime = LinearObserver::new(&d_core.acl, &(&proj * &dm.b), &k, &Mat::identity(n, n), &d_core.m);
     let matrices = vec![("M".into(), d_core.m.clone()), ("A1".into(), d_core.a1.clone()), ("L".into(), d_core.l.clone())];
     let report = sampled_report(KIND, sampled, &d_core.acl, d_core.fixed.clone(), matrices, vec![], dt);
-    Ok(Designed { report, runtime })
+    Ok(Designed { report, runtime, what: None })
 }
 
 #[cfg(feature = "lmi")]

@@ -42,5 +42,6 @@ pub(super) fn design(model: &Model, qd: &Mat, r: &Mat, dt: f64) -> Result<Design
             notes: vec![format!("ρ(Φ(I − MC)) = {:.6}", kf.radius)],
         },
         runtime,
+        what: None,
     })
 }

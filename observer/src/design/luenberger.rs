@@ -50,5 +50,5 @@ pub(super) fn design(model: &Model, gain: &Gain, dt: f64) -> Result<Designed, De
             sampled_report(KIND, sampled, &fd, fixed_d, vec![("L".into(), ld.clone()), ("F".into(), fd.clone())], vec![], dt)
         }
     };
-    Ok(Designed { report, runtime })
+    Ok(Designed { report, runtime, what: None })
 }

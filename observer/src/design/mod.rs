@@ -19,6 +19,7 @@ mod gi_full_order;
 mod hui_zak;
 mod kalman;
 mod luenberger;
+mod unknown_input;
 
 use lti::eig::{eigenvalues, format_list, format_one};
 use lti::place::{place_observer, Method};
@@ -29,6 +30,7 @@ use crate::runtime::LinearObserver;
 
 pub use gain::{Gain, Weights};
 pub use hui_zak::{lmi_available, LmiSolution, Path};
+pub use unknown_input::InputEstimator;
 pub(crate) use gain::{free_gain, Pair};
 
 /// Which observer, with its free parameters.
@@ -116,6 +118,9 @@ pub struct Designed {
     pub report: Report,
     /// The sampled-data observer.
     pub runtime: LinearObserver,
+    /// How the unknown inputs are reconstructed from its estimate (UIOs whose Γ_E the outputs
+    /// see whole).
+    pub what: Option<InputEstimator>,
 }
 
 /// A condition that fails, with everything evaluated up to it.
@@ -374,8 +379,18 @@ pub(crate) fn require_stable(checks: &mut Checks, name: &str, ev: &[C64], domain
     }
 }
 
-/// Designs the observer for `model`, sampled with period `dt`.
+/// Designs the observer for `model`, sampled with period `dt`; an unknown-input observer also
+/// gets its unknown-input estimator where the outputs see Γ_E whole.
 pub fn design(model: &Model, spec: &Spec, dt: f64) -> Result<Designed, DesignError> {
+    let mut d = design_family(model, spec, dt)?;
+    if spec.decouples() {
+        let m = model.discretize(dt);
+        d.what = unknown_input::estimator(&m, matches!(spec, Spec::HuiZak { .. }));
+    }
+    Ok(d)
+}
+
+fn design_family(model: &Model, spec: &Spec, dt: f64) -> Result<Designed, DesignError> {
     match spec {
         Spec::Luenberger { gain } => luenberger::design(model, gain, dt),
         Spec::ChenPatton { gain } => chen_patton::design(model, gain, dt),

@@ -68,7 +68,10 @@ pub fn blueprint(s: &Scenario) -> Blueprint {
     let mut plant_signals: Vec<ContainerLike> = Vec::new();
     if !n.disturbance.is_empty() || !n.measurement_disturbance.is_empty() {
         let parts = [with_units(&n.disturbance), with_units(&n.measurement_disturbance)].concat();
-        plant_signals.push(TimeSeriesView::new(titled("unknown inputs", &parts)).with_contents(["/disturbance/**", "/measurement_disturbance/**"]).into());
+        // With every UIO's ŵ (recorded only for those whose outputs see Γ_E whole).
+        let mut contents = vec!["/disturbance/**".to_string(), "/measurement_disturbance/**".to_string()];
+        contents.extend(s.observers.iter().filter(|o| o.spec.as_ref().is_some_and(|sp| sp.decouples())).map(|o| format!("/observer/{}/what/**", o.name)));
+        plant_signals.push(TimeSeriesView::new(titled("unknown inputs w, v and estimates ŵ", &parts)).with_contents(contents).into());
     }
     let inputs_title = if s.controller.is_some() { "inputs r and controller u" } else { "inputs" };
     plant_signals.push(TimeSeriesView::new(titled(inputs_title, &with_units(&n.input))).with_contents(["/input/**", "/controller/**"]).into());

@@ -7,6 +7,7 @@ use lti::kernel::mul_into;
 use lti::Mat;
 
 use super::tail::{tail_start, BlockMax};
+use super::what::InputEstimate;
 use super::StepRow;
 
 /// The figures of one observer.
@@ -20,6 +21,8 @@ pub struct ObserverFigures {
     pub max_abs_error: f64,
     /// max_i |x_i − x̂_i| at the last step.
     pub final_abs_error: f64,
+    /// max over the tail of max_j |w_j − ŵ_j|, for an observer that estimates w.
+    pub tail_max_abs_input_error: Option<f64>,
 }
 
 /// max(a, b) that propagates NaN (`f64::max` ignores it): a non-finite estimate must not score
@@ -51,6 +54,8 @@ pub struct Metrics {
     pub error: Vec<Vec<f64>>,
     /// Residuals of the last row.
     pub residual: Vec<Vec<f64>>,
+    /// Per observer, its unknown-input estimate ŵ when it has one.
+    pub what: Vec<Option<InputEstimate>>,
 }
 
 impl Metrics {
@@ -74,7 +79,13 @@ impl Metrics {
             steps: 0,
             error: vec![vec![0.0; layout.n]; observers],
             residual: vec![vec![0.0; layout.p]; observers],
+            what: vec![None; observers],
         }
+    }
+
+    /// Observer `o` estimates the unknown inputs: ŵ_k = W y_{k+1} − (WCΦ) x̂_k − (WCΓ_B) u_k.
+    pub fn estimate_inputs(&mut self, o: usize, w: Mat, w_c_phi: &Mat, w_c_gamma_b: &Mat) {
+        self.what[o] = Some(InputEstimate::new(w, w_c_phi, w_c_gamma_b, self.planned, self.planned_tail));
     }
 
     /// The first step of the tail of the steps completed so far.
@@ -87,9 +98,10 @@ impl Metrics {
     pub fn finish(&mut self) {
         let start = self.tail_start();
         let completed = self.steps >= self.planned;
-        for ((f, [e, r]), exact) in self.observers.iter_mut().zip(&self.blocks).zip(&self.exact) {
+        for (((f, [e, r]), exact), what) in self.observers.iter_mut().zip(&self.blocks).zip(&self.exact).zip(&self.what) {
             f.tail_max_abs_error = start.map(|s| if completed { exact[0] } else { e.max_from(s) });
             f.tail_max_abs_residual = start.map(|s| if completed { exact[1] } else { r.max_from(s) });
+            f.tail_max_abs_input_error = what.as_ref().and_then(|w| start.map(|s| w.tail_max_abs_error(s, completed)));
         }
     }
 
@@ -110,6 +122,9 @@ impl Metrics {
             for (r, &yj) in res.iter_mut().zip(y) {
                 *r = yj - *r;
                 rmax = nan_max(rmax, r.abs());
+            }
+            if let Some(what) = &mut self.what[o] {
+                what.push(row.k, y, &row.plant[self.layout.u_prev()], &row.plant[self.layout.w()], xhat);
             }
             let f = &mut self.observers[o];
             f.max_abs_error = nan_max(f.max_abs_error, emax);

@@ -9,6 +9,7 @@ mod metrics;
 mod rrd;
 mod select;
 pub mod tail;
+mod what;
 
 pub use blueprint::blueprint;
 pub use file_sink::UncompressedFileSink;
@@ -16,6 +17,7 @@ pub use latency::{histogram, Latency, Percentiles};
 pub use metrics::{nan_max, Metrics, ObserverFigures};
 pub use rrd::{RrdSink, SeriesId};
 pub use select::Selection;
+pub use what::InputEstimate;
 
 use lockstep::{Header, PlantLayout};
 
