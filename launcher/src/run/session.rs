@@ -164,7 +164,14 @@ impl Session {
     /// `select` thins and filters what is written; the figures see every step.
     pub fn new(s: &Scenario, layout: PlantLayout, plan: &Plan, rrd: Option<&Path>, select: &Selection, pace_s: Option<f64>) -> Result<Self, LaunchError> {
         let banks = &plan.banks[..];
-        let estimates: Vec<Option<&InputEstimator>> = plan.observers.iter().map(|(_, d)| d.as_ref().and_then(|d| d.what.as_ref())).collect();
+        // ŵ of the scenario's own observers (a bank member's model widens E with its blind
+        // channels: its estimator is not of the plant's w).
+        let estimates: Vec<Option<&InputEstimator>> = plan
+            .observers
+            .iter()
+            .zip(&s.observers)
+            .map(|((_, d), o)| d.as_ref().and_then(|d| d.what.as_ref()).filter(|w| o.member.is_none() && w.w.nrows() == layout.q))
+            .collect();
         let pace = pace_s.map(|p| Pace { period_ns: (p * 1e9).round() as u64, t0: None, steps: 0, overruns: 0, max_late_ns: 0, last_end: 0 });
         let mut overrun = None;
         let monitors: Vec<Monitor> = banks
