@@ -16,7 +16,7 @@
 
 use lti::eig::{eigenvalues, format_list};
 use lti::place::{place, Method};
-use lti::{Mat, Model, Poles, C64};
+use lti::{Discrete, Mat, Model, Poles, C64};
 
 /// How G is obtained.
 #[derive(Debug, Clone, PartialEq)]
@@ -93,6 +93,41 @@ pub fn design(model: &Model, spec: &FeedbackSpec, track: Option<&Mat>, dt: f64) 
         },
     };
     Ok(FeedbackDesign { g, n, closed_loop, discrete_closed_loop, unstable })
+}
+
+/// G for a discrete-time plant given per step (Φ, Γ_B): placed at e^{p·dt} on (Φ, Γ_B), or
+/// given; `closed_loop` is then ln(z)/dt of eig(Φ − Γ_BG), and the prefilter makes the sampled
+/// loop's DC gain one: N = (C_t (I − Φ + Γ_BG)⁻¹ Γ_B)⁻¹.
+pub fn design_discrete(dm: &Discrete, spec: &FeedbackSpec, track: Option<&Mat>) -> Result<FeedbackDesign, String> {
+    let (n, l) = (dm.a.nrows(), dm.b.ncols());
+    let g = match spec {
+        FeedbackSpec::Poles { poles, placement } => place(&dm.a, &dm.b, &poles.to_discrete(dm.dt), *placement).map_err(|e| e.to_string())?.gain,
+        FeedbackSpec::Gain(g) => {
+            if g.shape() != (l, n) {
+                return Err(format!("gain is {}×{}, must be {l}×{n}", g.nrows(), g.ncols()));
+            }
+            g.clone()
+        }
+    };
+    let acl = &dm.a - &dm.b * &g;
+    let discrete_closed_loop = eigenvalues(&acl).map_err(|e| e.to_string())?;
+    // ln(z)/dt; a deadbeat mode (z = 0) has no continuous image and is left out.
+    let closed_loop: Vec<C64> = discrete_closed_loop.iter().filter(|z| z.norm() >= 1e-12).map(|z| z.ln() / dm.dt).collect();
+    let unstable: Vec<C64> = closed_loop.iter().copied().filter(|z| z.re >= 0.0).collect();
+    let prefilter = match track {
+        None => Mat::identity(l, l),
+        Some(ct) if ct.shape() != (l, n) => return Err(format!("track is {}×{}, must be {l}×{n} (one tracked output per input)", ct.nrows(), ct.ncols())),
+        Some(ct) => {
+            let x = (Mat::identity(n, n) - &acl).lu().solve(&dm.b);
+            let dc = x.map(|x| ct * x);
+            match dc.as_ref().and_then(|dc| dc.clone().try_inverse()).filter(|i| i.iter().all(|v| v.is_finite())) {
+                Some(i) => i,
+                None if !unstable.is_empty() => Mat::identity(l, l),
+                None => return Err("the sampled closed loop's DC gain to the tracked outputs, C_t(I − Φ + Γ_BG)⁻¹Γ_B, is singular: those outputs cannot follow r".into()),
+            }
+        }
+    };
+    Ok(FeedbackDesign { g, n: prefilter, closed_loop, discrete_closed_loop, unstable })
 }
 
 /// N = −(C_t (A − BG)⁻¹ B)⁻¹ (see the module documentation).

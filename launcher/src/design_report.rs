@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 
 use lti::eig::{format_list, sig};
 use lti::Mat;
-use observer::design::{design, Condition};
+use observer::design::Condition;
 use serde::Serialize;
 use serde_json::{json, Value};
 
@@ -63,7 +63,7 @@ pub fn report(s: &Scenario) -> DesignReport {
             observers.push(json!({ "name": o.name, "kind": "process", "command": p.command, "params": p.params }));
             continue;
         };
-        match design(&s.model, spec, s.dt) {
+        match crate::plan::design_observer(s, spec) {
             Ok(d) => {
                 let r = &d.report;
                 text += "  conditions:\n";

@@ -32,6 +32,12 @@ pub struct PlanError {
     pub observer: Option<usize>,
 }
 
+/// One observer's design: on the continuous plant and its exact sampling, or on a discrete-time
+/// plant's own (Φ, Γ_B, Γ_E).
+pub fn design_observer(s: &Scenario, spec: &observer::Spec) -> Result<Designed, observer::DesignError> {
+    if s.discrete { observer::design::design_discrete(&s.sampled_model(), spec) } else { design(&s.model, spec, s.dt) }
+}
+
 /// Designs every observer and the controller.
 #[allow(clippy::result_large_err)] // made once per command, never on a hot path
 pub fn plan(s: &Scenario) -> Result<Plan, PlanError> {
@@ -47,7 +53,7 @@ pub fn plan(s: &Scenario) -> Result<Plan, PlanError> {
             observers.push((o.name.clone(), None));
             continue;
         };
-        let mut d = design(&s.model, spec, s.dt).map_err(|e| {
+        let mut d = design_observer(s, spec).map_err(|e| {
             let placement = e.condition.ends_with("poles") || e.condition.ends_with("pole placement");
             let (sub, reason) = if placement {
                 (".poles", format!("{} observer '{}': {}", e.kind, o.name, e.detail))
@@ -64,10 +70,17 @@ pub fn plan(s: &Scenario) -> Result<Plan, PlanError> {
         observers.push((o.name.clone(), Some(d)));
     }
     let feedback = match s.controller.as_ref().and_then(|c| c.spec.as_ref().map(|spec| (c, spec))) {
-        Some((c, spec)) => Some(design_feedback(&s.model, spec, c.track.as_ref(), s.dt).map_err(|reason| {
-            let field = if matches!(spec, FeedbackSpec::Gain(_)) { "controller.gain" } else { "controller.poles" };
-            PlanError { error: locate(field.into(), reason), conditions: vec![], observer: None }
-        })?),
+        Some((c, spec)) => {
+            let designed = if s.discrete {
+                controller::design::design_discrete(&s.sampled_model(), spec, c.track.as_ref())
+            } else {
+                design_feedback(&s.model, spec, c.track.as_ref(), s.dt)
+            };
+            Some(designed.map_err(|reason| {
+                let field = if matches!(spec, FeedbackSpec::Gain(_)) { "controller.gain" } else { "controller.poles" };
+                PlanError { error: locate(field.into(), reason), conditions: vec![], observer: None }
+            })?)
+        }
         None => None,
     };
     let warnings = warnings(s, &observers, feedback.as_ref());
@@ -104,7 +117,8 @@ fn warnings(s: &Scenario, observers: &[(String, Option<Designed>)], feedback: Op
             out.push(format!("dt = {} is coarse for {what}: fastest pole |p| = {}, |p|·dt = {} (keep it below 0.2)", s.dt, sig(f), sig(f * s.dt)));
         }
     };
-    if let Ok(ev) = eigenvalues(&s.model.a) {
+    // A discrete plant has no continuous poles to compare with dt.
+    if let Ok(ev) = eigenvalues(&s.model.a).map(|ev| if s.discrete { Vec::new() } else { ev }) {
         check("the plant".into(), &ev);
     }
     for (name, d) in &observers {
@@ -113,7 +127,9 @@ fn warnings(s: &Scenario, observers: &[(String, Option<Designed>)], feedback: Op
         }
     }
     if let Some(fb) = feedback {
-        check("the closed loop".into(), &fb.closed_loop);
+        if !s.discrete {
+            check("the closed loop".into(), &fb.closed_loop);
+        }
         if let Some(why) = fb.instability() {
             out.push(why);
         }

@@ -40,6 +40,10 @@ pub struct PlantConfig {
     pub faults: Vec<Fault>,
     /// Process and measurement noise, if any.
     pub noise: Option<Noise>,
+    /// A discrete-time plant: `a`, `b`, `e` (and `ff`) are Φ, Γ_B, Γ_E (Γ_F) of one step, and
+    /// x_{k+1} = Φx_k + Γ_Bu_k + Γ_Ew(t_k) (+ Γ_F f(t_k)).
+    #[serde(default)]
+    pub discrete: bool,
 }
 
 #[derive(Deserialize)]
@@ -53,6 +57,9 @@ struct ProtocolModel {
     x0: Vec<f64>,
     #[serde(default)]
     Ff: Vec<Vec<f64>>,
+    /// "discrete" when A, B, E are a discrete-time plant's Φ, Γ_B, Γ_E.
+    #[serde(default)]
+    time: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -101,6 +108,7 @@ impl PlantConfig {
             ff: rows(&m.Ff, n),
             faults: s.faults,
             noise: s.noise,
+            discrete: m.time.as_deref() == Some("discrete"),
         })
     }
 }

@@ -18,6 +18,10 @@
 //! computed once, at construction. Whether a switching time is on a sample or inside a step is
 //! decided exactly, on the decimals the scenario writes ([`lti::signal::locate`]): no tolerance.
 //! The generator is re-evaluated from t at every step rather than propagated, so it cannot drift.
+//!
+//! A discrete-time plant (`PlantConfig::discrete`, an identified model) is given per step:
+//! x_{k+1} = Φx_k + Γ_Bu_k + Γ_Ew(t_k), the unknown inputs sampled at t_k and held — the same
+//! recursion with Φ_h = Φ, Γ_h = [Γ_B, Γ_E, a_iΓ_E,i e₁ᵀ …] and no step split.
 
 use lockstep::PlantLayout;
 use lti::discretize::exp_upper;
@@ -146,8 +150,19 @@ impl Plant {
             }
             Piece { offset, phi: dm.a, gamma, held: Vec::new() }
         };
-        let full = piece(0.0, cfg.dt);
-        let splits = split_steps(cfg, &piece);
+        let (full, splits) = if cfg.discrete {
+            // Φ, Γ_B, Γ_E as given; a sine enters through its value at t_k: a_i·sin(ω_it_k + φ_i)·Γ_E,i.
+            let mut gamma = DMatrix::<f64>::zeros(n, m);
+            gamma.columns_mut(0, l).copy_from(&b);
+            gamma.columns_mut(l, q).copy_from(&e);
+            for (j, &(i, _, _)) in sines.iter().enumerate() {
+                let amp = cfg.disturbances[i].sine().map_or(0.0, |s| s.0);
+                gamma.set_column(l + q + 2 * j, &(e.column(i) * amp));
+            }
+            (Piece { offset: 0.0, phi: a.clone(), gamma, held: Vec::new() }, Vec::new())
+        } else {
+            (piece(0.0, cfg.dt), split_steps(cfg, &piece))
+        };
         let layout = PlantLayout { n, p, q, r, l, f: cfg.faults.len() };
         let ff: DMatrix<f64> = (&cfg.ff).into();
         for f in &cfg.faults {
@@ -173,6 +188,10 @@ impl Plant {
                     Target::Component(j) => ff.column(j).into_owned(),
                     Target::Sensor(_) => unreachable!("sensor faults act at the sample"),
                 };
+                if cfg.discrete {
+                    // Γ₀ is the column itself (a per-step distribution); f is held at f(t_k).
+                    return (i, column.clone(), DVector::zeros(n));
+                }
                 let mut g = DMatrix::<f64>::zeros(n, 2);
                 g.set_column(0, &column);
                 let (_, gamma) = exp_upper(&a, &g, &ramp_generator, cfg.dt);

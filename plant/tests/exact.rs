@@ -32,6 +32,7 @@ fn sinusoidal_disturbance_matches_scipy() {
         ff: lti::MatData { rows: 0, cols: 0, data: vec![] },
         faults: vec![],
         noise: None,
+        discrete: false,
     };
     let mut plant = Plant::new(&cfg).unwrap();
     let u = [0.5, -0.2];
@@ -89,6 +90,7 @@ fn divergence_names_the_state_and_step() {
         ff: lti::MatData { rows: 0, cols: 0, data: vec![] },
         faults: vec![],
         noise: None,
+        discrete: false,
     };
     let mut plant = Plant::new(&cfg).unwrap();
     let mut k = 0;
@@ -123,6 +125,7 @@ fn scalar(w: Signal, steps: u64) -> PlantConfig {
         ff: lti::MatData { rows: 0, cols: 0, data: vec![] },
         faults: vec![],
         noise: None,
+        discrete: false,
     }
 }
 

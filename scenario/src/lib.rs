@@ -42,8 +42,10 @@ pub struct Scenario {
     pub duration: f64,
     /// Number of steps, round(duration / dt).
     pub steps: u64,
-    /// The plant.
+    /// The plant: continuous (A, B, C, E, D), or with `discrete` its per-step (Φ, Γ_B, C, Γ_E, D).
     pub model: Model,
+    /// `[plant] time = "discrete"`: `model`'s A, B and E are Φ, Γ_B and Γ_E of one step of dt.
+    pub discrete: bool,
     /// Initial state.
     pub x0: Vec<f64>,
     /// |x_i| beyond this stops the run.
@@ -198,6 +200,17 @@ pub fn locate_error(s: &Scenario, field: &str, reason: String) -> ScenarioError 
 }
 
 impl Scenario {
+    /// The plant over one step of dt: the exact zero-order-hold sampling of a continuous plant,
+    /// or a discrete plant's own Φ, Γ_B, Γ_E.
+    pub fn sampled_model(&self) -> lti::Discrete {
+        if self.discrete {
+            let m = &self.model;
+            lti::Discrete { a: m.a.clone(), b: m.b.clone(), c: m.c.clone(), e: m.e.clone(), d: m.d.clone(), dt: self.dt }
+        } else {
+            self.model.discretize(self.dt)
+        }
+    }
+
     /// Reads and validates a scenario file: a regular file of at most [`MAX_SCENARIO_BYTES`].
     pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
         let text = untrusted::read_bounded(path, MAX_SCENARIO_BYTES).map_err(|reason| ScenarioError {

@@ -15,8 +15,17 @@ pub const MAX_MATRIX_FILE_BYTES: u64 = 1 << 30;
 /// Replaces every matrix given as a file by its rows; an error names the field.
 pub(crate) fn load_all(raw: &mut RawScenario, dir: &Path) -> Result<(), Bad> {
     let p = &mut raw.plant;
-    let mut fields: Vec<(String, &mut Rows)> = vec![("plant.A".into(), &mut p.a), ("plant.B".into(), &mut p.b), ("plant.C".into(), &mut p.c)];
-    for (name, m) in [("plant.E", &mut p.e), ("plant.D", &mut p.d), ("plant.Ff", &mut p.ff)] {
+    let mut fields: Vec<(String, &mut Rows)> = vec![("plant.C".into(), &mut p.c)];
+    for (name, m) in [
+        ("plant.A", &mut p.a),
+        ("plant.B", &mut p.b),
+        ("plant.Phi", &mut p.phi),
+        ("plant.Gamma_B", &mut p.gamma_b),
+        ("plant.Gamma_E", &mut p.gamma_e),
+        ("plant.E", &mut p.e),
+        ("plant.D", &mut p.d),
+        ("plant.Ff", &mut p.ff),
+    ] {
         fields.extend(m.as_mut().map(|m| (name.to_string(), m)));
     }
     if let Some(noise) = raw.noise.as_mut() {

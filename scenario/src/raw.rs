@@ -132,10 +132,21 @@ pub struct RawDiagnoser {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawPlant {
+    /// "continuous" (default: A, B, E) or "discrete" (Phi, Gamma_B, Gamma_E per step of dt).
+    pub time: Option<String>,
     #[serde(rename = "A")]
-    pub a: Rows,
+    pub a: Option<Rows>,
     #[serde(rename = "B")]
-    pub b: Rows,
+    pub b: Option<Rows>,
+    /// Φ of a discrete-time plant.
+    #[serde(rename = "Phi")]
+    pub phi: Option<Rows>,
+    /// Γ_B of a discrete-time plant.
+    #[serde(rename = "Gamma_B")]
+    pub gamma_b: Option<Rows>,
+    /// Γ_E of a discrete-time plant.
+    #[serde(rename = "Gamma_E")]
+    pub gamma_e: Option<Rows>,
     #[serde(rename = "C")]
     pub c: Rows,
     #[serde(rename = "E")]

@@ -205,18 +205,38 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
     let steps = steps_f as u64;
     let remote = super::hosts::placements(&raw)?;
 
-    // Plant.
+    // Plant: continuous (A, B, E) or, for an identified model, discrete (Φ, Γ_B, Γ_E per step).
     let p = &raw.plant;
-    let a = matrix("plant.A", &p.a, (None, None), "")?;
+    let discrete = match p.time.as_deref() {
+        None | Some("continuous") => false,
+        Some("discrete") => true,
+        Some(other) => return Err(bad("plant.time", format!("{} is not a time domain (continuous, discrete)", quoted(other)))),
+    };
+    let ([ka, kb, ke], given, other) = if discrete {
+        (["Phi", "Gamma_B", "Gamma_E"], [&p.phi, &p.gamma_b, &p.gamma_e], [("A", p.a.is_some()), ("B", p.b.is_some()), ("E", p.e.is_some())])
+    } else {
+        (["A", "B", "E"], [&p.a, &p.b, &p.e], [("Phi", p.phi.is_some()), ("Gamma_B", p.gamma_b.is_some()), ("Gamma_E", p.gamma_e.is_some())])
+    };
+    if let Some((key, _)) = other.iter().find(|(_, g)| *g) {
+        let why = if discrete {
+            "a discrete-time plant (time = \"discrete\") is given per step by Phi, Gamma_B and Gamma_E"
+        } else {
+            "Phi, Gamma_B and Gamma_E give a discrete-time plant: add time = \"discrete\" (or give A, B and E)"
+        };
+        return Err(bad(format!("plant.{key}"), why));
+    }
+    let [a_rows, b_rows, e_rows] = given;
+    let required = |rows: &Option<Rows>, key: &str| rows.clone().ok_or_else(|| bad("plant", format!("missing field `{key}`")));
+    let a = matrix(&format!("plant.{ka}"), &required(a_rows, ka)?, (None, None), "")?;
     let n = a.nrows();
     if a.ncols() != n {
-        return Err(bad("plant.A", format!("is {}×{}, must be square", n, a.ncols())));
+        return Err(bad(format!("plant.{ka}"), format!("is {}×{}, must be square", n, a.ncols())));
     }
-    let b = matrix("plant.B", &p.b, (Some(n), None), "n rows, one column per known input")?;
+    let b = matrix(&format!("plant.{kb}"), &required(b_rows, kb)?, (Some(n), None), "n rows, one column per known input")?;
     let c = matrix("plant.C", &p.c, (None, Some(n)), "one column per state")?;
     let pn = c.nrows();
-    let e = match &p.e {
-        Some(rows) => matrix("plant.E", rows, (Some(n), None), "n rows, one column per unknown input")?,
+    let e = match e_rows {
+        Some(rows) => matrix(&format!("plant.{ke}"), rows, (Some(n), None), "n rows, one column per unknown input")?,
         None => Mat::zeros(n, 0),
     };
     let d = match &p.d {
@@ -256,6 +276,19 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
         None => Mat::zeros(n, 0),
     };
     let model = Model { a, b, c, e, d };
+    if discrete {
+        // What needs the continuous A: a continuous noise intensity (Van Loan), an external
+        // plant (PROTOCOL.md §3 sends A), the banks' structure from Markov parameters.
+        if raw.noise.as_ref().is_some_and(|z| z.process.is_some()) {
+            return Err(bad("noise.process", "a discrete-time plant takes process_discrete (Q_d per step), not a continuous intensity"));
+        }
+        if p.process.is_some() {
+            return Err(bad("plant.process", "time = \"discrete\" is for the built-in plant: an external plant simulates itself"));
+        }
+        if !raw.diagnoser.is_empty() {
+            return Err(bad("diagnoser[1]", "diagnosis banks need a continuous-time plant (time = \"discrete\" does not take [[diagnoser]] yet)"));
+        }
+    }
     let noise = super::fault_diagnosis::noise(&raw.noise, &model, dt)?;
     if raw.fault.len() > MAX_FAULTS {
         return Err(bad(format!("fault[{}]", MAX_FAULTS + 1), format!("{} faults: at most {MAX_FAULTS} (each adds two values to every plant sample and two recorded signals)", raw.fault.len())));
@@ -338,6 +371,7 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
         duration,
         steps,
         model,
+        discrete,
         x0: p.x0.clone(),
         state_bound,
         names: layout_names,

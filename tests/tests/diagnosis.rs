@@ -122,6 +122,7 @@ fn a_ramp_fault_is_integrated_exactly() {
         ff: one(1.0),
         faults: vec![Fault { name: "ramp".into(), target: Target::Component(0), kind: Kind::Additive, value: 0.3, profile: Profile::Ramp { start: 1.0, end: None } }],
         noise: None,
+        discrete: false,
     };
     let mut p = plant::Plant::new(&cfg).unwrap();
     for k in 0..50u64 {

@@ -38,12 +38,14 @@ fn check_scenario(name: &str) {
     assert!(rp.complete && ri.complete);
     let (tp, ti) = (trajectories(&rp), trajectories(&ri));
     assert_eq!(tp.len(), ti.len());
-    // x (3) y (2) w (1) r (2) u (2) + 2 observers × (x̂ 3 + e 3 + r 2 + log10 max|e| 1)
-    assert_eq!(tp.len(), 3 + 2 + 1 + 2 + 2 + 2 * 9, "{:?}", tp.iter().map(|(k, _)| k).collect::<Vec<_>>());
+    // x (3) y (2) w (1) r (2) u (2) + 2 observers × (x̂ 3 + e 3 + r 2 + log10 max|e| 1) + the
+    // UIO's ŵ (1)
+    assert_eq!(tp.len(), 3 + 2 + 1 + 2 + 2 + 2 * 9 + 1, "{:?}", tp.iter().map(|(k, _)| k).collect::<Vec<_>>());
     for ((kp, sp), (ki, si)) in tp.iter().zip(&ti) {
         assert_eq!(kp, ki);
-        // Exactly one value per step.
-        assert_eq!(sp.steps, (0..steps as i64).collect::<Vec<_>>(), "{kp}");
+        // Exactly one value per step (ŵ_k completes with step k + 1: none for the last step).
+        let recorded = if kp.contains("/what/") { steps as i64 - 1 } else { steps as i64 };
+        assert_eq!(sp.steps, (0..recorded).collect::<Vec<_>>(), "{kp}");
         let same = sp.values.iter().zip(&si.values).all(|(a, b)| a.to_bits() == b.to_bits());
         assert!(same && sp.values.len() == si.values.len(), "{kp} differs between modes");
     }

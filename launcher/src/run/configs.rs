@@ -71,6 +71,7 @@ pub fn configs(s: &Scenario, plan: &Plan) -> Configs {
             ff: (&s.ff).into(),
             faults: s.faults.clone(),
             noise: noise(s),
+            discrete: s.discrete,
     };
     let followers = s.observers.iter().map(|o| is_follower(s, &o.name)).collect();
     let observers = plan

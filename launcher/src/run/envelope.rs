@@ -78,7 +78,13 @@ pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> V
         steps: s.steps,
         publishes,
         reads,
-        model: json!({ "A": rows(&m.a), "B": rows(&m.b), "C": rows(&m.c), "D": rows(&m.d), "E": rows(&m.e), "Ff": rows(&s.ff), "x0": s.x0 }),
+        model: {
+            let mut model = json!({ "A": rows(&m.a), "B": rows(&m.b), "C": rows(&m.c), "D": rows(&m.d), "E": rows(&m.e), "Ff": rows(&s.ff), "x0": s.x0 });
+            if s.discrete {
+                model["time"] = json!("discrete");
+            }
+            model
+        },
         signals: Value::Null,
         params,
         pace_s: None,

@@ -15,7 +15,7 @@
 use lti::eig::format_list;
 use lti::pinv::{pinv, rank};
 use lti::zeros::decoupling;
-use lti::{Mat, Model, C64};
+use lti::{Discrete, Mat, Model, C64};
 
 use super::{eig, eq_detail, free_gain, require_stable, sampled_report, Checks, Designed, DesignError, Domain, Gain, Pair, Report};
 use crate::runtime::LinearObserver;
@@ -57,8 +57,9 @@ pub(super) fn core(
             format_list(&zeros.zeros)
         } else {
             format!(
-                "unstable zero(s) {z}: (TA, C) is not detectable — its unobservable mode(s) s = {z} stay in F = TA − K1C whatever K1 is",
-                z = format_list(&unstable)
+                "unstable zero(s) {z}: (TA, C) is not detectable — its unobservable mode(s) {var} = {z} stay in F = TA − K1C whatever K1 is",
+                z = format_list(&unstable),
+                var = if domain == Domain::Continuous { "s" } else { "z" }
             )
         },
     )?;
@@ -72,14 +73,17 @@ pub(super) fn core(
     Ok(Core { h, t, k1, k2, f, fixed })
 }
 
-pub(super) fn design(model: &Model, gain: &Gain, dt: f64) -> Result<Designed, DesignError> {
+pub(super) fn design(model: Option<&Model>, dm: &Discrete, gain: &Gain) -> Result<Designed, DesignError> {
+    let dt = dm.dt;
     let mut checks = Checks::new(KIND);
-    let ct = if gain.is_lqe() { None } else { Some(core(&model.a, &model.c, &model.e, gain, &[], Domain::Continuous, &mut checks)?) };
+    let ct = match model.filter(|_| !gain.is_lqe()) {
+        Some(model) => Some(core(&model.a, &model.c, &model.e, gain, &[], Domain::Continuous, &mut checks)?),
+        None => None,
+    };
     let carried = ct.as_ref().map(|c| c.fixed.clone()).unwrap_or_default();
-    let dm = model.discretize(dt);
     let mut sampled = Checks::sampled(KIND, dt);
     let d = core(&dm.a, &dm.c, &dm.e, gain, &carried, Domain::Discrete(dt), &mut sampled)?;
-    let n = model.n();
+    let n = dm.a.nrows();
     let runtime = LinearObserver::new(&d.f, &(&d.t * &dm.b), &(&d.k1 + &d.k2), &Mat::identity(n, n), &d.h);
     let matrices = |c: &Core| vec![("H".into(), c.h.clone()), ("T".into(), c.t.clone()), ("K1".into(), c.k1.clone()), ("K2".into(), c.k2.clone()), ("F".into(), c.f.clone())];
     let report = match ct {

@@ -13,7 +13,7 @@
 //! Sampled counterpart: the same equations with A_d, B_d (as for Das–Ghosal).
 
 use lti::pinv::rank;
-use lti::{Mat, Model, C64};
+use lti::{Discrete, Mat, Model, C64};
 
 use super::das_ghosal::independent_columns_of_complement;
 use super::{eig, eq_detail, free_gain, require_stable, sampled_report, Checks, Designed, DesignError, Domain, Gain, Pair, Report};
@@ -55,22 +55,25 @@ fn core(a: &Mat, b: &Mat, c: &Mat, h: &Mat, gain: &Gain, carried: &[C64], domain
     Ok(Core { e, f, k, fo, ky, ku, fixed })
 }
 
-pub(super) fn design(model: &Model, gain: &Gain, h: Option<&Mat>, dt: f64) -> Result<Designed, DesignError> {
+pub(super) fn design(model: Option<&Model>, dm: &Discrete, gain: &Gain, h: Option<&Mat>) -> Result<Designed, DesignError> {
+    let dt = dm.dt;
     let mut checks = Checks::new(KIND);
-    let (n, p) = (model.n(), model.p());
+    let (n, p) = (dm.a.nrows(), dm.c.nrows());
     let h = match h {
         Some(h) if h.shape() != (n - p, n) => {
             return Err(checks.error("H", format!("is {}×{}, must be {}×{}", h.nrows(), h.ncols(), n - p, n)));
         }
         Some(h) => h.clone(),
-        None => independent_columns_of_complement(&model.c).transpose(),
+        None => independent_columns_of_complement(&dm.c).transpose(),
     };
     if h.nrows() != n - p {
         return Err(checks.error("C", format!("must have full row rank {p} for Cumming's observer")));
     }
-    let ct = if gain.is_lqe() { None } else { Some(core(&model.a, &model.b, &model.c, &h, gain, &[], Domain::Continuous, &mut checks)?) };
+    let ct = match model.filter(|_| !gain.is_lqe()) {
+        Some(model) => Some(core(&model.a, &model.b, &model.c, &h, gain, &[], Domain::Continuous, &mut checks)?),
+        None => None,
+    };
     let carried = ct.as_ref().map(|c| c.fixed.clone()).unwrap_or_default();
-    let dm = model.discretize(dt);
     let mut sampled = Checks::sampled(KIND, dt);
     let d = core(&dm.a, &dm.b, &dm.c, &h, gain, &carried, Domain::Discrete(dt), &mut sampled)?;
     let q = &d.e + &d.f * &d.k;

@@ -23,7 +23,7 @@
 //! x̂_k = Lq_k + (Cᵍ + LK_d)y_k.
 
 use lti::pinv::{pinv, rank};
-use lti::{Mat, Model, C64};
+use lti::{Discrete, Mat, Model, C64};
 
 use super::{eig, free_gain, require_stable, sampled_report, Checks, Designed, DesignError, Domain, Gain, Pair, Report};
 use crate::runtime::LinearObserver;
@@ -145,13 +145,16 @@ pub(super) fn core(
     Ok(Core { cg, l, lg, k, f, ky, ku, fixed, notes })
 }
 
-pub(super) fn design(model: &Model, gain: Free, uio: bool, dt: f64) -> Result<Designed, DesignError> {
+pub(super) fn design(model: Option<&Model>, dm: &Discrete, gain: Free, uio: bool) -> Result<Designed, DesignError> {
+    let dt = dm.dt;
     let kind = if uio { "das-ghosal-uio" } else { "das-ghosal" };
     let mut checks = Checks::new(kind);
     let lqe = matches!(&gain, Free::Gain(g) if g.is_lqe());
-    let ct = if lqe { None } else { Some(core(&model.a, &model.b, &model.c, &model.e, &gain, uio, &[], Domain::Continuous, &mut checks)?) };
+    let ct = match model.filter(|_| !lqe) {
+        Some(model) => Some(core(&model.a, &model.b, &model.c, &model.e, &gain, uio, &[], Domain::Continuous, &mut checks)?),
+        None => None,
+    };
     let carried = ct.as_ref().map(|c| c.fixed.clone()).unwrap_or_default();
-    let dm = model.discretize(dt);
     let mut sampled = Checks::sampled(kind, dt);
     let d = core(&dm.a, &dm.b, &dm.c, &dm.e, &gain, uio, &carried, Domain::Discrete(dt), &mut sampled)?;
     let q = &d.cg + &d.l * &d.k;

@@ -13,7 +13,7 @@
 //! equations with A_d, B_d: q_{k+1} = (A_d − KCA_d)q_k + (B_d − KCB_d)u_k + (A_d − KCA_d)K y_k.
 
 use lti::pinv::rank;
-use lti::{Mat, Model};
+use lti::{Discrete, Mat, Model};
 
 use super::{eig, free_gain, require_stable, sampled_report, Checks, Designed, DesignError, Domain, Gain, Pair, Report};
 use crate::runtime::LinearObserver;
@@ -29,20 +29,28 @@ fn core(a: &Mat, c: &Mat, gain: &Gain, carried: &[lti::C64], domain: Domain, che
     Ok((k, f, fixed))
 }
 
-pub(super) fn design(model: &Model, gain: &Gain, dt: f64) -> Result<Designed, DesignError> {
+pub(super) fn design(model: Option<&Model>, dm: &Discrete, gain: &Gain) -> Result<Designed, DesignError> {
+    let dt = dm.dt;
     let mut checks = Checks::new(KIND);
-    let n = model.n();
-    let ra = rank(&model.a);
-    let continuous = if gain.is_lqe() { None } else { Some(core(&model.a, &model.c, gain, &[], Domain::Continuous, &mut checks)?) };
+    let n = dm.a.nrows();
+    let continuous = match model.filter(|_| !gain.is_lqe()) {
+        Some(model) => Some(core(&model.a, &model.c, gain, &[], Domain::Continuous, &mut checks)?),
+        None => None,
+    };
     let carried = continuous.as_ref().map(|c| c.2.clone()).unwrap_or_default();
-    let dm = model.discretize(dt);
     let mut sampled = Checks::sampled(KIND, dt);
     let (kd, fd, fixed_d) = core(&dm.a, &dm.c, gain, &carried, Domain::Discrete(dt), &mut sampled)?;
     let g = &dm.b - &kd * &dm.c * &dm.b;
     let ky = &fd * &kd;
     let runtime = LinearObserver::new(&fd, &g, &ky, &Mat::identity(n, n), &kd);
     // The paper's lemma: (A, C) observable and A non-singular imply (A, CA) observable.
-    let notes = vec![format!("rank(A) = {ra} of {n}{}", if ra == n { " (A non-singular)" } else { " (A singular: (A, CA) checked directly)" })];
+    let notes = model
+        .map(|m| {
+            let ra = rank(&m.a);
+            format!("rank(A) = {ra} of {n}{}", if ra == n { " (A non-singular)" } else { " (A singular: (A, CA) checked directly)" })
+        })
+        .into_iter()
+        .collect();
     let report = match continuous {
         Some((k, f, fixed)) => Report {
             kind: KIND,

@@ -27,7 +27,7 @@ use lti::eig::{format_list, sig};
 use lti::lyapunov;
 use lti::place::Method;
 use lti::zeros::decoupling;
-use lti::{Mat, Model, PoleSpec, Poles, C64};
+use lti::{Discrete, Mat, Model, PoleSpec, Poles, C64};
 
 use super::{eig, eq_detail, free_gain, require_stable, sampled_report, Checks, Designed, DesignError, Domain, Gain, Pair, Report};
 use crate::runtime::LinearObserver;
@@ -104,8 +104,9 @@ fn core(
             format_list(&fixed)
         } else {
             format!(
-                "unstable zero(s) {z}: (A1, NC) is not detectable — its unobservable mode(s) s = {z} stay in A1 − LC whatever L is",
-                z = format_list(&unstable)
+                "unstable zero(s) {z}: (A1, NC) is not detectable — its unobservable mode(s) {var} = {z} stay in A1 − LC whatever L is",
+                z = format_list(&unstable),
+                var = if domain == Domain::Continuous { "s" } else { "z" }
             )
         },
     )?;
@@ -155,7 +156,8 @@ fn discrete_certificate(acl_d: &Mat, decay: f64, dt: f64) -> Result<(f64, f64), 
     Ok((rho, lhs.symmetric_eigen().eigenvalues.max()))
 }
 
-pub(super) fn design(model: &Model, decay: f64, gain: Option<&Gain>, method: Method, path: Path, dt: f64) -> Result<Designed, DesignError> {
+pub(super) fn design(model: Option<&Model>, dm: &Discrete, decay: f64, gain: Option<&Gain>, method: Method, path: Path) -> Result<Designed, DesignError> {
+    let dt = dm.dt;
     let mut checks = Checks::new(KIND);
     if !(decay >= 0.0 && decay.is_finite()) {
         return Err(checks.error("decay", format!("{decay} must be finite and ≥ 0")));
@@ -164,8 +166,16 @@ pub(super) fn design(model: &Model, decay: f64, gain: Option<&Gain>, method: Met
         if path == Path::Lmi {
             return Err(checks.error("path", "gain = lqe computes L from a DARE: it takes no LMI path"));
         }
-        return design_lqe(model, decay, g, dt);
+        return design_sampled(dm, decay, g);
     }
+    let Some(model) = model else {
+        // A discrete-time plant: no continuous design, so no LMI and no default poles.
+        return match (gain, path) {
+            (_, Path::Lmi) => Err(checks.error("path", "the LMI is of the continuous-time plant: a discrete-time plant takes gain = lqe or poles")),
+            (Some(g), _) => design_sampled(dm, decay, g),
+            (None, _) => Err(checks.error("poles", "a discrete-time plant has no continuous fixed modes to default the poles from: give poles or gain = lqe")),
+        };
+    };
     let poles = match gain {
         Some(Gain::Place { poles, method: m }) => Some((poles, *m)),
         _ => None,
@@ -216,7 +226,6 @@ pub(super) fn design(model: &Model, decay: f64, gain: Option<&Gain>, method: Met
     };
 
     // Sampled: the LMI path keeps the LMI's continuous poles, mapped to e^{p·dt}.
-    let dm = model.discretize(dt);
     let mut sampled = Checks::sampled(KIND, dt);
     let free_poles = match (&lmi, poles) {
         (Some(_), _) => {
@@ -251,21 +260,22 @@ pub(super) fn design(model: &Model, decay: f64, gain: Option<&Gain>, method: Met
     })
 }
 
-/// `gain = "lqe"`: L from the DARE of the sampled pair (A1d, NC); the decay rate is certified
-/// on the sampled error dynamics only (there is no continuous design).
-fn design_lqe(model: &Model, decay: f64, gain: &Gain, dt: f64) -> Result<Designed, DesignError> {
-    let dm = model.discretize(dt);
+/// The sampled design alone (`gain = "lqe"`, or a discrete-time plant): L from the DARE of the
+/// sampled pair (A1d, NC), or placed there at e^{p·dt}; the decay rate is certified on the sampled
+/// error dynamics only.
+fn design_sampled(dm: &Discrete, decay: f64, gain: &Gain) -> Result<Designed, DesignError> {
+    let dt = dm.dt;
     let mut sampled = Checks::sampled(KIND, dt);
-    let d_core = core(&dm.a, &dm.c, &dm.e, &model.d, Some(gain), &[], None, Domain::Discrete(dt), &mut sampled)?;
+    let d_core = core(&dm.a, &dm.c, &dm.e, &dm.d, Some(gain), &[], None, Domain::Discrete(dt), &mut sampled)?;
     let (rho, worst_d) = discrete_certificate(&d_core.acl, decay, dt).map_err(|e| sampled.error("Lyapunov certificate", e))?;
     sampled.require(
         &format!("decay rate {decay}: AᵀPA − ρ²P ⪯ 0 with ρ = e^(−α·dt/2)"),
         worst_d <= 1e-9,
         format!("ρ = {}, λmax = {}", sig(rho), sig(worst_d)),
     )?;
-    let n = model.n();
+    let (n, p) = (dm.a.nrows(), dm.c.nrows());
     let proj = Mat::identity(n, n) - &d_core.m * &dm.c;
-    let k = &d_core.a1 * &d_core.m + &d_core.l * (Mat::identity(model.p(), model.p()) - &dm.c * &d_core.m);
+    let k = &d_core.a1 * &d_core.m + &d_core.l * (Mat::identity(p, p) - &dm.c * &d_core.m);
     let runtime = LinearObserver::new(&d_core.acl, &(&proj * &dm.b), &k, &Mat::identity(n, n), &d_core.m);
     let matrices = vec![("M".into(), d_core.m.clone()), ("A1".into(), d_core.a1.clone()), ("L".into(), d_core.l.clone())];
     let report = sampled_report(KIND, sampled, &d_core.acl, d_core.fixed.clone(), matrices, vec![], dt);

@@ -12,18 +12,18 @@
 //! not modelled (they are what the unknown-input observers reject and the filter does not).
 //! There is no continuous design: the report's poles are ln(z)/dt of the filter's.
 
-use lti::{steady_state_kalman, Mat, Model};
+use lti::{steady_state_kalman, Discrete, Mat};
 
 use super::{eig, require_stable, Checks, Designed, DesignError, Domain, Report};
 use crate::runtime::LinearObserver;
 
 const KIND: &str = "kalman";
 
-pub(super) fn design(model: &Model, qd: &Mat, r: &Mat, dt: f64) -> Result<Designed, DesignError> {
+pub(super) fn design(dm: &Discrete, qd: &Mat, r: &Mat) -> Result<Designed, DesignError> {
+    let dt = dm.dt;
     let mut checks = Checks::sampled(KIND, dt);
-    let dm = model.discretize(dt);
     let kf = steady_state_kalman(&dm.a, &dm.c, qd, r).map_err(|e| checks.error("DARE(Φᵀ, Cᵀ, Q_d, R) has a stabilising solution", e.to_string()))?;
-    let n = model.n();
+    let n = dm.a.nrows();
     let p_upd = Mat::identity(n, n) - &kf.gain * &dm.c;
     let f = &dm.a * &p_upd;
     let discrete = eig(&f);

@@ -5,20 +5,21 @@
 //! Sampled counterpart (predictor form): x̂_{k+1} = A_d x̂_k + B_d u_k + L_d(y_k − Cx̂_k),
 //! eig(A_d − L_dC) = e^{p·dt}.
 
-use lti::{Mat, Model};
+use lti::{Discrete, Mat, Model};
 
 use super::{eig, free_gain, require_stable, sampled_report, Checks, Designed, DesignError, Domain, Gain, Pair, Report};
 use crate::runtime::LinearObserver;
 
 const KIND: &str = "luenberger";
 
-pub(super) fn design(model: &Model, gain: &Gain, dt: f64) -> Result<Designed, DesignError> {
+pub(super) fn design(model: Option<&Model>, dm: &Discrete, gain: &Gain) -> Result<Designed, DesignError> {
+    let dt = dm.dt;
     let mut checks = Checks::new(KIND);
     // The continuous design (placement only): the report's paper form, and the fixed modes the
     // sampled design carries over.
-    let continuous = match gain {
-        Gain::Lqe(_) => None,
-        Gain::Place { .. } => {
+    let continuous = match (gain, model) {
+        (Gain::Lqe(_), _) | (_, None) => None,
+        (Gain::Place { .. }, Some(model)) => {
             let (l, fixed) = free_gain(&mut checks, &Pair::full(&model.a, &model.c, "(A, C)"), gain, &[], Domain::Continuous)?;
             let f = &model.a - &l * &model.c;
             let poles_c = eig(&f);
@@ -28,12 +29,11 @@ pub(super) fn design(model: &Model, gain: &Gain, dt: f64) -> Result<Designed, De
     };
     let carried = continuous.as_ref().map(|c| c.3.clone()).unwrap_or_default();
 
-    let dm = model.discretize(dt);
     let mut sampled = Checks::sampled(KIND, dt);
     let (ld, fixed_d) = free_gain(&mut sampled, &Pair::full(&dm.a, &dm.c, "(Φ, C)"), gain, &carried, Domain::Discrete(dt))?;
     let fd = &dm.a - &ld * &dm.c;
-    let n = model.n();
-    let runtime = LinearObserver::new(&fd, &dm.b, &ld, &Mat::identity(n, n), &Mat::zeros(n, model.p()));
+    let n = dm.a.nrows();
+    let runtime = LinearObserver::new(&fd, &dm.b, &ld, &Mat::identity(n, n), &Mat::zeros(n, dm.c.nrows()));
     let report = match continuous {
         Some((l, f, poles, fixed)) => Report {
             kind: KIND,

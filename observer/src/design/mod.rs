@@ -24,7 +24,7 @@ mod unknown_input;
 use lti::eig::{eigenvalues, format_list, format_one};
 use lti::place::{place_observer, Method};
 use lti::staircase::observability_staircase;
-use lti::{Mat, Model, Poles, C64};
+use lti::{Discrete, Mat, Model, Poles, C64};
 
 use crate::runtime::LinearObserver;
 
@@ -213,7 +213,7 @@ pub(crate) fn sampled_report(
 ) -> Report {
     let discrete = eig(f);
     matrices.extend(sampled.weight_matrices());
-    notes.insert(0, "gain = lqe: the sampled design only; matrices are the sampled observer's, poles are ln(z)/dt".into());
+    notes.insert(0, "the sampled design only (gain = lqe, or a discrete-time plant): matrices are the sampled observer's, poles are ln(z)/dt".into());
     let (poles, deadbeat) = continuous_image(&discrete, dt);
     if deadbeat > 0 {
         notes.push(format!("{deadbeat} deadbeat mode(s) z = 0 (no continuous image, left out of the poles)"));
@@ -379,22 +379,24 @@ pub(crate) fn require_stable(checks: &mut Checks, name: &str, ev: &[C64], domain
     }
 }
 
-/// Designs the observer for `model`, sampled with period `dt`; an unknown-input observer also
-/// gets its unknown-input estimator where the outputs see Γ_E whole.
+/// Designs the observer for the continuous-time `model`, sampled with period `dt`.
 pub fn design(model: &Model, spec: &Spec, dt: f64) -> Result<Designed, DesignError> {
-    let mut d = design_family(model, spec, dt)?;
-    if spec.decouples() {
-        let m = model.discretize(dt);
-        d.what = unknown_input::estimator(&m, matches!(spec, Spec::HuiZak { .. }));
-    }
-    Ok(d)
+    design_on(Some(model), &model.discretize(dt), spec)
 }
 
-fn design_family(model: &Model, spec: &Spec, dt: f64) -> Result<Designed, DesignError> {
-    match spec {
-        Spec::Luenberger { gain } => luenberger::design(model, gain, dt),
-        Spec::ChenPatton { gain } => chen_patton::design(model, gain, dt),
-        Spec::DasGhosal { gain } => das_ghosal::design(model, das_ghosal::Free::Gain(gain.clone()), false, dt),
+/// Designs the observer for a discrete-time plant x⁺ = Φx + Γ_Bu + Γ_Ew given per step (an
+/// identified model): the sampled design alone, its poles mapped e^{p·dt} when placed.
+pub fn design_discrete(dm: &Discrete, spec: &Spec) -> Result<Designed, DesignError> {
+    design_on(None, dm, spec)
+}
+
+/// The family's design from the continuous model (if there is one) and the sampled one; an
+/// unknown-input observer also gets its unknown-input estimator where the outputs see Γ_E whole.
+fn design_on(model: Option<&Model>, dm: &Discrete, spec: &Spec) -> Result<Designed, DesignError> {
+    let mut d = match spec {
+        Spec::Luenberger { gain } => luenberger::design(model, dm, gain),
+        Spec::ChenPatton { gain } => chen_patton::design(model, dm, gain),
+        Spec::DasGhosal { gain } => das_ghosal::design(model, dm, das_ghosal::Free::Gain(gain.clone()), false),
         Spec::DasGhosalUio { h, gain } => {
             let free = match (h, gain) {
                 (Some(h), _) => das_ghosal::Free::H(h.clone()),
@@ -403,11 +405,15 @@ fn design_family(model: &Model, spec: &Spec, dt: f64) -> Result<Designed, Design
                     return Err(Checks::new("das-ghosal-uio").error("H or poles", "give H = [[…]], poles = […] or gain = \"lqe\""));
                 }
             };
-            das_ghosal::design(model, free, true, dt)
+            das_ghosal::design(model, dm, free, true)
         }
-        Spec::GiFullOrder { gain } => gi_full_order::design(model, gain, dt),
-        Spec::Cumming { gain, h } => cumming::design(model, gain, h.as_ref(), dt),
-        Spec::HuiZak { decay, gain, placement, path } => hui_zak::design(model, *decay, gain.as_ref(), *placement, *path, dt),
-        Spec::Kalman { qd, r } => kalman::design(model, qd, r, dt),
+        Spec::GiFullOrder { gain } => gi_full_order::design(model, dm, gain),
+        Spec::Cumming { gain, h } => cumming::design(model, dm, gain, h.as_ref()),
+        Spec::HuiZak { decay, gain, placement, path } => hui_zak::design(model, dm, *decay, gain.as_ref(), *placement, *path),
+        Spec::Kalman { qd, r } => kalman::design(dm, qd, r),
+    }?;
+    if spec.decouples() {
+        d.what = unknown_input::estimator(dm, matches!(spec, Spec::HuiZak { .. }));
     }
+    Ok(d)
 }
