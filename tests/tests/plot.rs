@@ -126,7 +126,7 @@ fn signals_and_a_time_window_choose_what_is_drawn() {
     assert!(out.status.success(), "{:?}", text(&out));
     let mut files: Vec<String> = std::fs::read_dir(s.join("png")).unwrap().flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect();
     files.sort();
-    assert_eq!(files, ["error_uio.png", "errors_log.png", "residual_uio.png", "state_1_x1.png", "state_2_x2.png", "state_3_x3.png"]);
+    assert_eq!(files, ["error_uio.png", "errors_log.png", "input_estimate_uio.png", "residual_uio.png", "state_1_x1.png", "state_2_x2.png", "state_3_x3.png"]);
     let r = read(&rrd).unwrap();
     let sel = PlotSelection { signals: vec!["/observer/uio/**".into()], from: Some(5.0), to: Some(7.5) };
     for (file, fig) in figures(&r, &sel).unwrap() {

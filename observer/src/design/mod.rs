@@ -106,8 +106,8 @@ pub struct Report {
     pub fixed_modes: Vec<C64>,
     /// Further facts worth showing (certificates, choices made).
     pub notes: Vec<String>,
-    /// True when there is no continuous design (an LQE gain, a Kalman filter): `poles` are then
-    /// ln(z)/dt of the sampled ones, and a deadbeat mode z = 0 shows as −∞.
+    /// True when there is no continuous design (an LQE gain, a Kalman filter, a discrete-time
+    /// plant): `poles` are then ln(z)/dt of the sampled ones, a deadbeat mode z = 0 left out.
     pub sampled_only: bool,
 }
 
@@ -200,7 +200,7 @@ impl Checks {
     }
 }
 
-/// The report of a design that has only its sampled part (an LQE gain): the sampled checks as
+/// The report of a design that has only its sampled part (an LQE gain, a discrete-time plant): the sampled checks as
 /// conditions, ln(z)/dt as continuous poles and fixed modes, the sampled matrices and the weights.
 pub(crate) fn sampled_report(
     kind: &'static str,
