@@ -84,5 +84,9 @@ fn a_python_plant_is_paced_too() {
     assert!(out.status.success(), "{:?}", text(&out));
     let rt = &summary(&s, "cartpole-python-plant")["realtime"];
     let (paced, scheduled) = (rt["paced_wall_s"].as_f64().unwrap(), rt["scheduled_s"].as_f64().unwrap());
-    assert!((scheduled - 2.0).abs() < 1e-9 && (paced / scheduled - 1.0).abs() < 0.01, "{rt}");
+    // Paced means never ahead of the schedule (unpaced, this plant takes ~1.3 s for the 2 s); a
+    // late finish is the machine's, not the pacing's: at 0.2 ms a step the Python plant needs
+    // long to catch up after one stall (the page cache's writeback stalled it 50–120 ms in CI
+    // after the tests before it wrote their recordings), so the upper bound is loose.
+    assert!((scheduled - 2.0).abs() < 1e-9 && paced >= scheduled * 0.999 && paced <= scheduled * 1.25, "{rt}");
 }
