@@ -113,9 +113,9 @@ fn plot_draws_one_png_per_view() {
     assert!(out.status.success(), "{:?}", text(&out));
     let mut files: Vec<String> = std::fs::read_dir(s.join("png")).unwrap().flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect();
     files.sort();
-    // 4 states, max |e| of both observers, error and residual for 2 observers, unknown inputs,
-    // inputs, outputs, latency.
-    let expected = ["error_dgo-uio.png", "error_luenberger.png", "errors_log.png", "inputs.png", "latency.png", "outputs.png", "residual_dgo-uio.png", "residual_luenberger.png", "state_1_gamma_dot.png", "state_2_q.png", "state_3_eta.png", "state_4_eta_dot.png", "unknown_inputs.png"];
+    // 4 states, max |e| of both observers, error and residual for 2 observers, the UIO's ŵ,
+    // unknown inputs, inputs, outputs, latency.
+    let expected = ["error_dgo-uio.png", "error_luenberger.png", "errors_log.png", "input_estimate_dgo-uio.png", "inputs.png", "latency.png", "outputs.png", "residual_dgo-uio.png", "residual_luenberger.png", "state_1_gamma_dot.png", "state_2_q.png", "state_3_eta.png", "state_4_eta_dot.png", "unknown_inputs.png"];
     assert_eq!(files, expected);
     for f in &files {
         let frac = non_white_fraction(&s.join("png").join(f));
