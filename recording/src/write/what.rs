@@ -62,7 +62,7 @@ impl InputEstimate {
             mul_acc(&mut self.value, &self.neg_w_c_gamma_b, u_prev);
             let err = self.value.iter().zip(&self.prev_w).fold(0.0, |m, (a, b)| nan_max(m, (a - b).abs()));
             self.errors.push(k - 1, err);
-            if k - 1 >= self.planned_tail {
+            if k > self.planned_tail {
                 self.exact_tail = nan_max(self.exact_tail, err);
             }
         }
