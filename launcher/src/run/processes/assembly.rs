@@ -71,6 +71,24 @@ impl Queue {
         Ok(got)
     }
 
+    /// The first queued sample that breaks the protocol by itself (its version, its number of
+    /// values, a non-finite value), whether or not its step is complete: when a component stops
+    /// because of another's sample, the launcher names the one that broke the protocol.
+    fn violation(&self, width: usize) -> Option<LaunchError> {
+        self.items.iter().find_map(|(h, values)| {
+            let broken = |why: String| Some(LaunchError::Component(format!("{} broke the protocol at step {}: {why}", self.label, h.step)));
+            if h.protocol != PROTOCOL_VERSION {
+                return broken(format!("its sample says protocol version {}, the run speaks {PROTOCOL_VERSION}", h.protocol));
+            }
+            if values.len() != width {
+                return broken(format!("its sample has {} values, the run's configuration says {width}", values.len()));
+            }
+            let i = values.iter().position(|v| !v.is_finite())?;
+            let name = self.names.get(i).map_or(String::new(), |n| format!(" ({})", scenario::untrusted::quoted(n)));
+            broken(format!("value {}{name} is {}", i + 1, values[i]))
+        })
+    }
+
     /// Takes the sample of step `k` into `out`, checking it against the protocol (PROTOCOL.md
     /// §6): the step, the protocol version, its stamps (a finite sim_time, taken no later than
     /// sent), the number of values, and that each is finite.
@@ -139,6 +157,15 @@ impl Assembly {
             return Some(1 + i);
         }
         self.controller.as_ref().filter(|q| q.is_empty()).map(|_| 1 + self.observers.len())
+    }
+
+    /// A queued sample that breaks the protocol (see [`Queue::violation`]), with the widths of
+    /// `row`: the plant's first, then the observers', then the controller's.
+    pub(super) fn queued_violation(&self, row: &StepRow) -> Option<LaunchError> {
+        self.plant
+            .violation(row.plant.len())
+            .or_else(|| self.observers.iter().zip(&row.xhat).find_map(|(q, x)| q.violation(x.len())))
+            .or_else(|| self.controller.as_ref().and_then(|q| q.violation(row.u.len())))
     }
 
     /// Moves every complete step into the session.

@@ -203,6 +203,11 @@ fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: 
                 continue;
             }
             stop_all(procs);
+            // A component that stopped on another's broken sample (the plant reads every
+            // observer) is not the one to name.
+            if let Some(e) = asm.queued_violation(&row) {
+                return Err(e);
+            }
             let mut what = procs[i].describe_exit();
             if st.success() {
                 let last = asm.queue(i).last.map_or("none".to_string(), |l| format!("of step {l}"));
