@@ -10,7 +10,7 @@ pair: one `expm` for Φ, Γ_E, then H = Γ_E(CΓ_E)⁺, T = I − HC, and `solve
 I, I)` with the gain, or `place_poles((TΦ)ᵀ, Cᵀ, e^{p·dt})` (Tits–Yang). Every timing runs in a
 child process with a time limit; one that runs out is reported as "> limit".
 
-    .venv/bin/python scripts/design-bench.py [--sizes 50,200,500,1000] [--limit 300] [--runs 3]
+    .venv/bin/python scripts/design-bench.py [--sizes 50,200,500,1000] [--limit 300] [--runs 3] [--gains lqe,place]
 
 The launcher is the release build in $CARGO_TARGET_DIR (default target/).
 """
@@ -120,6 +120,7 @@ def main():
     ap.add_argument("--sizes", default="50,200,500,1000")
     ap.add_argument("--limit", type=float, default=300.0)
     ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--gains", default="lqe,place", help="which designs to time: lqe, place or both")
     args = ap.parse_args()
     target = os.environ.get("CARGO_TARGET_DIR") or str(REPO / "target")
     launcher = os.path.join(target, "release", "launcher")
@@ -129,7 +130,7 @@ def main():
             d = Path(tmp)
             scenarios(d, n, *model(n, np.random.default_rng(n)))
             row = {"n": n, "p": max(n // 10, 2)}
-            for what in ("lqe", "place"):
+            for what in args.gains.split(","):
                 best, verdict = None, ""
                 for _ in range(args.runs):
                     wall, done = timed([launcher, "design", str(d / f"{what}.toml")], args.limit)
@@ -156,9 +157,10 @@ def main():
             print(json.dumps(row), flush=True)
     print("\n| n | p | ours, lqe | scipy, DARE | ours, placement | scipy, place_poles (YT) |")
     print("|---|---|---|---|---|---|")
-    fmt = lambda v: (f"{v[0]:.2f} s " if v[0] is not None else "") + v[1]
+    fmt = lambda v: (f"{v[0]:.2f} s " if v[0] is not None else "") + v[1] if v else "—"
     for r in rows:
-        print(f"| {r['n']} | {r['p']} | {fmt(r['ours_lqe'])} | {fmt(r['scipy_lqe'])} | {fmt(r['ours_place'])} | {fmt(r['scipy_place'])} |")
+        cells = [fmt(r.get(k)) for k in ("ours_lqe", "scipy_lqe", "ours_place", "scipy_place")]
+        print(f"| {r['n']} | {r['p']} | " + " | ".join(cells) + " |")
 
 
 if __name__ == "__main__":

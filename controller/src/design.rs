@@ -14,7 +14,7 @@
 //! the same DC gain, (I − A_d + B_dG)⁻¹B_d = −(A − BG)⁻¹B, so N holds for the sampled loop too.
 //! Without tracked outputs N = I: u = r − G x̂.
 
-use lti::eig::{eigenvalues, format_list};
+use lti::eig::{continuous_image, eigenvalues, format_list};
 use lti::place::{place, Method};
 use lti::{Discrete, Mat, Model, Poles, C64};
 
@@ -111,8 +111,7 @@ pub fn design_discrete(dm: &Discrete, spec: &FeedbackSpec, track: Option<&Mat>) 
     };
     let acl = &dm.a - &dm.b * &g;
     let discrete_closed_loop = eigenvalues(&acl).map_err(|e| e.to_string())?;
-    // ln(z)/dt; a deadbeat mode (z = 0) has no continuous image and is left out.
-    let closed_loop: Vec<C64> = discrete_closed_loop.iter().filter(|z| z.norm() >= 1e-12).map(|z| z.ln() / dm.dt).collect();
+    let (closed_loop, _) = continuous_image(&discrete_closed_loop, dm.dt);
     let unstable: Vec<C64> = closed_loop.iter().copied().filter(|z| z.re >= 0.0).collect();
     let prefilter = match track {
         None => Mat::identity(l, l),

@@ -9,7 +9,6 @@ use observer::design::Condition;
 use serde::Serialize;
 use serde_json::{json, Value};
 
-use crate::plan::plan;
 use scenario::Scenario;
 
 /// The report, in both renderings.
@@ -55,7 +54,13 @@ pub fn report(s: &Scenario) -> DesignReport {
     let mut ok = true;
     let mut text = format!("{}: {}\n", s.name, scenario::untrusted::one_line(&s.description));
     let mut observers = Vec::new();
-    for o in s.observers.iter().filter(|o| o.member.is_none()) {
+    // Each design made once, then handed to the plan (the controller and the warnings).
+    let mut own: Vec<Option<observer::Designed>> = Vec::new();
+    for o in &s.observers {
+        own.push(None);
+        if o.member.is_some() {
+            continue;
+        }
         text += &format!("\nobserver '{}' ({})\n", o.name, o.kind());
         let Some(spec) = &o.spec else {
             let p = o.process.as_ref().expect("an observer without a design is a process");
@@ -63,7 +68,7 @@ pub fn report(s: &Scenario) -> DesignReport {
             observers.push(json!({ "name": o.name, "kind": "process", "command": p.command, "params": p.params }));
             continue;
         };
-        match crate::plan::design_observer(s, spec) {
+        match crate::plan::design_observer(s, o, spec) {
             Ok(d) => {
                 let r = &d.report;
                 text += "  conditions:\n";
@@ -90,6 +95,7 @@ pub fn report(s: &Scenario) -> DesignReport {
                     "fixed_modes": lti::re_im(&r.fixed_modes),
                     "sampled": sampled_json(&d.runtime, s.dt),
                 }));
+                *own.last_mut().expect("pushed above") = Some(d);
             }
             Err(e) => {
                 ok = false;
@@ -107,13 +113,14 @@ pub fn report(s: &Scenario) -> DesignReport {
             }
         }
     }
-    let (banks_text, diagnosers, banks_ok) = banks_report(s);
+    let banks = crate::plan::banks(s);
+    let (banks_text, diagnosers, banks_ok) = banks_report(s, &banks);
     text += &banks_text;
     ok &= banks_ok;
     let mut controller = Value::Null;
     let mut warnings = Vec::new();
-    if ok {
-        match plan(s) {
+    if let (true, Ok(banks)) = (ok, banks) {
+        match crate::plan::complete(s, banks, own) {
             Ok(p) => {
                 warnings = p.warnings.clone();
                 if let (Some(c), Some(fb)) = (&s.controller, &p.feedback) {
@@ -165,15 +172,15 @@ pub fn report(s: &Scenario) -> DesignReport {
 
 /// Each bank: its members (role, poles, threshold), and the structure matrix computed from the
 /// designs beside the one asked for.
-fn banks_report(s: &Scenario) -> (String, Vec<Value>, bool) {
+fn banks_report(s: &Scenario, banks: &Result<Vec<diagnosis::Bank>, crate::plan::PlanError>) -> (String, Vec<Value>, bool) {
     let mut text = String::new();
     let mut out = Vec::new();
     if s.diagnosers.is_empty() {
         return (text, out, true);
     }
-    match crate::plan::banks(s) {
+    match banks {
         Ok(banks) => {
-            for b in &banks {
+            for b in banks {
                 let d = &b.spec;
                 text += &format!("\ndiagnoser '{}' ({} scheme, {} faults, {} members)\n", d.name, d.scheme.name(), d.channels.name(), b.members.len());
                 let mut members = Vec::new();

@@ -6,7 +6,7 @@ use lti::eig::{eigenvalues, format_list, sig, C64};
 use diagnosis::{design_bank, Bank};
 use observer::{design, Designed};
 
-use scenario::{Scenario, ScenarioError};
+use scenario::{ObserverEntry, Scenario, ScenarioError};
 
 /// The designs of a scenario.
 #[derive(Debug, Clone)]
@@ -32,43 +32,51 @@ pub struct PlanError {
     pub observer: Option<usize>,
 }
 
-/// One observer's design: on the continuous plant and its exact sampling, or on a discrete-time
-/// plant's own (Φ, Γ_B, Γ_E).
-pub fn design_observer(s: &Scenario, spec: &observer::Spec) -> Result<Designed, observer::DesignError> {
-    if s.discrete { observer::design::design_discrete(&s.sampled_model(), spec) } else { design(&s.model, spec, s.dt) }
+/// One observer's design, on the continuous plant and its exact sampling or on a discrete-time
+/// plant's own (Φ, Γ_B, Γ_E), starting at the observer's `xhat0`.
+pub fn design_observer(s: &Scenario, o: &ObserverEntry, spec: &observer::Spec) -> Result<Designed, observer::DesignError> {
+    let mut d = if s.discrete { observer::design::design_discrete(&s.sampled_model(), spec) } else { design(&s.model, spec, s.dt) }?;
+    d.runtime.xhat0 = o.xhat0.clone();
+    Ok(d)
+}
+
+/// Observer `i`'s refusal, located at its field.
+fn observer_error(s: &Scenario, i: usize, o: &ObserverEntry, e: &observer::DesignError) -> PlanError {
+    let placement = e.condition.ends_with("poles") || e.condition.ends_with("pole placement");
+    let (sub, reason) = if placement {
+        (".poles", format!("{} observer '{}': {}", e.kind, o.name, e.detail))
+    } else {
+        ("", format!("{} observer '{}': {} does not hold: {}", e.kind, o.name, e.condition, e.detail))
+    };
+    PlanError { error: scenario::locate_error(s, &format!("observer[{}]{sub}", i + 1), reason), conditions: e.conditions.clone(), observer: Some(i) }
 }
 
 /// Designs every observer and the controller.
 #[allow(clippy::result_large_err)] // made once per command, never on a hot path
 pub fn plan(s: &Scenario) -> Result<Plan, PlanError> {
-    let locate = |field: String, reason: String| scenario::locate_error(s, &field, reason);
     let banks = banks(s)?;
-    let mut observers = Vec::new();
+    let mut own = Vec::new();
     for (i, o) in s.observers.iter().enumerate() {
-        if let Some((d, j)) = o.member {
-            observers.push((o.name.clone(), Some(banks[d].members[j].designed.clone())));
-            continue;
-        }
-        let Some(spec) = &o.spec else {
-            observers.push((o.name.clone(), None));
-            continue;
-        };
-        let mut d = design_observer(s, spec).map_err(|e| {
-            let placement = e.condition.ends_with("poles") || e.condition.ends_with("pole placement");
-            let (sub, reason) = if placement {
-                (".poles", format!("{} observer '{}': {}", e.kind, o.name, e.detail))
-            } else {
-                ("", format!("{} observer '{}': {} does not hold: {}", e.kind, o.name, e.condition, e.detail))
-            };
-            PlanError {
-                error: locate(format!("observer[{}]{sub}", i + 1), reason),
-                conditions: e.conditions.clone(),
-                observer: Some(i),
-            }
-        })?;
-        d.runtime.xhat0 = o.xhat0.clone();
-        observers.push((o.name.clone(), Some(d)));
+        own.push(match (&o.spec, o.member) {
+            (Some(spec), None) => Some(design_observer(s, o, spec).map_err(|e| observer_error(s, i, o, &e))?),
+            _ => None,
+        });
     }
+    complete(s, banks, own)
+}
+
+/// The plan from the banks and the scenario's own observers already designed (`None` for an
+/// external one and for bank members, which come from their banks): the controller's design
+/// and the warnings.
+#[allow(clippy::result_large_err)]
+pub fn complete(s: &Scenario, banks: Vec<Bank>, own: Vec<Option<Designed>>) -> Result<Plan, PlanError> {
+    let locate = |field: String, reason: String| scenario::locate_error(s, &field, reason);
+    let observers: Vec<(String, Option<Designed>)> = s
+        .observers
+        .iter()
+        .zip(own)
+        .map(|(o, d)| (o.name.clone(), o.member.map_or(d, |(b, j)| Some(banks[b].members[j].designed.clone()))))
+        .collect();
     let feedback = match s.controller.as_ref().and_then(|c| c.spec.as_ref().map(|spec| (c, spec))) {
         Some((c, spec)) => {
             let designed = if s.discrete {
@@ -118,7 +126,9 @@ fn warnings(s: &Scenario, observers: &[(String, Option<Designed>)], feedback: Op
         }
     };
     // A discrete plant has no continuous poles to compare with dt.
-    if let Ok(ev) = eigenvalues(&s.model.a).map(|ev| if s.discrete { Vec::new() } else { ev }) {
+    if !s.discrete
+        && let Ok(ev) = eigenvalues(&s.model.a)
+    {
         check("the plant".into(), &ev);
     }
     for (name, d) in &observers {

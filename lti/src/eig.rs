@@ -90,6 +90,14 @@ pub fn spectral_abscissa(ev: &[C64]) -> f64 {
     ev.iter().map(|e| e.re).fold(f64::NEG_INFINITY, f64::max)
 }
 
+/// ln(z)/dt of each sampled eigenvalue (the continuous one it is the image of, e^{s·dt} = z),
+/// and how many were left out as deadbeat (z = 0 to rounding: no continuous image).
+pub fn continuous_image(discrete: &[C64], dt: f64) -> (Vec<C64>, usize) {
+    let kept: Vec<C64> = discrete.iter().filter(|z| z.norm() >= 1e-12).map(|z| z.ln() / dt).collect();
+    let dropped = discrete.len() - kept.len();
+    (kept, dropped)
+}
+
 /// Largest modulus (the spectral radius): the decay factor of a discrete system.
 pub fn spectral_radius(ev: &[C64]) -> f64 {
     ev.iter().map(|e| e.norm()).fold(0.0, f64::max)

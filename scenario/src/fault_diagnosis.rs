@@ -11,7 +11,7 @@ use plant::fault::{Fault, Kind, Profile, Target};
 use super::limits::{MAX_CALIBRATION_RUNS, MAX_WINDOW};
 use super::raw::{RawDiagnoser, RawFault, RawNoise};
 use super::untrusted::quoted;
-use super::validate::{bad, check_name, finite, matrix, placement, poles, Bad};
+use super::validate::{bad, check_name, definite, finite, matrix, placement, poles, Bad};
 
 /// The run's noise: the per-step covariances the plant draws from and the Kalman filter uses.
 #[derive(Debug, Clone, PartialEq)]
@@ -26,13 +26,7 @@ pub struct NoiseSpec {
 /// the Riccati and Van Loan code applies to its arguments ([`lti::dare::symmetric`]).
 fn covariance(field: &str, symbol: &str, rows: &super::raw::Rows, size: Option<usize>, why: &str) -> Result<Mat, Bad> {
     let m = matrix(field, rows, (size, size), why)?;
-    lti::dare::symmetric(symbol, &m, lti::dare::Definite::Semi).map_err(|e| {
-        let reason = match e {
-            lti::LtiError::InvalidInput(r) => r,
-            other => other.to_string(),
-        };
-        bad(field, reason)
-    })
+    definite(field, symbol, &m, lti::dare::Definite::Semi)
 }
 
 /// `[noise]`, with Q_d computed from the continuous intensity by Van Loan's method.

@@ -551,8 +551,9 @@ fn lqe_weights(f: &str, o: &RawObserver, model: &Model, noise: Option<&super::No
     Ok(Some(Weights { q, r }))
 }
 
-/// A weight that must be symmetric and (semi-)definite, by the DARE's own rule.
-fn definite(field: &str, symbol: &str, m: &Mat, how: lti::dare::Definite) -> Result<Mat, Bad> {
+/// A weight or covariance that must be symmetric and (semi-)definite, by the rule the Riccati
+/// and Van Loan code applies to its arguments ([`lti::dare::symmetric`]).
+pub(crate) fn definite(field: &str, symbol: &str, m: &Mat, how: lti::dare::Definite) -> Result<Mat, Bad> {
     lti::dare::symmetric(symbol, m, how).map_err(|e| {
         let reason = match e {
             lti::LtiError::InvalidInput(r) => r,

@@ -31,8 +31,8 @@ struct ObserverChannels {
 /// measured at step k, and what completes one step late (the step time, controller→plant).
 struct Channels {
     signals: usize,
-    /// ŵ_{k−1}, completed by row k.
-    estimates_late: usize,
+    /// ŵ_{k−1}, completed by row k (a group only when some observer estimates w).
+    estimates_late: Option<usize>,
     hops_now: usize,
     hops_late: usize,
     x: Vec<SeriesId>,
@@ -170,7 +170,7 @@ impl Session {
             .observers
             .iter()
             .zip(&s.observers)
-            .map(|((_, d), o)| d.as_ref().and_then(|d| d.what.as_ref()).filter(|w| o.member.is_none() && w.w.nrows() == layout.q))
+            .map(|((_, d), o)| d.as_ref().and_then(|d| d.what.as_ref()).filter(|_| o.member.is_none()))
             .collect();
         let pace = pace_s.map(|p| Pace { period_ns: (p * 1e9).round() as u64, t0: None, steps: 0, overruns: 0, max_late_ns: 0, last_end: 0 });
         let mut overrun = None;
@@ -189,7 +189,7 @@ impl Session {
                 let mut sink = RrdSink::create(path, &s.name, blueprint(s), &s.source).map_err(LaunchError::BadInput)?;
                 sink.select(select.clone());
                 let (signals, hops_now, hops_late) = (sink.group(), sink.group(), sink.group());
-                let estimates_late = sink.group();
+                let estimates_late = estimates.iter().any(Option::is_some).then(|| sink.group());
                 let overrun_group = pace.is_some().then(|| sink.group());
                 let names = &s.names;
                 let observer_names: Vec<String> = s.observers.iter().map(|o| o.name.clone()).collect();
@@ -221,9 +221,9 @@ impl Session {
                             error: (0..layout.n).map(|i| series(signals, sig::error(name, i), format!("e{} ({name})", i + 1))).collect(),
                             residual: (0..layout.p).map(|j| series(signals, sig::residual(name, j), format!("r{} ({name})", j + 1))).collect(),
                             log_error: series(signals, sig::log_error(name), format!("log10 max|e| ({name})")),
-                            what: match estimates[i] {
-                                Some(_) => (0..layout.q).map(|k| series(estimates_late, sig::input_estimate(name, k), format!("{} estimate ({name})", names.disturbance[k].name))).collect(),
-                                None => Vec::new(),
+                            what: match (estimates[i], estimates_late) {
+                                (Some(_), Some(g)) => (0..layout.q).map(|k| series(g, sig::input_estimate(name, k), format!("{} estimate ({name})", names.disturbance[k].name))).collect(),
+                                _ => Vec::new(),
                             },
                         })
                     })
@@ -432,8 +432,10 @@ impl Session {
             sink.push(oc.log_error, sig::log10_floored(self.metrics.observers[o].final_abs_error));
         }
         // ŵ_{k−1}, completed by this row, at the step it estimates.
-        if k > 0 && self.metrics.what.iter().any(|w| w.as_ref().is_some_and(|w| w.ready)) {
-            sink.row(ch.estimates_late, k - 1, (k - 1) as f64 * self.dt);
+        if let Some(g) = ch.estimates_late
+            && self.metrics.what.iter().any(|w| w.as_ref().is_some_and(|w| w.ready))
+        {
+            sink.row(g, k - 1, (k - 1) as f64 * self.dt);
             for (oc, what) in ch.observers.iter().zip(&self.metrics.what) {
                 if let (Some(oc), Some(what)) = (oc, what) {
                     put(sink, &oc.what, &what.value);

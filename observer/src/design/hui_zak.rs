@@ -238,18 +238,13 @@ pub(super) fn design(model: Option<&Model>, dm: &Discrete, decay: f64, gain: Opt
     let d_core = core(&dm.a, &dm.c, &dm.e, d, free.as_ref(), &ct.fixed, None, Domain::Discrete(dt), &mut sampled)?;
     let (rho, worst_d) = discrete_certificate(&d_core.acl, decay, dt).map_err(|e| sampled.error("Lyapunov certificate", e))?;
     notes.push(format!("sampled decay certificate: ρ = e^(−α·dt/2) = {}, λmax(AᵀPA − ρ²P) = {}", sig(rho), sig(worst_d)));
-    let n = model.n();
-    let proj = Mat::identity(n, n) - &d_core.m * &dm.c;
-    let f = &d_core.acl;
-    let k = &d_core.a1 * &d_core.m + &d_core.l * (Mat::identity(model.p(), model.p()) - &dm.c * &d_core.m);
-    let g = &proj * &dm.b;
-    let runtime = LinearObserver::new(f, &g, &k, &Mat::identity(n, n), &d_core.m);
+    let runtime = runtime(&d_core, dm);
     Ok(Designed {
         report: Report {
             kind: KIND,
             conditions: checks.into_list(),
             poles: poles_c,
-            discrete_poles: eig(f),
+            discrete_poles: eig(&d_core.acl),
             fixed_modes: ct.fixed,
             matrices: vec![("M".into(), ct.m), ("A1".into(), ct.a1), ("L".into(), ct.l), ("P".into(), p)],
             notes,
@@ -258,6 +253,15 @@ pub(super) fn design(model: Option<&Model>, dm: &Discrete, decay: f64, gain: Opt
         runtime,
         what: None,
     })
+}
+
+/// The runtime form of the sampled design: x̂ = z + My,
+/// z⁺ = (A1d − LC)z + (I − MC)B_d u + (A1d M + L(I − CM)) y.
+fn runtime(d: &Core, dm: &Discrete) -> LinearObserver {
+    let (n, p) = (dm.a.nrows(), dm.c.nrows());
+    let proj = Mat::identity(n, n) - &d.m * &dm.c;
+    let k = &d.a1 * &d.m + &d.l * (Mat::identity(p, p) - &dm.c * &d.m);
+    LinearObserver::new(&d.acl, &(&proj * &dm.b), &k, &Mat::identity(n, n), &d.m)
 }
 
 /// The sampled design alone (`gain = "lqe"`, or a discrete-time plant): L from the DARE of the
@@ -273,10 +277,7 @@ fn design_sampled(dm: &Discrete, decay: f64, gain: &Gain) -> Result<Designed, De
         worst_d <= 1e-9,
         format!("ρ = {}, λmax = {}", sig(rho), sig(worst_d)),
     )?;
-    let (n, p) = (dm.a.nrows(), dm.c.nrows());
-    let proj = Mat::identity(n, n) - &d_core.m * &dm.c;
-    let k = &d_core.a1 * &d_core.m + &d_core.l * (Mat::identity(p, p) - &dm.c * &d_core.m);
-    let runtime = LinearObserver::new(&d_core.acl, &(&proj * &dm.b), &k, &Mat::identity(n, n), &d_core.m);
+    let runtime = runtime(&d_core, dm);
     let matrices = vec![("M".into(), d_core.m.clone()), ("A1".into(), d_core.a1.clone()), ("L".into(), d_core.l.clone())];
     let report = sampled_report(KIND, sampled, &d_core.acl, d_core.fixed.clone(), matrices, vec![], dt);
     Ok(Designed { report, runtime, what: None })

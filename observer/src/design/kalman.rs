@@ -28,7 +28,7 @@ pub(super) fn design(dm: &Discrete, qd: &Mat, r: &Mat) -> Result<Designed, Desig
     let f = &dm.a * &p_upd;
     let discrete = eig(&f);
     require_stable(&mut checks, "Φ(I − MC) stable", &discrete, Domain::Discrete(dt))?;
-    let (continuous, _) = super::continuous_image(&discrete, dt);
+    let (continuous, _) = lti::eig::continuous_image(&discrete, dt);
     let runtime = LinearObserver::new(&f, &dm.b, &kf.predictor_gain, &p_upd, &kf.gain);
     Ok(Designed {
         report: Report {

@@ -21,7 +21,7 @@ mod kalman;
 mod luenberger;
 mod unknown_input;
 
-use lti::eig::{eigenvalues, format_list, format_one};
+use lti::eig::{continuous_image, eigenvalues, format_list, format_one};
 use lti::place::{place_observer, Method};
 use lti::staircase::observability_staircase;
 use lti::{Discrete, Mat, Model, Poles, C64};
@@ -228,13 +228,6 @@ pub(crate) fn sampled_report(
         notes,
         sampled_only: true,
     }
-}
-
-/// ln(z)/dt for each sampled pole, and how many were left out as deadbeat (z = 0 to rounding).
-pub(crate) fn continuous_image(discrete: &[C64], dt: f64) -> (Vec<C64>, usize) {
-    let kept: Vec<C64> = discrete.iter().filter(|z| z.norm() >= 1e-12).map(|z| z.ln() / dt).collect();
-    let dropped = discrete.len() - kept.len();
-    (kept, dropped)
 }
 
 /// An observer gain for the pair (A, C) placing the requested spectrum on its observable part;
