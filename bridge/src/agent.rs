@@ -46,32 +46,32 @@ pub struct Options {
 /// Runs the agent until SIGTERM or SIGINT; returns the exit code.
 pub fn run(o: &Options) -> i32 {
     if let Err(e) = keys::check_host(&o.host) {
-        eprintln!("agent: --host: {e}");
+        say!("agent: --host: {e}");
         return 2;
     }
     let tls = if o.listen.starts_with("tls/") {
-        eprintln!("agent {}: --listen {}: {}", o.host, o.listen, session::TLS_OVER_TCP);
+        say!("agent {}: --listen {}: {}", o.host, o.listen, session::TLS_OVER_TCP);
         return 2;
     } else if secured(&o.listen) {
         match credentials::load(&o.credentials, Side::Agent) {
             Ok(c) => Some(c),
             Err(e) => {
-                eprintln!("agent {}: credentials: {e}", o.host);
+                say!("agent {}: credentials: {e}", o.host);
                 return 2;
             }
         }
     } else if o.listen.starts_with("tcp/") && o.insecure {
-        eprintln!("agent {}: --insecure: plain TCP, anyone who reaches {} can start components here and read their samples", o.host, o.listen);
+        say!("agent {}: --insecure: plain TCP, anyone who reaches {} can start components here and read their samples", o.host, o.listen);
         None
     } else if o.listen.starts_with("tcp/") {
-        eprintln!("agent {}: --listen {}: plain TCP admits anyone who reaches it; listen on quic/… with credentials (`launcher agent init`), or add --insecure on a network you trust", o.host, o.listen);
+        say!("agent {}: --listen {}: plain TCP admits anyone who reaches it; listen on quic/… with credentials (`launcher agent init`), or add --insecure on a network you trust", o.host, o.listen);
         return 2;
     } else {
-        eprintln!("agent {}: --listen {}: an endpoint is quic/<address>:<port> (or tcp/… with --insecure)", o.host, o.listen);
+        say!("agent {}: --listen {}: an endpoint is quic/<address>:<port> (or tcp/… with --insecure)", o.host, o.listen);
         return 2;
     };
     if o.max_workers == 0 {
-        eprintln!("agent {}: --max-workers must be at least 1", o.host);
+        say!("agent {}: --max-workers must be at least 1", o.host);
         return 2;
     }
     // SAFETY: the handler only stores to an atomic.
@@ -82,7 +82,7 @@ pub fn run(o: &Options) -> i32 {
     match serve(o, tls.as_ref()) {
         Ok(()) => 0,
         Err(e) => {
-            eprintln!("agent {}: {e}", o.host);
+            say!("agent {}: {e}", o.host);
             3
         }
     }
@@ -93,7 +93,7 @@ fn serve(o: &Options, tls: Option<&Credentials>) -> Result<(), String> {
     let z = open(Role::Router { listen: &o.listen, access: access::config(tls.is_some()) }, tls).map_err(|e| format!("cannot listen on {e}"))?;
     let _token = z.liveliness().declare_token(keys::agent(host)).wait().map_err(|e| e.to_string())?;
     let starts = z.declare_queryable(keys::start(host)).wait().map_err(|e| e.to_string())?;
-    eprintln!("agent {host}: listening on {}", o.listen);
+    say!("agent {host}: listening on {}", o.listen);
     // Each worker with the (run, component) it serves: one worker per pair.
     let mut workers: Vec<(Child, String, String)> = Vec::new();
     while !STOP.load(Ordering::Relaxed) {
@@ -108,7 +108,7 @@ fn serve(o: &Options, tls: Option<&Credentials>) -> Result<(), String> {
         let _ = match answer {
             Ok(()) => query.reply(keys::start(host), "started").wait(),
             Err(e) => {
-                eprintln!("agent {host}: refused a start request: {e}");
+                say!("agent {host}: refused a start request: {e}");
                 query.reply_err(e).wait()
             }
         };

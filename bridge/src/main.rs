@@ -2,6 +2,18 @@
 //! `uio-bridge remote` in place of a component that runs on another host; `launcher agent` is
 //! `uio-bridge agent` on that host; the agent starts `uio-bridge worker`s.
 
+/// One line on stderr in a single write: the agent and its workers (processes of their own)
+/// share one stderr, and `eprintln!` writes a line in pieces that another process's line can
+/// split (the two-host test once read "worker for worker for luenberger: …").
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let mut line = format!($($arg)*);
+        line.push('\n');
+        let _ = std::io::stderr().write_all(line.as_bytes());
+    }};
+}
+
 mod access;
 mod agent;
 mod beat;
@@ -104,14 +116,14 @@ fn main() {
                     0
                 }
                 Err(e) => {
-                    eprintln!("agent init: {e}");
+                    say!("agent init: {e}");
                     2
                 }
             }
         }
         Cmd::Agent { init: None, host, listen, credentials: dir, insecure, max_workers } => {
             let (Some(host), Some(listen)) = (host, listen) else {
-                eprintln!("agent: --host and --listen are required (or `agent init`)");
+                say!("agent: --host and --listen are required (or `agent init`)");
                 std::process::exit(2);
             };
             agent::run(&agent::Options { host, listen, credentials: dir.unwrap_or_else(credentials::default_dir), insecure, max_workers })

@@ -42,7 +42,7 @@ pub fn run(host: &str, connect: &str, builtin: &str) -> i32 {
     match proxy(host, connect, builtin) {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("host {host}: {e}");
+            say!("host {host}: {e}");
             FAILED
         }
     }
@@ -142,7 +142,7 @@ fn finish(name: &str, host: &str, line: &str, imports: &mut Imports) -> Result<i
         return Err(format!("{name} sent {count} samples, {} arrived", imports.received));
     }
     if code != 0 {
-        eprintln!("{name} on host {host}: {message}");
+        say!("{name} on host {host}: {message}");
     }
     Ok(code)
 }
@@ -176,7 +176,7 @@ fn watchdog(z: &zenoh::Session, pulse: Pulse, host: &str, name: &str) {
     std::thread::spawn(move || loop {
         std::thread::sleep(Duration::from_millis(100));
         if z.info().routers_zid().wait().next().is_none() || !pulse.alive() {
-            eprintln!("host {host}: {}", lost(&name));
+            say!("host {host}: {}", lost(&name));
             std::process::exit(FAILED);
         }
     });

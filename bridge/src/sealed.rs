@@ -67,7 +67,7 @@ impl SealedSubscriber {
                 return Some(&self.buf[8..len]);
             }
             if refused.is_multiple_of(1000) {
-                eprintln!("ignored a message on {} that is not from this run's other side ({} so far)", self.key, refused + 1);
+                say!("ignored a message on {} that is not from this run's other side ({} so far)", self.key, refused + 1);
             }
         }
     }

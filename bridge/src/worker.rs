@@ -43,27 +43,27 @@ pub fn run(connect: &str, credentials: Option<&std::path::Path>) -> i32 {
     }
     let mut text = String::new();
     if let Err(e) = std::io::stdin().read_to_string(&mut text) {
-        eprintln!("worker: stdin: {e}");
+        say!("worker: stdin: {e}");
         return 3;
     }
     let req: StartRequest = match serde_json::from_str(&text) {
         Ok(r) => r,
         Err(e) => {
-            eprintln!("worker: bad request: {e}");
+            say!("worker: bad request: {e}");
             return 3;
         }
     };
     let space = match RunSpace::create() {
         Ok(s) => s,
         Err(e) => {
-            eprintln!("worker: {e}");
+            say!("worker: {e}");
             return 3;
         }
     };
     let code = match serve(connect, credentials, &req, &space) {
         Ok(()) => 0,
         Err(e) => {
-            eprintln!("worker for {}: {e}", req.run);
+            say!("worker for {}: {e}", req.run);
             3
         }
     };
@@ -159,7 +159,7 @@ fn serve(connect: &str, credentials: Option<&std::path::Path>, req: &StartReques
                 };
                 imports.shift_ns = theta;
                 beat.arm();
-                eprintln!("worker for {name}: this host's clock reads {theta} ns ahead of the launcher's host's (± {} ns, half the shortest of 16 round trips)", rtt / 2);
+                say!("worker for {name}: this host's clock reads {theta} ns ahead of the launcher's host's (± {} ns, half the shortest of 16 round trips)", rtt / 2);
                 if let Some(s) = stdin.as_mut() {
                     s.write_all(b"go\n").and_then(|_| s.flush()).map_err(|e| format!("{name}: {e}"))?;
                 }
