@@ -1,11 +1,17 @@
-//! The controller component: state feedback on an observer's estimate, u_k = N r_k − G x̂_k
-//! (seed 000 eq. 24, with the reference prefilter N of [`design`]), its design, and the process
-//! shell that runs it in lockstep.
+//! The controller component: state feedback on an observer's estimate,
+//!
+//! ```text
+//! u_k = N r_k − G x̂_k − G_ξ ξ_k − M ŵ_{k−1},      ξ_{k+1} = ξ_k + dt (r_k − z_k)
+//! ```
+//!
+//! (seed 000 eq. 24, with the reference prefilter N of [`design`]; the integrators ξ of
+//! [`design::integral`] and the cancellation M ŵ of [`design::feedforward`] when asked), its
+//! design, and the process shell that runs it in lockstep.
 
 pub mod design;
 pub mod shell;
 
-use lti::kernel::mul_into;
+use lti::kernel::{mul_acc, mul_into};
 use lti::signal::Signal;
 use lti::MatData;
 use nalgebra::{DMatrix, DVector};
@@ -24,6 +30,42 @@ pub struct ControllerConfig {
     pub dt: f64,
     /// The observer whose estimate is fed back.
     pub observer: String,
+    /// Integral action, if asked.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub integral: Option<IntegralConfig>,
+    /// Cancellation of the unknown input, if asked.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub feedforward: Option<FeedforwardConfig>,
+}
+
+/// The integrators ξ_{k+1} = ξ_k + dt (r_k − z_k) and their gain. The tracked outputs z = C_t x
+/// are measured, z_k = M y_k, when C_t = MC (so that neither an observer's bias nor a model error
+/// leaves a steady-state error), else estimated, z_k = C_t x̂_k.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IntegralConfig {
+    /// G_ξ, l×l.
+    pub gi: MatData,
+    /// C_t (l×n, on x̂), or M (l×p, on the plant's y_k) when `y` is given.
+    pub ct: MatData,
+    /// [start, end) of y_k in the plant's sample, when z is measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub y: Option<[usize; 2]>,
+}
+
+/// M ŵ_{k−1} = (MW) y_k − (MWCΦ) x̂_{k−1} − (MWCΓ_B) u_{k−1}, from the plant's sample k (its y_k
+/// and the u_{k−1} it held) and the previous estimate.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FeedforwardConfig {
+    /// MW, l×p.
+    pub mw: MatData,
+    /// MWCΦ, l×n.
+    pub mw_c_phi: MatData,
+    /// MWCΓ_B, l×l.
+    pub mw_c_gamma_b: MatData,
+    /// [start, end) of y_k in the plant's sample.
+    pub y: [usize; 2],
+    /// [start, end) of u_{k−1} in the plant's sample.
+    pub u_prev: [usize; 2],
 }
 
 /// State feedback as a step function.
@@ -36,6 +78,29 @@ pub struct Controller {
     dt: f64,
     gx: DVector<f64>,
     u: DVector<f64>,
+    integral: Option<Integral>,
+    feedforward: Option<Feedforward>,
+}
+
+#[derive(Debug, Clone)]
+struct Integral {
+    gi: DMatrix<f64>,
+    ct: DMatrix<f64>,
+    y: Option<std::ops::Range<usize>>,
+    xi: DVector<f64>,
+    z: DVector<f64>,
+}
+
+#[derive(Debug, Clone)]
+struct Feedforward {
+    mw: DMatrix<f64>,
+    neg_mw_c_phi: DMatrix<f64>,
+    neg_mw_c_gamma_b: DMatrix<f64>,
+    y: std::ops::Range<usize>,
+    u_prev: std::ops::Range<usize>,
+    prev_xhat: Vec<f64>,
+    started: bool,
+    mw_hat: DVector<f64>,
 }
 
 impl Controller {
@@ -49,17 +114,72 @@ impl Controller {
         if n.shape() != (g.nrows(), g.nrows()) {
             return Err(format!("N is {}×{}, must be {}×{}", n.nrows(), n.ncols(), g.nrows(), g.nrows()));
         }
-        let l = g.nrows();
-        Ok(Self { gx: DVector::zeros(l), u: DVector::zeros(l), r: DVector::zeros(l), g, n, references: cfg.references.clone(), dt: cfg.dt })
+        let (l, nx) = g.shape();
+        let integral = cfg
+            .integral
+            .as_ref()
+            .map(|i| {
+                let (gi, ct): (DMatrix<f64>, DMatrix<f64>) = ((&i.gi).into(), (&i.ct).into());
+                let y = i.y.map(|[a, b]| a..b);
+                let cols = y.as_ref().map_or(nx, |y| y.len());
+                if gi.shape() != (l, l) || ct.shape() != (l, cols) {
+                    return Err(format!("integral: G_ξ is {}×{} and C_t {}×{}, must be {l}×{l} and {l}×{cols}", gi.nrows(), gi.ncols(), ct.nrows(), ct.ncols()));
+                }
+                Ok(Integral { gi, ct, y, xi: DVector::zeros(l), z: DVector::zeros(l) })
+            })
+            .transpose()?;
+        let feedforward = cfg
+            .feedforward
+            .as_ref()
+            .map(|f| {
+                let (mw, a, b): (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>) = ((&f.mw).into(), (&f.mw_c_phi).into(), (&f.mw_c_gamma_b).into());
+                let (y, u_prev) = (f.y[0]..f.y[1], f.u_prev[0]..f.u_prev[1]);
+                if mw.shape() != (l, y.len()) || a.shape() != (l, nx) || b.shape() != (l, l) || u_prev.len() != l {
+                    return Err("feedforward: MW, MWCΦ, MWCΓ_B and the sample's ranges do not conform".to_string());
+                }
+                Ok(Feedforward { mw, neg_mw_c_phi: -a, neg_mw_c_gamma_b: -b, y, u_prev, prev_xhat: vec![0.0; nx], started: false, mw_hat: DVector::zeros(l) })
+            })
+            .transpose()?;
+        Ok(Self { gx: DVector::zeros(l), u: DVector::zeros(l), r: DVector::zeros(l), g, n, references: cfg.references.clone(), dt: cfg.dt, integral, feedforward })
     }
 
-    /// u_k = N r(t_k) − G x̂_k.
-    pub fn step(&mut self, k: u64, xhat: &[f64]) -> &[f64] {
+    /// Whether it reads the plant's sample (for ŵ, or measured tracked outputs).
+    pub fn reads_plant(&self) -> bool {
+        self.feedforward.is_some() || self.integral.as_ref().is_some_and(|i| i.y.is_some())
+    }
+
+    /// u_k = N r(t_k) − G x̂_k (− G_ξ ξ_k − M ŵ_{k−1}); `plant` is the plant's sample k, read only
+    /// when [`Self::reads_plant`] (may be empty otherwise).
+    pub fn step(&mut self, k: u64, xhat: &[f64], plant: &[f64]) -> &[f64] {
         for (r, s) in self.r.iter_mut().zip(&self.references) {
             *r = s.sample_step(k, self.dt);
         }
         mul_into(self.u.as_mut_slice(), &self.n, self.r.as_slice());
         mul_into(self.gx.as_mut_slice(), &self.g, xhat);
+        if let Some(i) = &mut self.integral {
+            mul_acc(self.gx.as_mut_slice(), &i.gi, i.xi.as_slice());
+            // ξ_{k+1} = ξ_k + dt (r_k − z_k), after u_k used ξ_k.
+            match &i.y {
+                Some(y) => mul_into(i.z.as_mut_slice(), &i.ct, &plant[y.clone()]),
+                None => mul_into(i.z.as_mut_slice(), &i.ct, xhat),
+            }
+            for ((xi, r), z) in i.xi.iter_mut().zip(self.r.iter()).zip(i.z.iter()) {
+                *xi += self.dt * (r - z);
+            }
+        }
+        if let Some(f) = &mut self.feedforward {
+            // M ŵ_{k−1} once there is an x̂_{k−1}; nothing is cancelled at k = 0.
+            if f.started {
+                mul_into(f.mw_hat.as_mut_slice(), &f.mw, &plant[f.y.clone()]);
+                mul_acc(f.mw_hat.as_mut_slice(), &f.neg_mw_c_phi, &f.prev_xhat);
+                mul_acc(f.mw_hat.as_mut_slice(), &f.neg_mw_c_gamma_b, &plant[f.u_prev.clone()]);
+                for (gx, m) in self.gx.iter_mut().zip(f.mw_hat.iter()) {
+                    *gx += m;
+                }
+            }
+            f.prev_xhat.copy_from_slice(xhat);
+            f.started = true;
+        }
         for (u, gx) in self.u.iter_mut().zip(self.gx.iter()) {
             *u -= gx;
         }

@@ -19,7 +19,9 @@ impl Component for ControllerComponent {
     }
 
     fn step(&mut self, k: u64, inputs: &Inputs, out: &mut [f64]) -> Result<(), StepError> {
-        out.copy_from_slice(self.ctrl.step(k, inputs.get(0)));
+        // Its observer's x̂_k, and with feedforward the plant's sample k (the second read).
+        let plant = if self.ctrl.reads_plant() { inputs.get(1) } else { &[] };
+        out.copy_from_slice(self.ctrl.step(k, inputs.get(0), plant));
         Ok(())
     }
 }

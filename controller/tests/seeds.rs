@@ -1,6 +1,6 @@
 //! State-feedback designs of the seed papers (reference: fixtures/seed-models.json).
 
-use controller::design::{design, FeedbackSpec};
+use controller::design::{design, Domain, FeedbackSpec, Options};
 use lti::place::Method;
 use lti::{Mat, Model, PoleSpec, Poles, C64};
 
@@ -8,12 +8,17 @@ use lti::{Mat, Model, PoleSpec, Poles, C64};
 mod reader;
 use reader::{mat, seeds};
 
+/// The continuous placement (or a given gain) as the seed papers print it.
+fn design_c(model: &Model, spec: &FeedbackSpec, track: Option<&Mat>, dt: f64) -> Result<controller::design::FeedbackDesign, String> {
+    design(Some(model), &model.discretize(dt), spec, &Options { track, integral: false })
+}
+
 #[test]
 fn seed003_ackermann_gain() {
     let m = &seeds()["seed_003"]["model"];
     let model = Model { a: mat(&m["A"]), b: mat(&m["B"]), c: mat(&m["C"]), e: Mat::zeros(4, 0), d: Mat::zeros(2, 0) };
     let poles = Poles::new([-4.0, -5.0, -6.0, -7.0].map(PoleSpec::Real)).unwrap();
-    let fb = design(&model, &FeedbackSpec::Poles { poles, placement: Method::Ackermann }, None, 1e-3).unwrap();
+    let fb = design_c(&model, &FeedbackSpec::Poles { poles, placement: Method::Ackermann, domain: Domain::Continuous }, None, 1e-3).unwrap();
     let want = [6.00762691997, -28.0996201851, 14.6870142616, -1.54712121541];
     for (i, w) in want.iter().enumerate() {
         assert!((fb.g[(0, i)] - w).abs() < 1e-9, "G[{i}] = {}", fb.g[(0, i)]);
@@ -26,7 +31,7 @@ fn seed000_printed_gain_is_reported_unstable() {
     let m = &seeds()["seed_000"]["model_primary_open_loop"];
     let model = Model { a: mat(&m["A"]), b: mat(&m["B"]), c: mat(&m["C"]), e: mat(&m["Ed"]), d: Mat::zeros(2, 0) };
     let g = Mat::from_row_slice(1, 4, &[5.86, 0.99, 0.0, 0.0]);
-    let fb = design(&model, &FeedbackSpec::Gain(g), None, 1e-4).unwrap();
+    let fb = design_c(&model, &FeedbackSpec::Gain(g), None, 1e-4).unwrap();
     assert!(!fb.stable());
     assert_eq!(fb.unstable.len(), 1);
     assert!((fb.unstable[0] - C64::new(122.2708754065, 0.0)).norm() < 1e-6, "{:?}", fb.unstable);
@@ -45,7 +50,7 @@ fn seed003_prefilter_makes_the_angle_of_attack_follow_the_reference() {
     let poles = Poles::new([-4.0, -5.0, -6.0, -7.0].map(PoleSpec::Real)).unwrap();
     let track = Mat::from_row_slice(1, 4, &[0.0, 1.0, 0.0, 0.0]);
     let dt = 1e-3;
-    let fb = design(&model, &FeedbackSpec::Poles { poles, placement: Method::Ackermann }, Some(&track), dt).unwrap();
+    let fb = design_c(&model, &FeedbackSpec::Poles { poles, placement: Method::Ackermann, domain: Domain::Continuous }, Some(&track), dt).unwrap();
     let dm = model.discretize(dt);
     let (acl, bn) = (&dm.a - &dm.b * &fb.g, &dm.b * &fb.n);
     let r = Mat::from_element(1, 1, 0.1);
@@ -61,6 +66,6 @@ fn seed003_prefilter_makes_the_angle_of_attack_follow_the_reference() {
     }
     assert!((x[(1, 0)] - 0.1).abs() > 1e-2, "α without N: {}", x[(1, 0)]);
     // A tracked output the input cannot move in steady state is refused, with the reason.
-    let e = design(&model, &FeedbackSpec::Poles { poles: Poles::new([-4.0, -5.0, -6.0, -7.0].map(PoleSpec::Real)).unwrap(), placement: Method::Ackermann }, Some(&Mat::zeros(1, 4)), dt).unwrap_err();
+    let e = design_c(&model, &FeedbackSpec::Poles { poles: Poles::new([-4.0, -5.0, -6.0, -7.0].map(PoleSpec::Real)).unwrap(), placement: Method::Ackermann, domain: Domain::Continuous }, Some(&Mat::zeros(1, 4)), dt).unwrap_err();
     assert!(e.contains("singular"), "{e}");
 }

@@ -124,19 +124,61 @@ pub fn report(s: &Scenario) -> DesignReport {
             Ok(p) => {
                 warnings = p.warnings.clone();
                 if let (Some(c), Some(fb)) = (&s.controller, &p.feedback) {
-                    text += &format!("\ncontroller: state feedback u = {}r − G x̂ on '{}'\n", if c.track.is_some() { "N " } else { "" }, c.observer);
+                    let kind = if matches!(c.spec, Some(controller::design::FeedbackSpec::Lqr { .. })) { "lqr" } else { "state-feedback" };
+                    let law = match (&fb.integral, c.track.is_some()) {
+                        (Some(_), _) => "u = −G x̂ − G_ξ ξ, ξ⁺ = ξ + dt (r − z)",
+                        (None, true) => "u = N r − G x̂",
+                        (None, false) => "u = r − G x̂",
+                    };
+                    let ff = if fb.feedforward.is_some() { " − M ŵ" } else { "" };
+                    text += &format!("\ncontroller: {kind}, {law}{ff}, on '{}'\n  G {}\n", c.observer, fb.how);
                     text += &matrix_text("G", &fb.g);
-                    if c.track.is_some() {
-                        text += "  prefilter N = −(C_t(A − BG)⁻¹B)⁻¹ (u = N r − G x̂):\n";
+                    if let Some((gi, ct, m)) = &fb.integral {
+                        text += &format!(
+                            "  integral action on the tracked outputs z = C_t x, {} (designed on the augmented sampled plant):\n",
+                            if m.is_some() { "measured as z = M y" } else { "estimated as z = C_t x̂ (not a combination of the outputs)" }
+                        );
+                        text += &matrix_text("G_ξ", gi);
+                        text += &matrix_text("C_t", ct);
+                        if let Some(m) = m {
+                            text += &matrix_text("M", m);
+                        }
+                    } else if c.track.is_some() {
+                        text += "  prefilter N = (C_t(I − Φ + Γ_BG)⁻¹Γ_B)⁻¹ (unit DC gain from r to z):\n";
                         text += &matrix_text("N", &fb.n);
                     }
-                    text += &format!("  closed loop eig(A − BG):       {}\n", format_list(&fb.closed_loop));
-                    text += &format!("  sampled eig(A_d − B_dG):       {}\n", format_list(&fb.discrete_closed_loop));
+                    if let Some([mw, ..]) = &fb.feedforward {
+                        text += "  feedforward: u −= M ŵ_{k−1}, M = Γ_B⁺Γ_E (w enters through the inputs: Γ_E = Γ_B M); ŵ from the observer's estimator, M W:\n";
+                        text += &matrix_text("MW", mw);
+                    }
+                    let closed = if s.discrete || !matches!(c.spec, Some(controller::design::FeedbackSpec::Poles { domain: controller::design::Domain::Continuous, .. }) | Some(controller::design::FeedbackSpec::Gain(_))) {
+                        "ln(z)/dt of the sampled loop"
+                    } else {
+                        "eig(A − BG)"
+                    };
+                    text += &format!("  closed loop, {closed}: {}\n", format_list(&fb.closed_loop));
+                    text += &format!("  sampled eig(Φ − Γ_BG):       {}\n", format_list(&fb.discrete_closed_loop));
                     text += &format!("  stable: {}\n", fb.stable());
+                    let mut matrices = json!({"G": rows(&fb.g), "N": rows(&fb.n)});
+                    if let Some((gi, ct, m)) = &fb.integral {
+                        matrices["G_xi"] = json!(rows(gi));
+                        matrices["C_t"] = json!(rows(ct));
+                        if let Some(m) = m {
+                            matrices["M"] = json!(rows(m));
+                        }
+                    }
+                    if let Some([mw, a, b]) = &fb.feedforward {
+                        matrices["MW"] = json!(rows(mw));
+                        matrices["MWCPhi"] = json!(rows(a));
+                        matrices["MWCGamma_B"] = json!(rows(b));
+                    }
                     controller = json!({
-                        "kind": "state-feedback",
+                        "kind": kind,
                         "observer": c.observer,
-                        "matrices": {"G": rows(&fb.g), "N": rows(&fb.n)},
+                        "how": fb.how,
+                        "integral": fb.integral.is_some(),
+                        "feedforward": fb.feedforward.is_some(),
+                        "matrices": matrices,
                         "closed_loop_poles": lti::re_im(&fb.closed_loop),
                         "discrete_closed_loop_poles": lti::re_im(&fb.discrete_closed_loop),
                         "stable": fb.stable(),

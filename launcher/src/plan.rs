@@ -1,7 +1,9 @@
 //! Designing everything a scenario names, before anything runs: the observers, the state
 //! feedback, and the warnings an engineer should see.
 
-use controller::design::{design as design_feedback, FeedbackDesign, FeedbackSpec};
+use controller::design::feedforward::matched_gain;
+use controller::design::{design as design_feedback, FeedbackDesign, FeedbackSpec, Options};
+use lti::Mat;
 use lti::eig::{eigenvalues, format_list, sig, C64};
 use diagnosis::{design_bank, Bank};
 use observer::{design, Designed};
@@ -79,20 +81,41 @@ pub fn complete(s: &Scenario, banks: Vec<Bank>, own: Vec<Option<Designed>>) -> R
         .collect();
     let feedback = match s.controller.as_ref().and_then(|c| c.spec.as_ref().map(|spec| (c, spec))) {
         Some((c, spec)) => {
-            let designed = if s.discrete {
-                controller::design::design_discrete(&s.sampled_model(), spec, c.track.as_ref())
-            } else {
-                design_feedback(&s.model, spec, c.track.as_ref(), s.dt)
-            };
-            Some(designed.map_err(|reason| {
-                let field = if matches!(spec, FeedbackSpec::Gain(_)) { "controller.gain" } else { "controller.poles" };
+            let model = (!s.discrete).then_some(&s.model);
+            let opts = Options { track: c.track.as_ref(), integral: c.integral };
+            let designed = design_feedback(model, &s.sampled_model(), spec, &opts);
+            let mut fb = designed.map_err(|reason| {
+                let field = match spec {
+                    FeedbackSpec::Gain(_) => "controller.gain",
+                    FeedbackSpec::Lqr { .. } => "controller.kind",
+                    FeedbackSpec::Poles { .. } => "controller.poles",
+                };
+                let field = if reason.starts_with("integral") { "controller.integral" } else { field };
                 PlanError { error: locate(field.into(), reason), conditions: vec![], observer: None }
-            })?)
+            })?;
+            if c.feedforward {
+                fb.feedforward = Some(feedforward(s, c, &observers).map_err(|reason| PlanError { error: locate("controller.feedforward".into(), reason), conditions: vec![], observer: None })?);
+            }
+            Some(fb)
         }
         None => None,
     };
     let warnings = warnings(s, &observers, feedback.as_ref());
     Ok(Plan { observers, feedback, banks, warnings })
+}
+
+/// M ŵ's matrices (MW, MWCΦ, MWCΓ_B) for `feedforward = "what"`: w must enter through the
+/// inputs (Γ_E = Γ_B M), and the controller's observer must estimate it.
+fn feedforward(s: &Scenario, c: &scenario::ControllerEntry, observers: &[(String, Option<Designed>)]) -> Result<[Mat; 3], String> {
+    let m = matched_gain(&s.sampled_model())?;
+    let what = observers.iter().find(|(n, _)| *n == c.observer).and_then(|(_, d)| d.as_ref()).and_then(|d| d.what.as_ref());
+    let what = what.ok_or_else(|| {
+        format!(
+            "observer '{}' gives no estimate ŵ of the unknown input (an unknown-input observer of ours gives one when CΓ_E has full column rank): feedforward = \"what\" needs it",
+            c.observer
+        )
+    })?;
+    Ok([&m * &what.w, &m * &what.w_c_phi, &m * &what.w_c_gamma_b])
 }
 
 /// Designs every `[[diagnoser]]` bank; a refusal names the diagnoser, the member and the

@@ -89,7 +89,7 @@ pub(crate) fn faults(raw: &[RawFault], model: &Model, ff: &Mat, dt: f64) -> Resu
             "actuator" => (model.l(), "known inputs (columns of B)"),
             "sensor" => (model.p(), "outputs (rows of C)"),
             "component" => (ff.ncols(), "columns of plant.Ff"),
-            other => return Err(bad(at("target"), format!("{} is not a fault target (actuator, sensor, component)", quoted(other)))),
+            other => return Err(bad(at("target"), format!("{} is not a fault target (actuator, sensor, component){}", quoted(other), crate::suggest::did_you_mean(other, ["actuator", "sensor", "component"])))),
         };
         if f.channel < 1 || f.channel as usize > count {
             return Err(bad(at("channel"), format!("{} does not exist: the plant has {count} {what}", f.channel)));
@@ -106,7 +106,7 @@ pub(crate) fn faults(raw: &[RawFault], model: &Model, ff: &Mat, dt: f64) -> Resu
             Target::Component(_) => &["additive"],
         };
         if !kinds.contains(&f.kind.as_str()) {
-            return Err(bad(at("kind"), format!("{} is not a kind of {} fault ({})", quoted(&f.kind), f.target, kinds.join(", "))));
+            return Err(bad(at("kind"), format!("{} is not a kind of {} fault ({}){}", quoted(&f.kind), f.target, kinds.join(", "), crate::suggest::did_you_mean(&f.kind, kinds.iter().copied()))));
         }
         let kind = match f.kind.as_str() {
             "additive" => Kind::Additive,
@@ -167,7 +167,7 @@ pub(crate) fn faults(raw: &[RawFault], model: &Model, ff: &Mat, dt: f64) -> Resu
                 }
                 Profile::Intermittent { intervals: ivs }
             }
-            other => return Err(bad(at("profile"), format!("{} is not a profile (step, ramp, intermittent)", quoted(other)))),
+            other => return Err(bad(at("profile"), format!("{} is not a profile (step, ramp, intermittent){}", quoted(other), crate::suggest::did_you_mean(other, ["step", "ramp", "intermittent"])))),
         };
         out.push(Fault { name: f.name.clone(), target, kind, value, profile });
     }
@@ -183,13 +183,13 @@ pub(crate) fn diagnosers(raw: &[RawDiagnoser], model: &Model, ff: &Mat, noise: O
         let scheme = match d.scheme.as_str() {
             "generalized" => Scheme::Generalized,
             "dedicated" => Scheme::Dedicated,
-            other => return Err(bad(at("scheme"), format!("{} is not a scheme (generalized, dedicated)", quoted(other)))),
+            other => return Err(bad(at("scheme"), format!("{} is not a scheme (generalized, dedicated){}", quoted(other), crate::suggest::did_you_mean(other, ["generalized", "dedicated"])))),
         };
         let channels = match d.faults.as_str() {
             "actuator" => Channels::Actuator,
             "sensor" => Channels::Sensor,
             "component" => Channels::Component,
-            other => return Err(bad(at("faults"), format!("{} is not a channel class (actuator, sensor, component)", quoted(other)))),
+            other => return Err(bad(at("faults"), format!("{} is not a channel class (actuator, sensor, component){}", quoted(other), crate::suggest::did_you_mean(other, ["actuator", "sensor", "component"])))),
         };
         let m = diagnosis::bank::channel_labels(channels, model, ff).len();
         // The members' observer names must be free, and short enough to be names themselves.
@@ -219,7 +219,7 @@ pub(crate) fn diagnosers(raw: &[RawDiagnoser], model: &Model, ff: &Mat, noise: O
                 }
                 MemberKind::Kalman
             }
-            other => return Err(bad(at("observer"), format!("{} is not a member design (chen-patton-uio, luenberger, kalman)", quoted(other)))),
+            other => return Err(bad(at("observer"), format!("{} is not a member design (chen-patton-uio, luenberger, kalman){}", quoted(other), crate::suggest::did_you_mean(other, ["chen-patton-uio", "luenberger", "kalman"])))),
         };
         if channels != Channels::Sensor && kind != "chen-patton-uio" {
             return Err(bad(at("observer"), format!("{kind} cannot be blind to a {} channel: use chen-patton-uio", channels.name())));
@@ -258,7 +258,7 @@ pub(crate) fn diagnosers(raw: &[RawDiagnoser], model: &Model, ff: &Mat, noise: O
                 Evaluation::Forgetting { lambda: l }
             }
             "chi2" => Evaluation::Chi2,
-            other => return Err(bad(at("evaluation"), format!("{} is not an evaluation (norm, rms, forgetting, chi2)", quoted(other)))),
+            other => return Err(bad(at("evaluation"), format!("{} is not an evaluation (norm, rms, forgetting, chi2){}", quoted(other), crate::suggest::did_you_mean(other, ["norm", "rms", "forgetting", "chi2"])))),
         };
         if d.window.is_some() && !matches!(evaluation, Evaluation::Rms { .. }) {
             return Err(bad(at("window"), "only evaluation = \"rms\" takes a window"));

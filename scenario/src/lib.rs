@@ -9,6 +9,7 @@ pub mod limits;
 mod locate;
 pub mod matrix_file;
 mod raw;
+pub mod suggest;
 pub mod untrusted;
 mod validate;
 
@@ -155,8 +156,12 @@ pub struct ControllerEntry {
     pub observer: String,
     /// How G is obtained (`None` for an external controller).
     pub spec: Option<FeedbackSpec>,
-    /// Tracked outputs z = C_t x (l×n): the prefilter makes them follow r.
+    /// Tracked outputs z = C_t x (l×n): the prefilter (or the integrators) make them follow r.
     pub track: Option<Mat>,
+    /// Integral action on the tracked outputs.
+    pub integral: bool,
+    /// Cancel the matched unknown input with the observer's ŵ (`feedforward = "what"`).
+    pub feedforward: bool,
     /// The external controller, for `kind = "process"`.
     pub process: Option<ProcessSpec>,
 }

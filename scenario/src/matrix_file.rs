@@ -39,7 +39,7 @@ pub(crate) fn load_all(raw: &mut RawScenario, dir: &Path) -> Result<(), Bad> {
         }
     }
     if let Some(c) = raw.controller.as_mut() {
-        for (name, m) in [("controller.gain", &mut c.gain), ("controller.track", &mut c.track)] {
+        for (name, m) in [("controller.gain", &mut c.gain), ("controller.track", &mut c.track), ("controller.Q", &mut c.q), ("controller.R", &mut c.r)] {
             fields.extend(m.as_mut().map(|m| (name.to_string(), m)));
         }
     }

@@ -239,8 +239,19 @@ pub struct RawController {
     pub poles: Option<Vec<RawPole>>,
     pub gain: Option<Rows>,
     pub placement: Option<String>,
+    /// Where `poles` are placed: "sampled" (default) or "continuous".
+    pub domain: Option<String>,
+    /// `kind = "lqr"`: the state and input weights.
+    #[serde(rename = "Q")]
+    pub q: Option<Rows>,
+    #[serde(rename = "R")]
+    pub r: Option<Rows>,
     /// Rows of C_t: the state combinations that follow the reference.
     pub track: Option<Rows>,
+    /// Integral action on the tracked outputs.
+    pub integral: Option<bool>,
+    /// "what": cancel the matched unknown input with the observer's ŵ.
+    pub feedforward: Option<String>,
     /// `kind = "process"`: the command and its parameters.
     pub command: Option<Vec<String>>,
     pub params: Option<toml::Table>,

@@ -3,7 +3,7 @@
 use std::collections::BTreeSet;
 use std::path::Path;
 
-use controller::design::FeedbackSpec;
+use controller::design::{Domain, FeedbackSpec};
 use lti::place::Method;
 use lti::signal::Signal;
 use lti::{Mat, Model, PoleSpec, Poles};
@@ -43,7 +43,14 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<Scenario, ScenarioError> 
         if field.contains("poles") && reason.contains("untagged") {
             reason = "each pole is a number, or [re, im] for a complex pair".into();
         }
-        let loc = e.inner().span().map(|s| line_col(text, s.start)).or_else(|| at(&field));
+        let mut loc = e.inner().span().map(|s| line_col(text, s.start)).or_else(|| at(&field));
+        // serde names an unknown key with the table's span (its header): point at the key's own
+        // line, and suggest the known key it was likely meant to be.
+        if let Some((key, known)) = unknown_key(&reason) {
+            let own = if field.is_empty() { key.clone() } else { format!("{field}.{key}") };
+            loc = at(&own).or(loc);
+            reason += &crate::suggest::did_you_mean(&key, known.iter().map(String::as_str));
+        }
         ScenarioError { file: path.to_path_buf(), at: loc, field, reason }
     })?;
     let mut raw = raw;
@@ -54,6 +61,15 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<Scenario, ScenarioError> 
         s.source = text.to_string();
         s
     })
+}
+
+/// From serde's "unknown field `poels`, expected one of `kind`, `poles`, …": the key and the
+/// keys its table knows.
+fn unknown_key(message: &str) -> Option<(String, Vec<String>)> {
+    let rest = message.strip_prefix("unknown field `")?;
+    let (key, rest) = rest.split_once('`')?;
+    let known = rest.split('`').skip(1).step_by(2).map(str::to_string).collect();
+    Some((key.to_string(), known))
 }
 
 fn first_line(s: &str) -> &str {
@@ -160,7 +176,7 @@ pub(crate) fn placement(field: &str, p: &Option<String>) -> Result<Method, Bad> 
         Some("knv0") => Ok(Method::Knv0),
         Some("matlab") => Ok(Method::Matlab),
         Some("ackermann") => Ok(Method::Ackermann),
-        Some(other) => Err(bad(field, format!("{} is not a placement (robust, knv0, matlab, ackermann)", quoted(other)))),
+        Some(other) => Err(bad(field, format!("{} is not a placement (robust, knv0, matlab, ackermann){}", quoted(other), crate::suggest::did_you_mean(other, ["robust", "knv0", "matlab", "ackermann"])))),
     }
 }
 
@@ -210,7 +226,7 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
     let discrete = match p.time.as_deref() {
         None | Some("continuous") => false,
         Some("discrete") => true,
-        Some(other) => return Err(bad("plant.time", format!("{} is not a time domain (continuous, discrete)", quoted(other)))),
+        Some(other) => return Err(bad("plant.time", format!("{} is not a time domain (continuous, discrete){}", quoted(other), crate::suggest::did_you_mean(other, ["continuous", "discrete"])))),
     };
     let ([ka, kb, ke], given, other) = if discrete {
         (["Phi", "Gamma_B", "Gamma_E"], [&p.phi, &p.gamma_b, &p.gamma_e], [("A", p.a.is_some()), ("B", p.b.is_some()), ("E", p.e.is_some())])
@@ -416,7 +432,8 @@ fn observer_cap(own: usize, observers: &[ObserverEntry]) -> Result<(), Bad> {
 
 fn observer_spec(f: &str, o: &RawObserver, model: &Model, noise: Option<&super::NoiseSpec>) -> Result<Spec, Bad> {
     if !KINDS.contains(&o.kind.as_str()) {
-        return Err(bad(format!("{f}.kind"), format!("{} is not an observer kind ({}, process)", quoted(&o.kind), KINDS.join(", "))));
+        let hint = crate::suggest::did_you_mean(&o.kind, KINDS.iter().copied().chain(["process"]));
+        return Err(bad(format!("{f}.kind"), format!("{} is not an observer kind ({}, process){hint}", quoted(&o.kind), KINDS.join(", "))));
     }
     let method = placement(&format!("{f}.placement"), &o.placement)?;
     let refuse = |key: &str, given: bool| {
@@ -477,7 +494,7 @@ fn observer_spec(f: &str, o: &RawObserver, model: &Model, noise: Option<&super::
             let path = match o.path.as_deref() {
                 None | Some("placement") => HuiZakPath::Placement,
                 Some("lmi") => HuiZakPath::Lmi,
-                Some(other) => return Err(bad(format!("{f}.path"), format!("{} is not a design path (placement, lmi)", quoted(other)))),
+                Some(other) => return Err(bad(format!("{f}.path"), format!("{} is not a design path (placement, lmi){}", quoted(other), crate::suggest::did_you_mean(other, ["placement", "lmi"])))),
             };
             if path == HuiZakPath::Lmi && lqe.is_some() {
                 return Err(bad(format!("{f}.path"), "gain = \"lqe\" takes L from a DARE, not from the LMI: drop path = \"lmi\""));
@@ -600,34 +617,90 @@ pub(crate) fn plant_process(p: &Option<RawProcess>) -> Result<Option<ProcessSpec
 }
 
 fn controller_entry(c: &RawController, model: &Model, observers: &BTreeSet<String>) -> Result<ControllerEntry, Bad> {
-    if c.kind != "state-feedback" && c.kind != "process" {
-        return Err(bad("controller.kind", format!("{} is not a controller kind (state-feedback, process)", quoted(&c.kind))));
+    const KINDS: [&str; 3] = ["state-feedback", "lqr", "process"];
+    if !KINDS.contains(&c.kind.as_str()) {
+        return Err(bad("controller.kind", format!("{} is not a controller kind ({}){}", quoted(&c.kind), KINDS.join(", "), crate::suggest::did_you_mean(&c.kind, KINDS))));
     }
     if !observers.contains(&c.observer) {
         let known: Vec<&str> = observers.iter().map(String::as_str).collect();
-        return Err(bad("controller.observer", format!("no observer named {} (observers: {})", quoted(&c.observer), known.join(", "))));
+        return Err(bad("controller.observer", format!("no observer named {} (observers: {}){}", quoted(&c.observer), known.join(", "), crate::suggest::did_you_mean(&c.observer, known.iter().copied()))));
     }
+    let given = [
+        ("poles", c.poles.is_some()),
+        ("gain", c.gain.is_some()),
+        ("placement", c.placement.is_some()),
+        ("domain", c.domain.is_some()),
+        ("Q", c.q.is_some()),
+        ("R", c.r.is_some()),
+        ("track", c.track.is_some()),
+        ("integral", c.integral.is_some()),
+        ("feedforward", c.feedforward.is_some()),
+    ];
     if c.kind == "process" {
         let process = process_spec("controller", &c.command, &c.params)?;
-        for (key, given) in [("poles", c.poles.is_some()), ("gain", c.gain.is_some()), ("placement", c.placement.is_some()), ("track", c.track.is_some())] {
-            if given {
-                return Err(bad(format!("controller.{key}"), "a process controller takes no design keys (only command, observer and params)"));
-            }
+        if let Some((key, _)) = given.iter().find(|(_, g)| *g) {
+            return Err(bad(format!("controller.{key}"), "a process controller takes no design keys (only command, observer and params)"));
         }
-        return Ok(ControllerEntry { observer: c.observer.clone(), spec: None, track: None, process: Some(process) });
+        return Ok(ControllerEntry { observer: c.observer.clone(), spec: None, track: None, integral: false, feedforward: false, process: Some(process) });
     }
     if c.command.is_some() || c.params.is_some() {
         return Err(bad("controller.command", "only kind = \"process\" takes command and params"));
     }
-    let method = placement("controller.placement", &c.placement)?;
-    let spec = match (&c.poles, &c.gain) {
-        (Some(p), None) => FeedbackSpec::Poles { poles: poles("controller.poles", p)?, placement: method },
-        (None, Some(g)) => FeedbackSpec::Gain(matrix("controller.gain", g, (Some(model.l()), Some(model.n())), "one row per input, one column per state")?),
-        (Some(_), Some(_)) => return Err(bad("controller.gain", "give poles or gain, not both")),
-        (None, None) => return Err(bad("controller.poles", "a state-feedback controller needs poles = […] or gain = [[…]]")),
+    let integral = c.integral.unwrap_or(false);
+    // With integral action G and Q also cover one integrator per input.
+    let size = model.n() + if integral { model.l() } else { 0 };
+    let states = if integral { "one column per state, then one per integrator" } else { "one column per state" };
+    let spec = if c.kind == "lqr" {
+        for key in ["poles", "gain", "placement", "domain"] {
+            if given.iter().any(|(k, g)| *k == key && *g) {
+                return Err(bad(format!("controller.{key}"), "kind = \"lqr\" takes Q and R (its gain comes from the DARE), not poles, gain, placement or domain"));
+            }
+        }
+        let q = c.q.as_ref().map(|q| {
+            let field = "controller.Q";
+            let m = matrix(field, q, (Some(size), Some(size)), if integral { "the plant's states, then one integrator per input" } else { "one row and column per state" })?;
+            definite(field, "Q", &m, lti::dare::Definite::Semi)
+        });
+        let r = c.r.as_ref().map(|r| {
+            let field = "controller.R";
+            let m = matrix(field, r, (Some(model.l()), Some(model.l())), "one row and column per input")?;
+            definite(field, "R", &m, lti::dare::Definite::Positive)
+        });
+        FeedbackSpec::Lqr { q: q.transpose()?, r: r.transpose()? }
+    } else {
+        for key in ["Q", "R"] {
+            if given.iter().any(|(k, g)| *k == key && *g) {
+                return Err(bad(format!("controller.{key}"), "Q and R are the weights of kind = \"lqr\"; a state-feedback controller takes poles or gain"));
+            }
+        }
+        let method = placement("controller.placement", &c.placement)?;
+        let domain = match c.domain.as_deref() {
+            None | Some("sampled") => Domain::Sampled,
+            Some("continuous") => Domain::Continuous,
+            Some(other) => return Err(bad("controller.domain", format!("{} is not a domain (sampled, continuous){}", quoted(other), crate::suggest::did_you_mean(other, ["sampled", "continuous"])))),
+        };
+        match (&c.poles, &c.gain) {
+            (Some(p), None) => FeedbackSpec::Poles { poles: poles("controller.poles", p)?, placement: method, domain },
+            (None, Some(g)) => {
+                if c.domain.is_some() || c.placement.is_some() {
+                    return Err(bad(if c.domain.is_some() { "controller.domain" } else { "controller.placement" }, "a given gain is not placed: domain and placement go with poles"));
+                }
+                FeedbackSpec::Gain(matrix("controller.gain", g, (Some(model.l()), Some(size)), &format!("one row per input, {states}"))?)
+            }
+            (Some(_), Some(_)) => return Err(bad("controller.gain", "give poles or gain, not both")),
+            (None, None) => return Err(bad("controller.poles", "a state-feedback controller needs poles = […] or gain = [[…]] (or kind = \"lqr\")")),
+        }
     };
     let track = c.track.as_ref().map(|t| matrix("controller.track", t, (Some(model.l()), Some(model.n())), "one row per input: the state combination that follows it")).transpose()?;
-    Ok(ControllerEntry { observer: c.observer.clone(), spec: Some(spec), track, process: None })
+    if integral && track.is_none() {
+        return Err(bad("controller.integral", "integral action needs track = [[…]]: the state combinations (one per input) the integrators hold at r"));
+    }
+    let feedforward = match c.feedforward.as_deref() {
+        None => false,
+        Some("what") => true,
+        Some(other) => return Err(bad("controller.feedforward", format!("{} is not a feedforward (what: cancel the matched unknown input with the observer's ŵ)", quoted(other)))),
+    };
+    Ok(ControllerEntry { observer: c.observer.clone(), spec: Some(spec), track, integral, feedforward, process: None })
 }
 
 fn check_expect(e: &RawExpect, observers: &BTreeSet<String>) -> Result<(), Bad> {

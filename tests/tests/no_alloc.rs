@@ -106,7 +106,7 @@ fn step_functions_do_not_allocate() {
                 xhat[i].copy_from_slice(o.step(&row[lay.y()], &row[lay.u_prev()]));
             }
             match &mut controller {
-                Some(c) => u.copy_from_slice(c.step(k, &xhat[c_obs])),
+                Some(c) => u.copy_from_slice(c.step(k, &xhat[c_obs], &row)),
                 None => u.copy_from_slice(plant.reference()),
             }
             stopped = plant.advance(k, &u).is_err();

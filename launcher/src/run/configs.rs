@@ -1,7 +1,7 @@
 //! The configuration each component receives, built from the scenario and its designs. The
 //! same values drive the in-process loop, so both modes compute with identical numbers.
 
-use controller::ControllerConfig;
+use controller::{ControllerConfig, FeedforwardConfig, IntegralConfig};
 use lockstep::PlantLayout;
 use observer::shell::ObserverRun;
 use plant::PlantConfig;
@@ -80,7 +80,24 @@ pub fn configs(s: &Scenario, plan: &Plan) -> Configs {
         .map(|(name, d)| (name.clone(), d.as_ref().map(|d| ObserverRun { observer: d.runtime.clone(), layout })))
         .collect();
     let controller = match (&s.controller, &plan.feedback) {
-        (Some(c), Some(fb)) => Some(ControllerConfig { g: (&fb.g).into(), n: (&fb.n).into(), references: s.inputs.clone(), dt: s.dt, observer: c.observer.clone() }),
+        (Some(c), Some(fb)) => Some(ControllerConfig {
+            g: (&fb.g).into(),
+            n: (&fb.n).into(),
+            references: s.inputs.clone(),
+            dt: s.dt,
+            observer: c.observer.clone(),
+            integral: fb.integral.as_ref().map(|(gi, ct, m)| match m {
+                Some(m) => IntegralConfig { gi: gi.into(), ct: m.into(), y: Some([layout.y().start, layout.y().end]) },
+                None => IntegralConfig { gi: gi.into(), ct: ct.into(), y: None },
+            }),
+            feedforward: fb.feedforward.as_ref().map(|[mw, a, b]| FeedforwardConfig {
+                mw: mw.into(),
+                mw_c_phi: a.into(),
+                mw_c_gamma_b: b.into(),
+                y: [layout.y().start, layout.y().end],
+                u_prev: [layout.u_prev().start, layout.u_prev().end],
+            }),
+        }),
         _ => None,
     };
     Configs { plant, followers, closed_loop: s.controller.is_some(), observers, controller, layout, pace_s: None }

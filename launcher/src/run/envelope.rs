@@ -138,7 +138,11 @@ pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> V
 
     if let Some(c) = &s.controller {
         let publishes = PublishSpec { service: "controller".into(), len: lay.l, names: names(&s.names.input).iter().enumerate().map(|(i, _)| format!("u{}", i + 1)).collect() };
-        let reads = vec![ReadSpec { service: format!("observer/{}", c.observer), len: lay.n, lag: 0, sleep_us: None, fields: BTreeMap::new() }];
+        let mut reads = vec![ReadSpec { service: format!("observer/{}", c.observer), len: lay.n, lag: 0, sleep_us: None, fields: BTreeMap::new() }];
+        // ŵ is made from the plant's y_k and u_{k−1}, and measured tracked outputs from its y_k.
+        if cfg.controller.as_ref().is_some_and(|cc| cc.feedforward.is_some() || cc.integral.as_ref().is_some_and(|i| i.y.is_some())) {
+            reads.push(plant_read(None));
+        }
         let (program, params) = match (&c.process, &cfg.controller) {
             (Some(p), _) => (Program::External(p.clone()), p.params.clone()),
             (None, Some(cc)) => (Program::Builtin("controller"), serde_json::to_value(cc).expect("serialises")),

@@ -50,7 +50,7 @@ pub fn run(cfg: &Configs, session: &mut Session) -> Result<Stop, LaunchError> {
         }
         match (&mut controller, ctrl_obs) {
             (Some(c), Some(o)) => {
-                u.copy_from_slice(c.step(k, &row.xhat[o]));
+                u.copy_from_slice(c.step(k, &row.xhat[o], &row.plant));
                 row.u.copy_from_slice(&u);
             }
             _ => u.copy_from_slice(plant.reference()),

@@ -1,0 +1,212 @@
+//! State-feedback design: G placed, from the DARE (LQR) or given, with optional integral action
+//! and cancellation of the unknown input, and the loop it makes.
+//!
+//! The controller runs on samples held over each step, so by default the poles asked for are
+//! placed for the sampled loop exactly: eig(Φ − Γ_BG) = e^{p·dt}, as the observers are. The
+//! continuous placement eig(A − BG) = p (`domain = "continuous"`) reproduces a paper's printed
+//! gain; its sampled loop then only approximates the poles asked for.
+//!
+//! With u = N r − G x̂ and tracked outputs z = C_t x (one per input), the reference prefilter
+//!
+//! ```text
+//! N = (C_t (I − Φ + Γ_BG)⁻¹ Γ_B)⁻¹
+//! ```
+//!
+//! gives the sampled loop unit DC gain from r to z (Franklin, Powell & Emami-Naeini, *Feedback
+//! Control of Dynamic Systems*, §7.9, in its sampled form; for an exactly sampled continuous plant
+//! (I − Φ + Γ_BG)⁻¹Γ_B = −(A − BG)⁻¹B, the continuous formula). Without tracked outputs N = I:
+//! u = r − G x̂. With integral action ([`integral`]) N = 0: the integrator makes z settle on r.
+
+pub mod feedforward;
+pub mod integral;
+
+use lti::dare::solve_dare;
+use lti::eig::{continuous_image, eigenvalues, format_list};
+use lti::place::{place, Method};
+use lti::{Discrete, Mat, Model, Poles, C64};
+
+/// Where the poles asked for are placed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Domain {
+    /// eig(Φ − Γ_BG) = e^{p·dt}: the loop that runs.
+    Sampled,
+    /// eig(A − BG) = p (a continuous design applied to samples).
+    Continuous,
+}
+
+impl Domain {
+    /// The scenario's word.
+    pub fn name(self) -> &'static str {
+        match self {
+            Domain::Sampled => "sampled",
+            Domain::Continuous => "continuous",
+        }
+    }
+}
+
+/// How G is obtained.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FeedbackSpec {
+    /// Place the closed loop's poles.
+    Poles {
+        /// Continuous-time closed-loop poles p (placed at e^{p·dt} for the sampled loop).
+        poles: Poles,
+        /// Placement method.
+        placement: Method,
+        /// Which loop they are placed for.
+        domain: Domain,
+    },
+    /// The discrete LQR: G = (R + Γ_BᵀXΓ_B)⁻¹Γ_BᵀXΦ, X = DARE(Φ, Γ_B, Q, R), minimising
+    /// Σ x_kᵀQx_k + u_kᵀRu_k over the sampled plant (identities when not given).
+    Lqr {
+        /// State weight (n×n, or (n + l)×(n + l) with integral action).
+        q: Option<Mat>,
+        /// Input weight, l×l.
+        r: Option<Mat>,
+    },
+    /// G given (l×n, or l×(n + l) = [G_x, G_ξ] with integral action).
+    Gain(Mat),
+}
+
+/// What the loop asks besides G.
+#[derive(Debug, Clone, Default)]
+pub struct Options<'a> {
+    /// The tracked outputs z = C_t x (l×n): the prefilter, or the integrators, make them follow r.
+    pub track: Option<&'a Mat>,
+    /// Integral action on the tracked outputs.
+    pub integral: bool,
+}
+
+/// A designed state feedback.
+#[derive(Debug, Clone)]
+pub struct FeedbackDesign {
+    /// G, l×n (the state part G_x with integral action).
+    pub g: Mat,
+    /// With integral action: the integrators' gain G_ξ (l×l), C_t, and M when z = My is measured.
+    pub integral: Option<(Mat, Mat, Option<Mat>)>,
+    /// The reference prefilter N, l×l (I without tracked outputs, 0 with integral action).
+    pub n: Mat,
+    /// The continuous loop's poles: eig(A − BG) when placed in continuous time, else ln(z)/dt of
+    /// the sampled loop's; sorted.
+    pub closed_loop: Vec<C64>,
+    /// eig(Φ − Γ_BG) (of the augmented loop with integral action), sorted.
+    pub discrete_closed_loop: Vec<C64>,
+    /// The unstable continuous closed-loop eigenvalues (empty when stable).
+    pub unstable: Vec<C64>,
+    /// How G was made, in words: "placed for the sampled loop (e^{p·dt})", "LQR …", "given".
+    pub how: String,
+    /// With `feedforward = "what"`: MW, MWCΦ and MWCΓ_B of M ŵ_{k−1} ([`feedforward`]), set by
+    /// whoever knows the observer's estimator.
+    pub feedforward: Option<[Mat; 3]>,
+}
+
+impl FeedbackDesign {
+    /// Whether the continuous and the sampled loops are both asymptotically stable.
+    pub fn stable(&self) -> bool {
+        self.unstable.is_empty() && self.discrete_closed_loop.iter().all(|z| z.norm() < 1.0)
+    }
+
+    /// "unstable closed loop: eig(A − BG) has +122.271" style description, if unstable.
+    pub fn instability(&self) -> Option<String> {
+        if !self.unstable.is_empty() {
+            Some(format!("unstable closed loop: eig(A − BG) has {}", format_list(&self.unstable)))
+        } else if !self.stable() {
+            let bad: Vec<C64> = self.discrete_closed_loop.iter().copied().filter(|z| z.norm() >= 1.0).collect();
+            Some(format!("unstable sampled closed loop: eig(Φ − Γ_BG) has {} (|z| ≥ 1): dt too coarse", format_list(&bad)))
+        } else {
+            None
+        }
+    }
+}
+
+/// Designs (or checks) G for the sampled plant `dm` — and its continuous `model`, when there is
+/// one (not for a discrete-time plant) — with the options' prefilter or integrators.
+pub fn design(model: Option<&Model>, dm: &Discrete, spec: &FeedbackSpec, opts: &Options) -> Result<FeedbackDesign, String> {
+    let (n, l) = (dm.a.nrows(), dm.b.ncols());
+    if let Some(ct) = opts.track
+        && ct.shape() != (l, n)
+    {
+        return Err(format!("track is {}×{}, must be {l}×{n} (one tracked output per input)", ct.nrows(), ct.ncols()));
+    }
+    // The pair G is designed on: the plant's, or the plant with the integrators (integral.rs).
+    let ct = match (opts.integral, opts.track) {
+        (true, Some(ct)) => Some(ct.clone()),
+        (true, None) => return Err("integral action needs track = [[…]]: the outputs the integrators hold at r".into()),
+        (false, _) => None,
+    };
+    let (phi, gamma) = match &ct {
+        Some(ct) => integral::augment_sampled(dm, ct),
+        None => (dm.a.clone(), dm.b.clone()),
+    };
+    let continuous = model.map(|m| match &ct {
+        Some(ct) => integral::augment_continuous(m, ct),
+        None => (m.a.clone(), m.b.clone()),
+    });
+    let size = phi.nrows();
+    let states = if ct.is_some() { format!("n + l = {size} (the plant's {n} states and one integrator per tracked output)") } else { format!("{size}") };
+    let (g_all, how) = match spec {
+        FeedbackSpec::Poles { poles, placement, domain } => {
+            if poles.len() != size {
+                return Err(format!("{} poles given, the loop has {states}", poles.len()));
+            }
+            match domain {
+                Domain::Sampled => (
+                    place(&phi, &gamma, &poles.to_discrete(dm.dt), *placement).map_err(|e| e.to_string())?.gain,
+                    "placed for the sampled loop: eig(Φ − Γ_BG) = e^{p·dt}".to_string(),
+                ),
+                Domain::Continuous => {
+                    let (a, b) = continuous.as_ref().ok_or("domain = \"continuous\" needs a continuous-time plant (a discrete-time plant's poles are placed at e^{p·dt})")?;
+                    (place(a, b, poles, *placement).map_err(|e| e.to_string())?.gain, "placed in continuous time: eig(A − BG) = p (the sampled loop approximates them)".to_string())
+                }
+            }
+        }
+        FeedbackSpec::Lqr { q, r } => {
+            let q = q.clone().unwrap_or_else(|| Mat::identity(size, size));
+            let r = r.clone().unwrap_or_else(|| Mat::identity(l, l));
+            if q.shape() != (size, size) {
+                return Err(format!("Q is {}×{}, must be {size}×{size} ({states})", q.nrows(), q.ncols()));
+            }
+            if r.shape() != (l, l) {
+                return Err(format!("R is {}×{}, must be {l}×{l} (one row per input)", r.nrows(), r.ncols()));
+            }
+            let dare = solve_dare(&phi, &gamma, &q, &r).map_err(|e| format!("LQR: {e}"))?;
+            (dare.k, format!("LQR: X = DARE(Φ, Γ_B, Q, R), relative residual {:.1e}; G = (R + Γ_BᵀXΓ_B)⁻¹Γ_BᵀXΦ", dare.residual))
+        }
+        FeedbackSpec::Gain(g) => {
+            if g.shape() != (l, size) {
+                return Err(format!("gain is {}×{}, must be {l}×{size} ({states})", g.nrows(), g.ncols()));
+            }
+            (g.clone(), "given".to_string())
+        }
+    };
+    let acl = &phi - &gamma * &g_all;
+    let discrete_closed_loop = eigenvalues(&acl).map_err(|e| e.to_string())?;
+    let closed_loop = match (spec, &continuous) {
+        (FeedbackSpec::Poles { domain: Domain::Continuous, .. } | FeedbackSpec::Gain(_), Some((a, b))) => eigenvalues(&(a - b * &g_all)).map_err(|e| e.to_string())?,
+        _ => continuous_image(&discrete_closed_loop, dm.dt).0,
+    };
+    let unstable: Vec<C64> = closed_loop.iter().copied().filter(|z| z.re >= 0.0).collect();
+    let g = g_all.columns(0, n).into_owned();
+    let (prefilter, integral) = match (&ct, opts.track) {
+        (Some(ct), _) => (Mat::zeros(l, l), Some((g_all.columns(n, l).into_owned(), ct.clone(), integral::measured(ct, &dm.c)))),
+        (None, None) => (Mat::identity(l, l), None),
+        (None, Some(ct)) => match prefilter(&acl, &gamma, ct) {
+            Ok(p) => (p, None),
+            // An unstable loop is refused (or run on request) for its instability, the reason
+            // that matters; a prefilter that cannot be formed for it is then left at I.
+            Err(_) if !unstable.is_empty() => (Mat::identity(l, l), None),
+            Err(e) => return Err(e),
+        },
+    };
+    Ok(FeedbackDesign { g, integral, n: prefilter, closed_loop, discrete_closed_loop, unstable, how, feedforward: None })
+}
+
+/// N = (C_t (I − Φ + Γ_BG)⁻¹ Γ_B)⁻¹ (see the module documentation).
+fn prefilter(acl: &Mat, gamma: &Mat, ct: &Mat) -> Result<Mat, String> {
+    let n = acl.nrows();
+    let x = (Mat::identity(n, n) - acl).lu().solve(gamma).ok_or("Φ − Γ_BG has an eigenvalue at 1: the closed loop has no finite DC gain, so no prefilter can make the tracked outputs follow r")?;
+    let dc = ct * x;
+    dc.clone().try_inverse().filter(|i| i.iter().all(|v| v.is_finite())).ok_or_else(|| {
+        format!("the sampled closed loop's DC gain to the tracked outputs, C_t(I − Φ + Γ_BG)⁻¹Γ_B = {dc:.4}, is singular: those outputs cannot follow r")
+    })
+}
