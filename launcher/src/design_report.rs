@@ -159,6 +159,11 @@ pub fn report(s: &Scenario) -> DesignReport {
                     text += &format!("  closed loop, {closed}: {}\n", format_list(&fb.closed_loop));
                     text += &format!("  sampled eig(Φ − Γ_BG):       {}\n", format_list(&fb.discrete_closed_loop));
                     text += &format!("  stable: {}\n", fb.stable());
+                    if !fb.stable() {
+                        // The run refuses it without --allow-unstable: design says so by its exit code.
+                        ok = false;
+                        text += "  the run refuses an unstable loop (pass --allow-unstable to run it anyway)\n";
+                    }
                     let mut matrices = json!({"G": rows(&fb.g), "N": rows(&fb.n)});
                     if let Some((gi, ct, m)) = &fb.integral {
                         matrices["G_xi"] = json!(rows(gi));

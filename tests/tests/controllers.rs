@@ -111,16 +111,16 @@ fn feedforward_cancels_a_matched_unknown_input_and_refuses_an_unmatched_one() {
     assert!((e_y - 0.5).abs() > 1e-3, "without feedforward e_y ends at {e_y}");
     // The shipped wind acts 0.3 m ahead of the centre of gravity: not through the steering.
     let path = s.join("unmatched.toml");
-    std::fs::write(&path, text.replace("integral = true", "feedforward = \"what\"")).unwrap();
+    std::fs::write(&path, matched.replace("E = [[0.0], [0.0006666666666666666], [0.0], [0.00048]]", "E = [[0.0], [0.0006666667], [0.0], [0.00012]]")).unwrap();
     let out = launcher(&s).arg("design").arg(&path).output().unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
+    let err = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("controller.feedforward") && err.contains("w1 does not enter through the inputs"), "{err}");
     // An observer without ŵ is refused too.
     let path = s.join("luenberger.toml");
     std::fs::write(&path, matched.replace("observer = \"uio\"", "observer = \"luenberger\"")).unwrap();
     let out = launcher(&s).arg("design").arg(&path).output().unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
+    let err = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("'luenberger' gives no estimate ŵ"), "{err}");
 }

@@ -35,6 +35,8 @@ fn design_reports_the_unstable_printed_gain() {
     let out = launcher(&s).args(["design", "--json"]).arg(scenario("seed000-printed-gain")).output().unwrap();
     let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(j["controller"]["stable"], false);
+    // The run would refuse it (without --allow-unstable): design exits as it would.
+    assert_eq!(out.status.code(), Some(2));
     let w = j["warnings"].as_array().unwrap();
     assert!(w.iter().any(|w| w.as_str().unwrap().contains("122.271")), "{w:?}");
 }
@@ -141,4 +143,19 @@ fn design_json_sampled_matrices_reproduce_the_recorded_estimates() {
         }
         assert!(worst < 1e-9, "{name}: replayed estimate differs by {worst:e}");
     }
+}
+
+/// `launcher design` exits non-zero whenever something the run needs cannot be designed: an
+/// observer whose condition fails, like a bank member or an unstable loop, and 0 otherwise.
+#[test]
+fn design_exits_non_zero_when_an_observer_fails() {
+    let s = Scratch::new("design-exit");
+    let failing = variant(&s, "rank", &[("C = [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]", "C = [[0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]"), ("E = [[2.0], [0.0], [0.5]]", "E = [[0.0], [0.0], [1.0]]")]);
+    for json in [false, true] {
+        let out = launcher(&s).arg("design").args(json.then_some("--json")).arg(&failing).output().unwrap();
+        assert_eq!(out.status.code(), Some(2), "{}", String::from_utf8_lossy(&out.stdout));
+        assert!(String::from_utf8_lossy(&out.stdout).contains("rank(CE) = rank(E)"));
+    }
+    let out = launcher(&s).arg("design").arg(scenario("seed002-sine")).output().unwrap();
+    assert_eq!(out.status.code(), Some(0));
 }
