@@ -20,7 +20,7 @@ use observer::{design, Designed, Spec};
 use crate::covariance::residual_covariance;
 use crate::evaluate::threshold_for;
 use crate::spec::{Channels, DiagnoserSpec, MemberKind, Scheme};
-use crate::structure::{reacts, FaultInput};
+use crate::structure::{reacts, steady_state, FaultInput, BLIND};
 
 /// One residual generator.
 #[derive(Debug, Clone)]
@@ -50,8 +50,14 @@ pub struct Bank {
     pub members: Vec<Member>,
     /// Computed structure matrix: `structure[i][j]` = 1 if residual i reacts to channel j.
     pub structure: Vec<Vec<u8>>,
-    /// Channel labels, e.g. "u1", "y3", "f2".
+    /// The steady-state structure: `steady[i][j]` = 1 if residual i stays away from 0 under a
+    /// constant fault on channel j ([`crate::structure::steady_state`]); `None` when a member's
+    /// state is not a function of x (its T cannot be formed).
+    pub steady: Option<Vec<Vec<u8>>>,
+    /// Labels of the channels it watches, e.g. "u1", "y3", "f2".
     pub channels: Vec<String>,
+    /// Their indices in their class (0-based): column j of the structure is channel `ids[j]`.
+    pub ids: Vec<usize>,
 }
 
 /// Why a bank cannot be had: the member (0-based) when one is to blame, and the reason.
@@ -77,6 +83,15 @@ pub fn channel_labels(channels: Channels, model: &Model, ff: &Mat) -> Vec<String
     }
 }
 
+/// The channels a bank watches: (indices in the class, labels) — every channel of the class, or
+/// its `channels = […]` subset.
+pub fn monitored(spec: &DiagnoserSpec, model: &Model, ff: &Mat) -> (Vec<usize>, Vec<String>) {
+    let all = channel_labels(spec.channels, model, ff);
+    let ids: Vec<usize> = spec.subset.clone().unwrap_or_else(|| (0..all.len()).collect());
+    let labels = ids.iter().map(|&j| all[j].clone()).collect();
+    (ids, labels)
+}
+
 /// What member i is blind to, in words: "blind to u2", "without y1", "on y3 alone".
 pub fn role(spec: &DiagnoserSpec, labels: &[String], i: usize) -> String {
     let others: Vec<&str> = labels.iter().enumerate().filter(|&(j, _)| j != i).map(|(_, l)| l.as_str()).collect();
@@ -90,10 +105,10 @@ pub fn role(spec: &DiagnoserSpec, labels: &[String], i: usize) -> String {
 
 /// Designs every member, computes the structure matrix and each member's threshold.
 pub fn design_bank(spec: &DiagnoserSpec, model: &Model, ff: &Mat, dt: f64, noise: NoiseCov) -> Result<Bank, BankError> {
-    let labels = channel_labels(spec.channels, model, ff);
+    let (ids, labels) = monitored(spec, model, ff);
     let m = labels.len();
     if m < 2 {
-        return Err(BankError { member: None, key: "faults", reason: format!("a bank needs at least two {} channels to isolate between, the plant has {m}", spec.channels.name()) });
+        return Err(BankError { member: None, key: "faults", reason: format!("a bank needs at least two {} channels to isolate between, it watches {m}", spec.channels.name()) });
     }
     let columns: Option<Mat> = match spec.channels {
         Channels::Actuator => Some(model.b.clone()),
@@ -104,9 +119,10 @@ pub fn design_bank(spec: &DiagnoserSpec, model: &Model, ff: &Mat, dt: f64, noise
     let p = model.p();
     let mut members = Vec::with_capacity(m);
     for i in 0..m {
+        // The watched channels member i must be blind to (indices in the class).
         let blind: Vec<usize> = match spec.scheme {
-            Scheme::Generalized => vec![i],
-            Scheme::Dedicated => (0..m).filter(|&j| j != i).collect(),
+            Scheme::Generalized => vec![ids[i]],
+            Scheme::Dedicated => ids.iter().copied().filter(|&j| j != ids[i]).collect(),
         };
         let (member_model, outputs) = match &columns {
             Some(cols) => {
@@ -140,9 +156,10 @@ pub fn design_bank(spec: &DiagnoserSpec, model: &Model, ff: &Mat, dt: f64, noise
         widen(&mut designed, &outputs, p);
         members.push(Member { name: format!("{}-{}", spec.name, i + 1), outputs, blind, designed, covariance: None, threshold: 0.0, dof: 0 });
     }
-    // The structure, from the designs: residual i against a step fault on channel j.
-    let inputs: Vec<FaultInput> = (0..m)
-        .map(|j| match &columns {
+    // The structure, from the designs: residual i against a fault on watched channel j.
+    let inputs: Vec<FaultInput> = ids
+        .iter()
+        .map(|&j| match &columns {
             Some(cols) => {
                 let (_, g) = lti::discretize::zoh(&model.a, &cols.columns(j, 1).into_owned(), dt);
                 FaultInput::State(DVector::from_column_slice(g.as_slice()))
@@ -153,6 +170,11 @@ pub fn design_bank(spec: &DiagnoserSpec, model: &Model, ff: &Mat, dt: f64, noise
     let structure: Vec<Vec<u8>> =
         members.iter().map(|mb| inputs.iter().map(|inp| u8::from(reacts(&dm.a, &dm.c, &mb.designed.runtime, &mb.outputs, inp))).collect()).collect();
     check_structure(spec, &structure, &labels)?;
+    // Under a constant fault: which residuals stay away from zero.
+    let steady: Option<Vec<Vec<u8>>> = members
+        .iter()
+        .map(|mb| inputs.iter().map(|inp| steady_state(&dm.a, &dm.c, &mb.designed.runtime, &mb.outputs, inp).map(|g| u8::from(g > BLIND))).collect::<Option<Vec<u8>>>())
+        .collect();
     for (i, mb) in members.iter_mut().enumerate() {
         if let Some((qd, r)) = noise {
             let cov = residual_covariance(&dm.a, &dm.c, &mb.designed.runtime, &mb.outputs, qd, r)
@@ -163,7 +185,31 @@ pub fn design_bank(spec: &DiagnoserSpec, model: &Model, ff: &Mat, dt: f64, noise
         mb.threshold = threshold;
         mb.dof = dof;
     }
-    Ok(Bank { spec: spec.clone(), members, structure, channels: labels })
+    Ok(Bank { spec: spec.clone(), members, structure, steady, channels: labels, ids })
+}
+
+/// Per watched channel whose constant fault only the transient reveals: "u1: residual 2 returns
+/// to 0 in steady state; a constant u1 fault is isolable only during transients".
+pub fn transient_only(bank: &Bank) -> Vec<String> {
+    let Some(steady) = &bank.steady else { return Vec::new() };
+    let mut out = Vec::new();
+    for (j, label) in bank.channels.iter().enumerate() {
+        let gone: Vec<String> = (0..bank.members.len()).filter(|&i| bank.structure[i][j] == 1 && steady[i][j] == 0).map(|i| (i + 1).to_string()).collect();
+        if gone.is_empty() {
+            continue;
+        }
+        let column: Vec<u8> = steady.iter().map(|r| r[j]).collect();
+        let consequence = if column.iter().all(|&v| v == 0) {
+            "it is detected and isolated only during transients (a bias or step leaves no residual once they settle)".to_string()
+        } else if let Some(k) = (0..bank.channels.len()).find(|&k| k != j && bank.structure.iter().map(|r| r[k]).eq(column.iter().copied())) {
+            format!("in steady state its signature is {}'s: isolable only during transients", bank.channels[k])
+        } else {
+            "in steady state its signature matches no channel (\"unknown\"): isolable only during transients".to_string()
+        };
+        let which = if gone.len() == 1 { format!("residual {} returns", gone[0]) } else { format!("residuals {} return", gone.join(", ")) };
+        out.push(format!("diagnoser '{}': {label} bias: {which} to 0 in steady state; {consequence}", bank.spec.name));
+    }
+    out
 }
 
 /// K and Q of a member reading `outputs` widened to all p outputs (zero columns elsewhere).

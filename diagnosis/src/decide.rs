@@ -14,7 +14,7 @@ use crate::evaluate::Evaluator;
 pub enum Isolation {
     /// No alarm.
     None,
-    /// The alarm pattern is channel j's signature (0-based).
+    /// The alarm pattern is channel j's signature (0-based index in its class: u_{j+1}, y_{j+1}…).
     Channel(usize),
     /// Alarms that match no single channel.
     Unknown,
@@ -38,8 +38,10 @@ pub struct Monitor {
     pub name: String,
     /// Its channel class.
     pub channels: crate::Channels,
-    /// Channel labels.
+    /// Labels of the channels it watches.
     pub labels: Vec<String>,
+    /// Their indices in the class (column j of the structure is channel `ids[j]`).
+    pub ids: Vec<usize>,
     /// The structure matrix.
     pub structure: Vec<Vec<u8>>,
     /// Index of each member among the run's observers.
@@ -74,6 +76,7 @@ impl Monitor {
             name: bank.spec.name.clone(),
             channels: bank.spec.channels,
             labels: bank.channels.clone(),
+            ids: bank.ids.clone(),
             structure: bank.structure.clone(),
             observers,
             outputs: bank.members.iter().map(|mb| mb.outputs.clone()).collect(),
@@ -109,6 +112,11 @@ impl Monitor {
         self.isolation = self.isolate();
     }
 
+    /// The label of channel `channel` (index in the class), if the bank watches it.
+    pub fn label(&self, channel: usize) -> Option<&str> {
+        self.ids.iter().position(|&j| j == channel).map(|j| self.labels[j].as_str())
+    }
+
     fn isolate(&self) -> Isolation {
         if !self.alarms.iter().any(|&a| a) {
             return Isolation::None;
@@ -116,7 +124,7 @@ impl Monitor {
         let m = self.labels.len();
         let matches: Vec<usize> = (0..m).filter(|&j| self.structure.iter().zip(&self.alarms).all(|(row, &a)| (row[j] == 1) == a)).collect();
         match matches.as_slice() {
-            [j] => Isolation::Channel(*j),
+            [j] => Isolation::Channel(self.ids[*j]),
             _ => Isolation::Unknown,
         }
     }

@@ -2,9 +2,15 @@
 //! as, and the false alarms.
 //!
 //! * A fault's window runs from its start to the next fault's start (or the end of the run). It
-//!   is detected at the first step of its window with an alarm of any bank, and isolated as the
-//!   first single channel a bank of its class names in its window; that is correct when it is
-//!   the fault's own channel.
+//!   is detected at the first step of its window with an alarm of any bank, and first isolated as
+//!   the first single channel a bank of its class names in its window (`first_isolation_correct`
+//!   when that is its own channel).
+//! * Isolation over time: every decided step of the window at which the fault acts is counted as
+//!   isolated correctly (a bank of its class names its channel), as another channel, as
+//!   "unknown" (alarms that match no single channel) or in no alarm. The fault is `correct` when
+//!   the correct share of its active time reaches the scenario's `isolated_fraction` (0.9 by
+//!   default): a residual that returns to zero under a bias (a UIO's, in steady state) leaves the
+//!   fault unisolated for most of its time, however right its first alarm was.
 //! * Fault-free steps are those before the first fault starts (all of them in a run without
 //!   faults) from the bank's first decided step on. An alarm there is false; `false_alarms` counts
 //!   the episodes (an alarm switching on), `false_alarm_steps` the steps.
@@ -27,6 +33,8 @@ pub struct FaultInfo {
     pub channel: usize,
     /// When it first acts, s.
     pub start: f64,
+    /// The [on, off) steps it acts in (off = u64::MAX for no end).
+    pub active: Vec<(u64, u64)>,
 }
 
 /// One fault's figures.
@@ -44,7 +52,21 @@ pub struct FaultFigure {
     pub isolated_as: Option<String>,
     /// When the isolation was made, s.
     pub isolated_at: Option<f64>,
-    /// Whether it named the fault's own channel.
+    /// Whether that first isolation named the fault's own channel.
+    pub first_isolation_correct: bool,
+    /// Decided time in its window while it acted, s.
+    pub active_time: f64,
+    /// Of which isolated as its own channel, s.
+    pub isolated_correctly_time: f64,
+    /// … isolated as another channel, s.
+    pub isolated_otherwise_time: f64,
+    /// … in alarm matching no single channel ("unknown"), s.
+    pub unknown_time: f64,
+    /// … in no alarm, s.
+    pub no_alarm_time: f64,
+    /// isolated_correctly_time / active_time.
+    pub isolated_fraction: Option<f64>,
+    /// Whether isolated_fraction reached the scenario's `isolated_fraction`.
     pub correct: bool,
 }
 
@@ -76,16 +98,31 @@ pub struct Diagnosis {
     pub false_alarm_steps: u64,
     /// Fault-free time decided, s.
     pub fault_free_time: f64,
+    /// The share of its active time a fault must be isolated correctly for to be `correct`.
+    pub required_fraction: f64,
     /// Per injected fault, in start order.
     pub faults: Vec<FaultFigure>,
     /// Per residual.
     pub residuals: Vec<ResidualFigure>,
 }
 
+/// How one active, decided step of a fault was isolated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Verdict {
+    Correct,
+    Otherwise,
+    Unknown,
+    NoAlarm,
+}
+
 /// Accumulates the figures step by step.
 #[derive(Debug, Clone)]
 pub struct Judge {
     dt: f64,
+    /// The share of a fault's active time it must be isolated correctly for to count as correct.
+    fraction: f64,
+    /// Per fault: steps counted as [correct, otherwise, unknown, no alarm].
+    verdicts: Vec<[u64; 4]>,
     faults: Vec<FaultInfo>,
     /// [start, end) step of each fault's window.
     windows: Vec<(u64, u64)>,
@@ -102,17 +139,35 @@ pub struct Judge {
 }
 
 impl Judge {
-    /// For a run with these faults and monitors.
-    pub fn new(mut faults: Vec<FaultInfo>, monitors: &[Monitor], dt: f64) -> Self {
+    /// For a run with these faults and monitors; a fault counts as correctly isolated when it is
+    /// for at least `fraction` of its active time.
+    pub fn new(mut faults: Vec<FaultInfo>, monitors: &[Monitor], dt: f64, fraction: f64) -> Self {
         faults.sort_by(|a, b| a.start.total_cmp(&b.start));
         let starts: Vec<u64> = faults.iter().map(|f| lti::signal::first_sample_from(f.start, dt)).collect();
         let windows = starts.iter().map(|&s| (s, starts.iter().copied().filter(|&t| t > s).min().unwrap_or(u64::MAX))).collect();
         let figures = faults
             .iter()
-            .map(|f| FaultFigure { name: f.name.clone(), start: f.start, detected_at: None, delay: None, isolated_as: None, isolated_at: None, correct: false })
+            .map(|f| FaultFigure {
+                name: f.name.clone(),
+                start: f.start,
+                detected_at: None,
+                delay: None,
+                isolated_as: None,
+                isolated_at: None,
+                first_isolation_correct: false,
+                active_time: 0.0,
+                isolated_correctly_time: 0.0,
+                isolated_otherwise_time: 0.0,
+                unknown_time: 0.0,
+                no_alarm_time: 0.0,
+                isolated_fraction: None,
+                correct: false,
+            })
             .collect();
         Judge {
             dt,
+            fraction,
+            verdicts: vec![[0; 4]; faults.len()],
             first_fault: starts.first().copied().unwrap_or(u64::MAX),
             faults,
             windows,
@@ -162,22 +217,37 @@ impl Judge {
                 fig.detected_at = Some(t);
                 fig.delay = Some(t - f.start);
             }
+            let ours = || monitors.iter().filter(|m| m.channels == f.channels);
             if fig.isolated_as.is_none() {
-                for m in monitors.iter().filter(|m| m.channels == f.channels) {
+                for m in ours() {
                     if let Isolation::Channel(j) = m.isolation {
                         // Name the fault on that channel: this one if it is, else another fault
                         // of the run there, else the channel itself.
                         let named = if j == f.channel {
                             f.name.clone()
                         } else {
-                            self.faults.iter().find(|g| g.channels == m.channels && g.channel == j).map_or_else(|| m.labels[j].clone(), |g| g.name.clone())
+                            self.faults.iter().find(|g| g.channels == m.channels && g.channel == j).map_or_else(|| m.label(j).unwrap_or("?").to_string(), |g| g.name.clone())
                         };
                         fig.isolated_as = Some(named);
                         fig.isolated_at = Some(t);
-                        fig.correct = j == f.channel;
+                        fig.first_isolation_correct = j == f.channel;
                         break;
                     }
                 }
+            }
+            // Isolation over the fault's active, decided time: the best any bank of its class says.
+            let decided = ours().any(|m| k >= m.start_step);
+            if decided && f.active.iter().any(|&(on, off)| k >= on && k < off) {
+                let verdict = ours()
+                    .map(|m| match m.isolation {
+                        Isolation::Channel(j) if j == f.channel => Verdict::Correct,
+                        Isolation::Channel(_) => Verdict::Otherwise,
+                        Isolation::Unknown => Verdict::Unknown,
+                        Isolation::None => Verdict::NoAlarm,
+                    })
+                    .min_by_key(|v| *v as u8)
+                    .unwrap_or(Verdict::NoAlarm);
+                self.verdicts[i][verdict as usize] += 1;
             }
         }
     }
@@ -200,11 +270,23 @@ impl Judge {
                 })
             })
             .collect();
+        let mut faults = self.figures;
+        for (fig, v) in faults.iter_mut().zip(&self.verdicts) {
+            let steps: u64 = v.iter().sum();
+            fig.active_time = steps as f64 * self.dt;
+            fig.isolated_correctly_time = v[0] as f64 * self.dt;
+            fig.isolated_otherwise_time = v[1] as f64 * self.dt;
+            fig.unknown_time = v[2] as f64 * self.dt;
+            fig.no_alarm_time = v[3] as f64 * self.dt;
+            fig.isolated_fraction = (steps > 0).then(|| v[0] as f64 / steps as f64);
+            fig.correct = fig.isolated_fraction.is_some_and(|x| x >= self.fraction);
+        }
         Diagnosis {
             false_alarms: self.false_alarms,
             false_alarm_steps: self.false_alarm_steps,
             fault_free_time: self.fault_free_steps as f64 * self.dt,
-            faults: self.figures,
+            required_fraction: self.fraction,
+            faults,
             residuals,
         }
     }

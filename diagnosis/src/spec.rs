@@ -91,6 +91,8 @@ pub struct DiagnoserSpec {
     pub scheme: Scheme,
     /// What it watches.
     pub channels: Channels,
+    /// The channels of its class it watches (0-based, ascending), when not all of them.
+    pub subset: Option<Vec<usize>>,
     /// The members' design.
     pub member: MemberKind,
     /// The structure matrix asked for (rows: residuals, columns: channels), if given.

@@ -69,6 +69,46 @@ pub fn sensitivity(phi: &Mat, c: &Mat, obs: &LinearObserver, outputs: &[usize], 
     worst
 }
 
+/// The relative steady-state response of the residual to a constant fault: ≈ ε when it returns
+/// to zero once the transient has passed (a UIO member's residual under a sensor bias, say),
+/// O(1e-3 … 1) when it stays; `None` when it cannot be formed.
+///
+/// The observer's state tracks z → Tx, with T from its unbiased output map PT + QC = I
+/// (T = P⁺(I − QC), P of full column rank) and checked against TΦ − FT = KC. Then ζ = z − Tx
+/// obeys ζ_{k+1} = Fζ_k + b φ_k and r = D_f φ − SCP ζ, whatever the plant does (its modes cancel,
+/// even an integrator's), so the DC gain of the fault-to-residual transfer is
+///
+/// ```text
+/// r_ss = D_f − SCP (I − F)⁻¹ b,      b = −Tγ (through the state)  or  K e_j (on output j).
+/// ```
+///
+/// It is measured relative to ‖D_f‖ + ‖SCP‖‖(I − F)⁻¹‖‖b‖ (with ‖T‖‖γ‖ for ‖Tγ‖), the size the
+/// terms that form it would have without cancellation.
+pub fn steady_state(phi: &Mat, c: &Mat, obs: &LinearObserver, outputs: &[usize], input: &FaultInput) -> Option<f64> {
+    let Residual { f, k, p, q, s, i_cq, cp } = Residual::new(c, obs, outputs);
+    let n = phi.nrows();
+    let t = lti::pinv::pinv(&p) * (Mat::identity(n, n) - &q * c);
+    // T must make z an estimate of Tx: TΦ − FT = KC (and PT + QC = I).
+    let sylvester = (&t * phi - &f * &t - &k * c).norm();
+    let unbiased = (&p * &t + &q * c - Mat::identity(n, n)).norm();
+    let scale = (t.norm() * (phi.norm() + f.norm()) + k.norm() * c.norm()).max(1.0);
+    if sylvester > 1e-8 * scale || unbiased > 1e-8 * (1.0 + p.norm() * t.norm()) {
+        return None;
+    }
+    let r = f.nrows();
+    let resolvent = (Mat::identity(r, r) - &f).try_inverse()?;
+    let (b, b_scale, direct) = match input {
+        FaultInput::State(g) => (-(&t * g), t.norm() * g.norm(), DVector::zeros(outputs.len())),
+        FaultInput::Output(j) => (k.column(*j).into_owned(), k.column(*j).norm(), &s * i_cq.column(*j)),
+    };
+    let scp = &s * &cp;
+    let through = &scp * (&resolvent * &b);
+    let rss = &direct - &through;
+    // The size the response would have if nothing cancelled (a decoupled Tγ is rounding of ‖T‖‖γ‖).
+    let size = direct.norm() + scp.norm() * resolvent.norm() * b_scale;
+    Some(if size > 0.0 { rss.norm() / size } else { 0.0 })
+}
+
 /// Whether the residual reacts to the fault.
 pub fn reacts(phi: &Mat, c: &Mat, obs: &LinearObserver, outputs: &[usize], input: &FaultInput) -> bool {
     sensitivity(phi, c, obs, outputs, input) > BLIND

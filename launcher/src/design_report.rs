@@ -248,14 +248,23 @@ fn banks_report(s: &Scenario, banks: &Result<Vec<diagnosis::Bank>, crate::plan::
                         "sampled": sampled_json(&m.designed.runtime, s.dt),
                     }));
                 }
-                text += &format!("  structure (rows: residuals, columns: {}):\n", b.channels.join(", "));
+                text += &format!("  structure, transient (rows: residuals, columns: {}):\n", b.channels.join(", "));
                 for (i, r) in b.structure.iter().enumerate() {
                     text += &format!("    r{} {:?}\n", i + 1, r);
                 }
                 if d.structure.is_some() {
                     text += "  equals the structure asked for\n";
                 }
-                out.push(json!({ "name": d.name, "scheme": d.scheme.name(), "faults": d.channels.name(), "channels": b.channels, "structure": b.structure, "members": members }));
+                match &b.steady {
+                    Some(st) => {
+                        text += &format!("  steady-state structure under a constant fault (rows: residuals, columns: {}):\n", b.channels.join(", "));
+                        for (i, r) in st.iter().enumerate() {
+                            text += &format!("    r{} {:?}\n", i + 1, r);
+                        }
+                    }
+                    None => text += "  steady-state structure: not computed (a member's state is not a function of the plant's)\n",
+                }
+                out.push(json!({ "name": d.name, "scheme": d.scheme.name(), "faults": d.channels.name(), "channels": b.channels, "structure": b.structure, "steady_state_structure": b.steady, "members": members }));
             }
             (text, out, true)
         }

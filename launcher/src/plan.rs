@@ -100,7 +100,7 @@ pub fn complete(s: &Scenario, banks: Vec<Bank>, own: Vec<Option<Designed>>) -> R
         }
         None => None,
     };
-    let warnings = warnings(s, &observers, feedback.as_ref());
+    let warnings = warnings(s, &observers, feedback.as_ref(), &banks);
     Ok(Plan { observers, feedback, banks, warnings })
 }
 
@@ -138,7 +138,7 @@ pub fn banks(s: &Scenario) -> Result<Vec<Bank>, PlanError> {
 }
 
 /// dt too coarse for the fastest pole, an unstable loop, and the like.
-fn warnings(s: &Scenario, observers: &[(String, Option<Designed>)], feedback: Option<&FeedbackDesign>) -> Vec<String> {
+fn warnings(s: &Scenario, observers: &[(String, Option<Designed>)], feedback: Option<&FeedbackDesign>, banks: &[Bank]) -> Vec<String> {
     let observers: Vec<(&String, &Designed)> = observers.iter().filter_map(|(n, d)| d.as_ref().map(|d| (n, d))).collect();
     let mut out = Vec::new();
     let fastest = |ev: &[C64]| ev.iter().map(|z| z.norm()).fold(0.0, f64::max);
@@ -181,6 +181,10 @@ fn warnings(s: &Scenario, observers: &[(String, Option<Designed>)], feedback: Op
             "diagnoser '{}': its {kind} members do not decouple the unknown inputs: with E ≠ 0 and a non-zero disturbance, w drives every residual and can raise alarms no fault caused (a bank of chen-patton-uio members decouples w)",
             d.name
         ));
+    }
+    // A bias that a bank's residuals forget once the transient has passed.
+    for b in banks {
+        out.extend(diagnosis::bank::transient_only(b));
     }
     for (name, d) in &observers {
         if !d.report.fixed_modes.is_empty() {

@@ -207,6 +207,10 @@ impl Summary {
             let wrong = d.map(|d| d.faults.iter().filter(|f| !f.correct).count() as f64);
             add("faults_not_isolated_correctly".into(), 0.0, wrong);
         }
+        if e.first_isolation_correct == Some(true) {
+            let wrong = d.map(|d| d.faults.iter().filter(|f| !f.first_isolation_correct).count() as f64);
+            add("faults_first_isolated_wrongly".into(), 0.0, wrong);
+        }
         if let Some(limit) = e.false_alarms {
             add("false_alarms".into(), limit as f64, d.map(|d| d.false_alarms as f64));
         }
@@ -271,12 +275,23 @@ impl Summary {
             for f in &d.faults {
                 let at = |v: Option<f64>| v.map_or_else(|| "—".to_string(), |v| format!("{v:.4} s"));
                 t += &format!(
-                    "    {:<20} start {:>9}  detected {:>11}  isolated as {:<16} {}\n",
+                    "    {:<20} start {:>9}  detected {:>11}  first isolated as {:<16} {}\n",
                     f.name,
                     format!("{} s", f.start),
                     at(f.detected_at),
                     f.isolated_as.as_deref().unwrap_or("—"),
-                    if f.correct { "correct" } else { "WRONG" }
+                    if f.isolated_as.is_none() { "" } else if f.first_isolation_correct { "(right)" } else { "(wrong)" }
+                );
+                let pct = |x: f64| if f.active_time > 0.0 { format!("{:.1} %", 100.0 * x / f.active_time) } else { "—".into() };
+                t += &format!(
+                    "    {:<20} over its {} s: isolated correctly {}, as another channel {}, unknown {}, no alarm {}: {}\n",
+                    "",
+                    sig(f.active_time),
+                    pct(f.isolated_correctly_time),
+                    pct(f.isolated_otherwise_time),
+                    pct(f.unknown_time),
+                    pct(f.no_alarm_time),
+                    if f.correct { "correct".to_string() } else { format!("NOT isolated (needs ≥ {} % of its time)", sig(100.0 * d.required_fraction)) }
                 );
             }
         }

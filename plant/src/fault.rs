@@ -100,6 +100,14 @@ impl Fault {
     }
 }
 
+impl Fault {
+    /// The [k_on, k_off) steps it acts in, on the grid of dt (k_off = u64::MAX for no end).
+    pub fn active_steps(&self, dt: f64) -> Vec<(u64, u64)> {
+        let sample_of = |t: f64| lti::signal::first_sample_from(t, dt);
+        self.profile.intervals().iter().map(|i| (sample_of(i[0]), sample_of(i[1]))).collect()
+    }
+}
+
 /// A fault on the sample grid: its active steps and magnitude per step.
 #[derive(Debug, Clone)]
 pub(crate) struct Scheduled {
@@ -115,7 +123,7 @@ impl Scheduled {
     pub fn new(fault: &Fault, dt: f64) -> Self {
         // Validation puts every time on a sample (a time between would take effect at the next).
         let sample_of = |t: f64| lti::signal::first_sample_from(t, dt);
-        let steps = fault.profile.intervals().iter().map(|i| (sample_of(i[0]), sample_of(i[1]))).collect();
+        let steps = fault.active_steps(dt);
         let ramp = matches!(fault.profile, Profile::Ramp { .. }) || fault.kind == Kind::Drift;
         Scheduled { fault: fault.clone(), steps, k0: sample_of(fault.profile.start()), ramp }
     }

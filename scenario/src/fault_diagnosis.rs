@@ -191,7 +191,28 @@ pub(crate) fn diagnosers(raw: &[RawDiagnoser], model: &Model, ff: &Mat, noise: O
             "component" => Channels::Component,
             other => return Err(bad(at("faults"), format!("{} is not a channel class (actuator, sensor, component){}", quoted(other), crate::suggest::did_you_mean(other, ["actuator", "sensor", "component"])))),
         };
-        let m = diagnosis::bank::channel_labels(channels, model, ff).len();
+        let all = diagnosis::bank::channel_labels(channels, model, ff);
+        let subset = match &d.channels {
+            None => None,
+            Some(list) => {
+                let mut ids = Vec::with_capacity(list.len());
+                for &c in list {
+                    if c < 1 || c as usize > all.len() {
+                        return Err(bad(at("channels"), format!("{c} is not a {} channel: they are 1 … {} ({})", channels.name(), all.len(), all.join(", "))));
+                    }
+                    if ids.contains(&(c as usize - 1)) {
+                        return Err(bad(at("channels"), format!("{c} is listed twice")));
+                    }
+                    ids.push(c as usize - 1);
+                }
+                if ids.len() < 2 {
+                    return Err(bad(at("channels"), format!("a bank needs at least two channels to isolate between, {} given", ids.len())));
+                }
+                ids.sort_unstable();
+                Some(ids)
+            }
+        };
+        let m = subset.as_ref().map_or(all.len(), Vec::len);
         // The members' observer names must be free, and short enough to be names themselves.
         for j in 1..=m {
             let member = format!("{}-{j}", d.name);
@@ -319,7 +340,7 @@ pub(crate) fn diagnosers(raw: &[RawDiagnoser], model: &Model, ff: &Mat, noise: O
         if ignore_before < 0.0 {
             return Err(bad(at("ignore_before"), format!("{ignore_before} must be ≥ 0")));
         }
-        out.push(DiagnoserSpec { name: d.name.clone(), scheme, channels, member, structure, evaluation, threshold, persistence: persistence.min(u32::MAX as i64) as u32, ignore_before });
+        out.push(DiagnoserSpec { name: d.name.clone(), scheme, channels, subset, member, structure, evaluation, threshold, persistence: persistence.min(u32::MAX as i64) as u32, ignore_before });
     }
     Ok(out)
 }

@@ -77,6 +77,9 @@ pub struct Scenario {
     pub ff: Mat,
     /// Injected faults.
     pub faults: Vec<plant::Fault>,
+    /// The share of a fault's active time it must be isolated correctly for to count as
+    /// isolated (`isolated_fraction`, default 0.9).
+    pub isolated_fraction: f64,
     /// Banks of residual generators.
     pub diagnosers: Vec<diagnosis::DiagnoserSpec>,
 }

@@ -65,6 +65,9 @@ pub struct RawScenario {
     pub fault: Vec<RawFault>,
     #[serde(default)]
     pub diagnoser: Vec<RawDiagnoser>,
+    /// The share of a fault's active time it must be isolated correctly for to count as
+    /// isolated (default 0.9).
+    pub isolated_fraction: Option<f64>,
     /// Host name → its agent's Zenoh endpoint.
     pub hosts: Option<BTreeMap<String, String>>,
 }
@@ -114,6 +117,8 @@ pub struct RawDiagnoser {
     pub name: String,
     pub scheme: String,
     pub faults: String,
+    /// The channels of the class it watches (1-based), when not all.
+    pub channels: Option<Vec<i64>>,
     pub observer: Option<String>,
     pub poles: Option<Vec<RawPole>>,
     pub placement: Option<String>,
@@ -278,8 +283,11 @@ pub struct RawExpect {
     /// Upper bound on each named fault's detection delay, s.
     #[serde(default)]
     pub detection_delay: BTreeMap<String, f64>,
-    /// Every injected fault correctly isolated.
+    /// Every injected fault correctly isolated (for the scenario's `isolated_fraction` of its
+    /// active time).
     pub correct_isolation: Option<bool>,
+    /// Every injected fault's first isolation names its channel.
+    pub first_isolation_correct: Option<bool>,
     /// Upper bound on the false-alarm episodes.
     pub false_alarms: Option<u64>,
 }

@@ -351,11 +351,16 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
             ObserverEntry { name: o.name.clone(), spec: Some(observer_spec(&f, o, &model, noise.as_ref())?), process: None, member: None, xhat0 }
         });
     }
+    let isolated_fraction = match raw.isolated_fraction {
+        None => 0.9,
+        Some(x) if x.is_finite() && x > 0.0 && x <= 1.0 => x,
+        Some(x) => return Err(bad("isolated_fraction", format!("{x} must be a share of the fault's time, 0 < x ≤ 1"))),
+    };
     let mut taken = seen.clone();
     let diagnosers = super::fault_diagnosis::diagnosers(&raw.diagnoser, &model, &ff, noise.as_ref(), &mut taken)?;
     // Each bank member runs as an observer of its own, after the scenario's observers.
     for (di, d) in diagnosers.iter().enumerate() {
-        for j in 0..diagnosis::bank::channel_labels(d.channels, &model, &ff).len() {
+        for j in 0..diagnosis::bank::monitored(d, &model, &ff).0.len() {
             observers.push(ObserverEntry { name: format!("{}-{}", d.name, j + 1), spec: None, process: None, member: Some((di, j)), xhat0: None });
         }
     }
@@ -374,7 +379,7 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
             return Err(bad(f, format!("{v} must be a finite number > 0")));
         }
     }
-    let judged = !expect.detection_delay.is_empty() || expect.correct_isolation.is_some() || expect.false_alarms.is_some();
+    let judged = !expect.detection_delay.is_empty() || expect.correct_isolation.is_some() || expect.first_isolation_correct.is_some() || expect.false_alarms.is_some();
     if judged && diagnosers.is_empty() {
         return Err(bad("expect", "detection, isolation and false alarms are judged by a [[diagnoser]]; the scenario has none"));
     }
@@ -400,6 +405,7 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
         expect,
         source: String::new(),
         seed: raw.seed.unwrap_or(0),
+        isolated_fraction,
         noise,
         ff,
         faults,

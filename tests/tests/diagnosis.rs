@@ -85,6 +85,10 @@ fn bad_fault_noise_and_diagnoser_input_exits_2_naming_file_and_field() {
         ("seed002-actuator-faults", "evaluation = \"chi2\"", "evaluation = \"rms\"\nwindow = -5", "diagnoser[1].window", "-5 must be a whole number of samples ≥ 1"),
         ("seed002-actuator-faults", "start = 5.0", "start = 5.0005", "fault[1].start", "is not a sample time"),
         ("seed003-sensor-faults", "kind = \"drift\"", "kind = \"gain\"", "fault[2].kind", "is not a kind of sensor fault"),
+        ("seed003-sensor-faults", "kind = \"drift\"", "kind = \"drfit\"", "fault[2].kind", "(did you mean 'drift'?)"),
+        ("seed003-sensor-faults", "scheme = \"generalized\"", "scheme = \"generalized\"\nchannels = [1, 4]", "diagnoser[1].channels", "4 is not a sensor channel: they are 1 … 3 (y1, y2, y3)"),
+        ("seed003-sensor-faults", "scheme = \"generalized\"", "scheme = \"generalized\"\nchannels = [2, 2]", "diagnoser[1].channels", "2 is listed twice"),
+        ("seed003-sensor-faults", "scheme = \"generalized\"", "scheme = \"generalized\"\nchannels = [2]", "diagnoser[1].channels", "at least two channels"),
         ("seed002-fault-free", "[[observer]]\nname = \"kalman\"", "[[fault]]\nname = \"x\"\ntarget = \"component\"\nchannel = 1\nkind = \"additive\"\nvalue = 1.0\nstart = 1.0\n\n[[observer]]\nname = \"kalman\"", "fault[1].channel", "0 columns of plant.Ff"),
     ];
     for (name, from, to, field, reason) in cases {
@@ -166,7 +170,7 @@ fn sweep(name: &str, runs: usize, jobs: usize) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
 }
 
-/// 200 noisy realisations of each fault scenario: every fault detected and correctly isolated,
+/// 200 noisy realisations of each fault scenario: every fault detected and first isolated right,
 /// a false-alarm rate reported, and every χ² threshold's measured exceedance probability within
 /// a factor 2 of the one asked for. The fault-free scenario's 11 600 s make that sharp.
 #[test]
@@ -176,7 +180,18 @@ fn monte_carlo_of_200_runs_detects_isolates_and_keeps_the_asked_false_alarm_prob
         assert_eq!(sw["runs"], 200);
         for f in sw["faults"].as_array().unwrap() {
             assert_eq!(f["detected"], 200, "{name}: {f}");
-            assert_eq!(f["isolation_accuracy"], 1.0, "{name}: {f}");
+            assert_eq!(f["first_isolation_correct"], 200, "{name}: {f}");
+            // `isolation_accuracy` counts the realisations isolated for ≥ 90 % of the fault's
+            // time: the actuator bank holds its isolation; the sensor bank's Luenberger residuals
+            // settle under the χ² threshold, so its faults are isolated right but only briefly.
+            let share = &f["isolated_fraction"];
+            if name == "seed002-actuator-faults" {
+                assert_eq!(f["isolation_accuracy"], 1.0, "{name}: {f}");
+                assert!(share["min"].as_f64().unwrap() >= 0.9, "{name}: {f}");
+            } else {
+                assert_eq!(f["isolation_accuracy"], 0.0, "{name}: {f}");
+                assert!(share["max"].as_f64().unwrap() < 0.9, "{name}: {f}");
+            }
         }
         assert!(sw["false_alarm_rate_per_hour"].is_number(), "{name}");
         for r in sw["residuals"].as_array().unwrap() {
@@ -271,4 +286,115 @@ fn non_decoupling_bank_under_a_disturbance_is_warned() {
     assert!(done.status.code().is_some(), "{}", String::from_utf8_lossy(&done.stderr));
     let warnings = summary(&s, "seed003-sensor-faults")["warnings"].to_string();
     assert!(warnings.contains("do not decouple the unknown inputs"), "summary.json's warnings: {warnings}");
+}
+
+/// Issue 21: isolation over the whole fault. The camera-offset bias through a bank of UIOs is
+/// isolated at its first alarm, then its residual 2 returns to zero and the pattern matches no
+/// channel: `launcher design` warns that y1 (and y2) are isolable only during transients, and
+/// the summary's shares of the fault's time — isolated correctly, as another channel, unknown, no
+/// alarm — equal those counted from the recorded isolation signal, for the bias and for the
+/// look-ahead drift (a ramp) alike; `correct` holds only for a share ≥ `isolated_fraction`.
+#[test]
+fn isolation_is_judged_over_the_whole_fault_and_transient_isolability_is_warned() {
+    let s = Scratch::new("iso-time");
+    let path = scenario("vehicle-camera-bias");
+    let out = launcher(&s).args(["design", "--json"]).arg(&path).output().unwrap();
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let bank = &j["diagnosers"][0];
+    assert_eq!(bank["structure"][1][0], 1, "{bank}");
+    assert_eq!(bank["steady_state_structure"][1][0], 0, "residual 2 forgets a y1 bias: {bank}");
+    assert_eq!(bank["steady_state_structure"][2][0], 1, "{bank}");
+    let warned = j["warnings"].as_array().unwrap().iter().filter_map(|w| w.as_str()).any(|w| w.contains("y1 bias: residual 2 returns to 0 in steady state") && w.contains("isolable only during transients"));
+    assert!(warned, "{}", j["warnings"]);
+
+    for fraction in [None, Some(0.08)] {
+        let text = std::fs::read_to_string(&path).unwrap();
+        let file = s.join("scenario.toml");
+        std::fs::write(&file, match fraction {
+            Some(x) => format!("isolated_fraction = {x}\n{text}"),
+            None => text,
+        })
+        .unwrap();
+        let dir = s.join(&format!("out-{fraction:?}"));
+        let out = launcher(&s).args(["run", "--mode", "in-process", "--out"]).arg(&dir).arg(&file).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let sum: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("vehicle-camera-bias.summary.json")).unwrap()).unwrap();
+        let sc = scenario::Scenario::parse(&file, &std::fs::read_to_string(&file).unwrap()).unwrap();
+        let rec = recording::read::read(&dir.join("vehicle-camera-bias.rrd")).unwrap();
+        let iso = &rec.series["/diagnosis/cams/isolated"];
+        let start_step = (sc.diagnosers[0].ignore_before / sc.dt).round() as i64;
+        let mut starts: Vec<f64> = sc.faults.iter().map(|f| f.profile.start()).collect();
+        starts.sort_by(f64::total_cmp);
+        for f in &sc.faults {
+            let channel = match f.target {
+                plant::fault::Target::Sensor(j) => j as f64 + 1.0,
+                _ => unreachable!(),
+            };
+            let next = starts.iter().copied().find(|&t| t > f.profile.start()).map_or(i64::MAX, |t| (t / sc.dt).round() as i64);
+            let active = f.active_steps(sc.dt);
+            // [correct, another channel, unknown, no alarm], counted from the recording.
+            let mut counts = [0u64; 4];
+            let mut first: Option<(i64, f64)> = None;
+            for (&k, &code) in iso.steps.iter().zip(&iso.values) {
+                let from = (f.profile.start() / sc.dt).round() as i64;
+                if k < from || k >= next {
+                    continue;
+                }
+                if first.is_none() && code > 0.0 {
+                    first = Some((k, code));
+                }
+                let on = active.iter().any(|&(a, b)| (k as u64) >= a && (k as u64) < b);
+                if !on || k < start_step {
+                    continue;
+                }
+                let c = if code == channel { 0 } else if code > 0.0 { 1 } else if code < 0.0 { 2 } else { 3 };
+                counts[c] += 1;
+            }
+            let fig = sum["diagnosis"]["faults"].as_array().unwrap().iter().find(|x| x["name"] == f.name.as_str()).unwrap();
+            let steps = |key: &str| (fig[key].as_f64().unwrap() / sc.dt).round() as u64;
+            let got = [steps("isolated_correctly_time"), steps("isolated_otherwise_time"), steps("unknown_time"), steps("no_alarm_time")];
+            assert_eq!(got, counts, "{}: summary vs recording", f.name);
+            let total: u64 = counts.iter().sum();
+            let share = counts[0] as f64 / total as f64;
+            assert_eq!(fig["isolated_fraction"].as_f64().unwrap(), share, "{}", f.name);
+            assert_eq!(fig["correct"].as_bool().unwrap(), share >= fraction.unwrap_or(0.9), "{}", f.name);
+            let (k, code) = first.expect("isolated at some step");
+            assert_eq!(fig["isolated_at"].as_f64().unwrap(), k as f64 * sc.dt);
+            assert_eq!(fig["first_isolation_correct"].as_bool().unwrap(), code == channel);
+        }
+        // The bias: right at first, then "unknown" for most of its 6 s.
+        let bias = &sum["diagnosis"]["faults"][0];
+        assert!(bias["first_isolation_correct"].as_bool().unwrap() && bias["unknown_time"].as_f64().unwrap() > 4.0, "{bias}");
+        assert_eq!(bias["correct"].as_bool().unwrap(), fraction.is_some(), "{bias}");
+    }
+}
+
+/// A bank over a subset of the channels (`channels = [1, 3]`): members for y1 and y3 only, the
+/// structure over those two, and the pitch-rate bias on y3 isolated as y3 (recorded as 3, the
+/// channel's own number), in both modes alike; the structure asked for, over the subset, is
+/// checked as before.
+#[test]
+fn a_bank_over_chosen_channels_isolates_among_them() {
+    let s = Scratch::new("subset");
+    let p = edited(&s, "seed003-sensor-faults", "structure = [[0, 1, 1], [1, 0, 1], [1, 1, 0]]", "channels = [1, 3]\nstructure = [[0, 1], [1, 0]]");
+    let out = launcher(&s).args(["design", "--json"]).arg(&p).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stdout));
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let bank = &j["diagnosers"][0];
+    assert_eq!(bank["channels"], serde_json::json!(["y1", "y3"]));
+    assert_eq!(bank["members"].as_array().unwrap().len(), 2);
+    let mut recs = Vec::new();
+    for mode in ["in-process", "processes"] {
+        let dir = s.join(mode);
+        let out = launcher(&s).args(["run", "--mode", mode, "--out"]).arg(&dir).arg(&p).output().unwrap();
+        assert!(out.status.success(), "{mode}: {}", String::from_utf8_lossy(&out.stderr));
+        let sum: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("seed003-sensor-faults.summary.json")).unwrap()).unwrap();
+        let bias = sum["diagnosis"]["faults"].as_array().unwrap().iter().find(|f| f["name"] == "pitch-rate-bias").unwrap().clone();
+        assert_eq!(bias["isolated_as"], "pitch-rate-bias", "{bias}");
+        let r = recording::read::read(&dir.join("seed003-sensor-faults.rrd")).unwrap();
+        assert!(r.series["/diagnosis/gos/isolated"].values.contains(&3.0));
+        assert!(r.series.contains_key("/diagnosis/gos/evaluation/2") && !r.series.contains_key("/diagnosis/gos/evaluation/3"));
+        recs.push(r.series["/diagnosis/gos/isolated"].clone());
+    }
+    assert_eq!(recs[0], recs[1]);
 }

@@ -136,7 +136,7 @@ fn fault_infos(s: &Scenario) -> Vec<FaultInfo> {
                 Target::Sensor(j) => (diagnosis::Channels::Sensor, j),
                 Target::Component(j) => (diagnosis::Channels::Component, j),
             };
-            FaultInfo { name: f.name.clone(), channels, channel, start: f.profile.start() }
+            FaultInfo { name: f.name.clone(), channels, channel, start: f.profile.start(), active: f.active_steps(s.dt) }
         })
         .collect()
 }
@@ -181,7 +181,7 @@ impl Session {
                 Monitor::new(b, index, s.dt)
             })
             .collect();
-        let judge = (!banks.is_empty()).then(|| Judge::new(fault_infos(s), &monitors, s.dt));
+        let judge = (!banks.is_empty()).then(|| Judge::new(fault_infos(s), &monitors, s.dt, s.isolated_fraction));
         let controller_observer = s.controller.as_ref().and_then(|c| s.observers.iter().position(|o| o.name == c.observer));
         let hops = hop_names(s);
         let sink = match rrd {

@@ -56,10 +56,15 @@ pub struct FaultSweep {
     pub detected: usize,
     /// Delays of those, s.
     pub detection_delay: Option<Spread>,
-    /// Realisations that isolated it correctly.
+    /// Realisations that isolated it correctly: for at least the scenario's `isolated_fraction`
+    /// of its active time.
     pub isolated_correctly: usize,
     /// isolated_correctly / runs (none without a completed realisation).
     pub isolation_accuracy: Option<f64>,
+    /// Realisations whose first isolation named its channel.
+    pub first_isolation_correct: usize,
+    /// The share of its active time isolated correctly, over the realisations.
+    pub isolated_fraction: Option<Spread>,
 }
 
 /// One residual over the sweep.
@@ -92,6 +97,8 @@ pub struct SweepSummary {
     pub finished: usize,
     /// Whether the sweep was interrupted: the statistics are of the realisations it finished.
     pub partial: bool,
+    /// The share of a fault's active time it must be isolated correctly for to count.
+    pub isolated_fraction: f64,
     /// The signal that interrupted it.
     pub interrupted_by: Option<&'static str>,
     /// Seeds asked for: first and last.
@@ -244,7 +251,16 @@ pub fn gather(s: &Scenario, opts: &SweepOptions, jobs: usize, completed: &[(u64,
             let figs: Vec<&diagnosis::FaultFigure> = diag.iter().filter_map(|d| d.faults.iter().find(|x| x.name == f.name)).collect();
             let delays: Vec<f64> = figs.iter().filter_map(|x| x.delay).collect();
             let correct = figs.iter().filter(|x| x.correct).count();
-            FaultSweep { name: f.name.clone(), detected: delays.len(), detection_delay: spread(&delays), isolated_correctly: correct, isolation_accuracy: (!runs.is_empty()).then(|| correct as f64 / runs.len() as f64) }
+            let fractions: Vec<f64> = figs.iter().filter_map(|x| x.isolated_fraction).collect();
+            FaultSweep {
+                name: f.name.clone(),
+                detected: delays.len(),
+                detection_delay: spread(&delays),
+                isolated_correctly: correct,
+                isolation_accuracy: (!runs.is_empty()).then(|| correct as f64 / runs.len() as f64),
+                first_isolation_correct: figs.iter().filter(|x| x.first_isolation_correct).count(),
+                isolated_fraction: spread(&fractions),
+            }
         })
         .collect();
     let false_alarms: u64 = diag.iter().map(|d| d.false_alarms).sum();
@@ -285,6 +301,7 @@ pub fn gather(s: &Scenario, opts: &SweepOptions, jobs: usize, completed: &[(u64,
         requested: opts.runs,
         finished: runs.len(),
         partial: false,
+        isolated_fraction: s.isolated_fraction,
         interrupted_by: None,
         seeds: [opts.seed, opts.seed.wrapping_add(opts.runs.saturating_sub(1) as u64)],
         mode: opts.mode.name().into(),
@@ -329,12 +346,16 @@ impl SweepSummary {
         }
         for x in &self.faults {
             t += &format!(
-                "  fault {:<18} detected {}/{}  delay min/median/p95/max {} s  isolated correctly {}\n",
+                "  fault {:<18} detected {}/{}  delay min/median/p95/max {} s  isolated correctly (≥ {} % of its time) in {}; first isolation right in {}/{}; share of its time isolated min/median/p95/max {}\n",
                 x.name,
                 x.detected,
                 self.runs,
                 f(&x.detection_delay),
-                x.isolation_accuracy.map_or_else(|| "—".to_string(), |a| format!("{:.1} %", 100.0 * a))
+                lti::eig::sig(100.0 * self.isolated_fraction),
+                x.isolation_accuracy.map_or_else(|| "—".to_string(), |a| format!("{:.1} % of the realisations", 100.0 * a)),
+                x.first_isolation_correct,
+                self.runs,
+                f(&x.isolated_fraction)
             );
         }
         t += &format!(
