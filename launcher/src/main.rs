@@ -62,6 +62,11 @@ enum Command {
         /// X for --realtime: 2 runs twice as fast as real time, 0.5 half as fast.
         #[arg(long, value_name = "X", requires = "realtime")]
         speed: Option<f64>,
+        /// How long a component that runs, or waits for a core, may publish nothing before the
+        /// run is stopped (default: the scenario's stall_timeout, else 60 s). A stopped or
+        /// blocked component is named after 5 s whatever this is.
+        #[arg(long, value_name = "S")]
+        stall_timeout: Option<f64>,
     },
     /// Monte Carlo: run N noise realisations (seeds S, S+1, …) and write DIR/<name>.sweep.json
     /// with detection delays, isolation accuracy, false-alarm rates and tail errors.
@@ -245,9 +250,10 @@ fn main() -> ExitCode {
         seed: None,
         realtime: false,
         speed: None,
+        stall_timeout: None,
     });
     match command {
-        Command::Run { scenario, out, mode, wait, force, allow_unstable, pin, record_every, record, seed, realtime, speed } => {
+        Command::Run { scenario, out, mode, wait, force, allow_unstable, pin, record_every, record, seed, realtime, speed, stall_timeout } => {
             let speed = speed.unwrap_or(1.0);
             if let Err(e) = limits::speed(speed) {
                 return fail(&e);
@@ -259,10 +265,16 @@ fn main() -> ExitCode {
                 Ok(x) => x,
                 Err(e) => return fail(&LaunchError::BadInput(e)),
             };
-            let (s, p) = match prepared(&scenario, seed) {
+            let (mut s, p) = match prepared(&scenario, seed) {
                 Ok(x) => x,
                 Err(e) => return fail(&e),
             };
+            if let Some(t) = stall_timeout {
+                match scenario::limits::stall_timeout("--stall-timeout", t) {
+                    Ok(t) => s.stall_timeout = t,
+                    Err(e) => return fail(&LaunchError::BadInput(e)),
+                }
+            }
             if let Some(x) = realtime
                 && let Err(e) = limits::schedule(x, s.dt, s.steps)
             {

@@ -207,6 +207,11 @@ impl Inlet {
         self.wait = Wait::Sleep(us);
     }
 
+    /// How long a wait for a sample may last (10 s by default).
+    pub fn set_timeout(&mut self, t: Duration) {
+        self.timeout = t;
+    }
+
     /// Takes a pending sample, if any, checking its step and copying its values into `out`.
     pub fn try_step(&self, step: u64, out: &mut [f64]) -> Result<Option<Header>, LockstepError> {
         let Some(sample) = self.subscriber.receive().map_err(LockstepError::ipc)? else { return Ok(None) };

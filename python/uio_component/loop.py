@@ -23,6 +23,7 @@ in `setup` → `<name>: setup: <exception>`, exit 3 (`Diverged` from a plant's s
 
 from __future__ import annotations
 
+import math
 import os
 import time
 import sys
@@ -48,7 +49,7 @@ class Stepper:
     """The step order of PROTOCOL.md §5 around a step function, on ports already made."""
 
     def __init__(self, config: Config, outlet: Outlet, inlets: List[Inlet], step: Callable[..., Any],
-                 state: Any = None, with_state: bool = False, timeout_s: float = TIMEOUT_S) -> None:
+                 state: Any = None, with_state: bool = False, timeout_s: Optional[float] = None) -> None:
         self.config = config
         self.outlet = outlet
         self.inlets = inlets
@@ -56,7 +57,11 @@ class Stepper:
         self.step_fn = step
         self.state = state
         self.with_state = with_state
-        self.timeout_s = timeout_s
+        #: How long a wait for an input may last: the configuration's `inlet_timeout_s` (set by
+        #: the launcher above its stall limit, PROTOCOL.md §6), else TIMEOUT_S.
+        given = config.raw.get("inlet_timeout_s")
+        self.timeout_s = timeout_s if timeout_s is not None else (
+            float(given) if isinstance(given, (int, float)) and not isinstance(given, bool) and math.isfinite(given) and given > 0 else TIMEOUT_S)
         #: Real-time pacing of a plant (`pace_s`, PROTOCOL.md §5): sample k goes out no earlier
         #: than t0 + k·pace, t0 when sample 0 did.
         pace = config.raw.get("pace_s") if config.role == "plant" else None

@@ -80,6 +80,9 @@ pub struct Scenario {
     /// The share of a fault's active time it must be isolated correctly for to count as
     /// isolated (`isolated_fraction`, default 0.9).
     pub isolated_fraction: f64,
+    /// How long a component that is running or runnable may publish nothing before the run is
+    /// stopped, s (`stall_timeout`, default [`limits::STALL_TIMEOUT`]; `--stall-timeout`).
+    pub stall_timeout: f64,
     /// Banks of residual generators.
     pub diagnosers: Vec<diagnosis::DiagnoserSpec>,
 }

@@ -22,3 +22,19 @@ pub const MAX_WINDOW: i64 = 1_000_000;
 /// Most calibration realisations (`calibrate.runs`): each is a whole run of the scenario, made
 /// before the run itself starts.
 pub const MAX_CALIBRATION_RUNS: i64 = 10_000;
+
+/// The default stall limit for a component that runs, or waits for a core, but publishes
+/// nothing, s (a stopped or blocked one is named after 5 s).
+pub const STALL_TIMEOUT: f64 = 60.0;
+
+/// The largest stall limit accepted, s (a day).
+pub const MAX_STALL_TIMEOUT: f64 = 86_400.0;
+
+/// A stall limit: at least the 5 s after which a blocked component is named, at most a day.
+pub fn stall_timeout(field: &str, v: f64) -> Result<f64, String> {
+    if v.is_finite() && (5.0..=MAX_STALL_TIMEOUT).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("{field}: {v} s must be between 5 s (when a stopped or blocked component is named) and {MAX_STALL_TIMEOUT} s"))
+    }
+}

@@ -68,6 +68,9 @@ pub struct RawScenario {
     /// The share of a fault's active time it must be isolated correctly for to count as
     /// isolated (default 0.9).
     pub isolated_fraction: Option<f64>,
+    /// How long a component that is running (or waiting for a core) may publish nothing before
+    /// the run is stopped, s (default 60; `--stall-timeout` overrides it).
+    pub stall_timeout: Option<f64>,
     /// Host name → its agent's Zenoh endpoint.
     pub hosts: Option<BTreeMap<String, String>>,
 }

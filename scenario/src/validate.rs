@@ -356,6 +356,10 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
         Some(x) if x.is_finite() && x > 0.0 && x <= 1.0 => x,
         Some(x) => return Err(bad("isolated_fraction", format!("{x} must be a share of the fault's time, 0 < x ≤ 1"))),
     };
+    let stall_timeout = match raw.stall_timeout {
+        None => crate::limits::STALL_TIMEOUT,
+        Some(v) => crate::limits::stall_timeout("stall_timeout", v).map_err(|r| bad("stall_timeout", r.split_once(": ").map_or(r.clone(), |(_, x)| x.to_string())))?,
+    };
     let mut taken = seen.clone();
     let diagnosers = super::fault_diagnosis::diagnosers(&raw.diagnoser, &model, &ff, noise.as_ref(), &mut taken)?;
     // Each bank member runs as an observer of its own, after the scenario's observers.
@@ -406,6 +410,7 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
         source: String::new(),
         seed: raw.seed.unwrap_or(0),
         isolated_fraction,
+        stall_timeout,
         noise,
         ff,
         faults,

@@ -88,6 +88,9 @@ pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> V
         signals: Value::Null,
         params,
         pace_s: None,
+        // Above the launcher's stall limit: it names a stall first, and a component waits for a
+        // starved peer as long as the launcher does.
+        inlet_timeout_s: Some(s.stall_timeout + super::processes::STALL_BLOCKED.as_secs_f64()),
     };
     let plant_read = |sleep_us| ReadSpec { service: "plant".into(), len: lay.len(), lag: 0, sleep_us, fields: fields(lay) };
     let estimate = |name: &str| PublishSpec { service: format!("observer/{name}"), len: lay.n, names: names(&s.names.state) };

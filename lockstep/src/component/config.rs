@@ -104,6 +104,11 @@ pub struct ComponentConfig {
     /// t₀ + k·pace_s, t₀ when sample 0 was (PROTOCOL.md §5).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pace_s: Option<f64>,
+    /// How long a wait for an input may last before the component gives up (exit 3), s;
+    /// 10 s when absent. The launcher sets it above its own stall limit, so that it names a
+    /// stall first and a starved peer is waited for as long as the launcher waits.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inlet_timeout_s: Option<f64>,
 }
 
 impl Iceoryx2Place {

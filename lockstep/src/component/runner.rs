@@ -77,6 +77,9 @@ impl<C: Component> Runner<C> {
             if let Some(us) = r.sleep_us {
                 inlet.sleep_between_polls(us);
             }
+            if let Some(t) = cfg.inlet_timeout_s.filter(|t| t.is_finite() && *t > 0.0) {
+                inlet.set_timeout(std::time::Duration::from_secs_f64(t));
+            }
             inlets.push(inlet);
         }
         Ok(Runner {

@@ -7,6 +7,7 @@
 //! stops the run within a poll interval, the others are killed, and the recording is closed.
 
 mod assembly;
+mod liveness;
 pub(crate) mod placement;
 mod proc;
 
@@ -30,9 +31,10 @@ use recording::write::StepRow;
 
 /// How long components may take to report ready.
 const READY_TIMEOUT: Duration = Duration::from_secs(20);
-/// How long the run may make no progress before it is declared stuck: shorter than a
-/// component's own inlet timeout (10 s), so the launcher names the stall first.
-const STALL_TIMEOUT: Duration = Duration::from_secs(5);
+/// How long the run may make no progress before the component it waits for is looked at: named
+/// at once when the kernel has it stopped or blocked; waited for, up to the scenario's stall
+/// limit, when it runs or waits for a core ([`liveness`]).
+pub const STALL_BLOCKED: Duration = Duration::from_secs(5);
 /// Sleep between drains. The launcher shares the cores with the lockstep ring, and every
 /// wake-up takes a core from it for a moment: drain rarely, in large batches. At the fastest
 /// step rate measured (~250k steps/s) 5 ms is ~1300 samples, well inside the recorder's buffer.
@@ -73,7 +75,8 @@ fn run_in(s: &Scenario, space: &RunSpace, cfg: &Configs, session: &mut Session, 
         for (i, (c, &cpu)) in components.iter().zip(&cpus).enumerate() {
             procs.push(spawn(c, workdir, space, cpu, &tx, i)?);
         }
-        handshake(&mut procs, &rx)?;
+        let stall = Duration::from_secs_f64(s.stall_timeout);
+        handshake(&mut procs, &rx, stall)?;
         let r = Readers { plant: &readers[0], observers: &readers[1..1 + nobs], controller: readers.get(1 + nobs) };
         let mut asm = Assembly {
             plant: Queue::new(&components[0]),
@@ -84,7 +87,7 @@ fn run_in(s: &Scenario, space: &RunSpace, cfg: &Configs, session: &mut Session, 
             dt: s.dt,
             controller_observer: s.controller.as_ref().and_then(|c| s.observers.iter().position(|o| o.name == c.observer)),
         };
-        supervise(cfg, session, &mut procs, &r, &mut asm)
+        supervise(cfg, session, &mut procs, &r, &mut asm, stall)
     })();
     stop_all(&mut procs);
     drop((readers, bus));
@@ -96,9 +99,14 @@ fn run_in(s: &Scenario, space: &RunSpace, cfg: &Configs, session: &mut Session, 
 const EXIT_GRACE: Duration = Duration::from_millis(100);
 
 /// Waits for every component's `ready`, then tells them all `go`. A component whose stdout ends
-/// before `ready` cannot report it: it failed to start, and is named at once.
-fn handshake(procs: &mut [Proc], rx: &mpsc::Receiver<(usize, Option<String>)>) -> Result<(), LaunchError> {
-    let deadline = Instant::now() + READY_TIMEOUT;
+/// before `ready` cannot report it: it failed to start, and is named at once. One still starting
+/// after [`READY_TIMEOUT`] is waited for up to the stall limit while it runs or waits for a core
+/// (an interpreter importing its libraries on a loaded machine), and named once stopped or blocked.
+fn handshake(procs: &mut [Proc], rx: &mpsc::Receiver<(usize, Option<String>)>, stall: Duration) -> Result<(), LaunchError> {
+    let start = Instant::now();
+    let pgids: Vec<u32> = procs.iter().map(|p| p.child.id()).collect();
+    let mut watch: Option<liveness::Watch> = None;
+    let mut looks = 0usize;
     let mut ready = vec![false; procs.len()];
     while !ready.iter().all(|&r| r) {
         if let Some(sig) = interrupt::received() {
@@ -120,9 +128,25 @@ fn handshake(procs: &mut [Proc], rx: &mpsc::Receiver<(usize, Option<String>)>) -
             Ok(_) | Err(mpsc::RecvTimeoutError::Timeout) => {}
             Err(mpsc::RecvTimeoutError::Disconnected) => {}
         }
-        if Instant::now() > deadline {
-            let slow: Vec<&str> = procs.iter().zip(&ready).filter(|(_, r)| !**r).map(|(p, _)| p.label.as_str()).collect();
-            return Err(LaunchError::Component(format!("{} did not report ready within {} s", slow.join(", "), READY_TIMEOUT.as_secs())));
+        if start.elapsed() > READY_TIMEOUT {
+            let slow: Vec<usize> = (0..procs.len()).filter(|&i| !ready[i]).collect();
+            let w = watch.get_or_insert_with(|| liveness::Watch::new(&pgids));
+            // One slow component judged per look, in turn.
+            let mut named = None;
+            let i = slow[looks % slow.len()];
+            if let Some(v) = w.judge(&pgids, i) {
+                looks += 1;
+                if v != liveness::Verdict::Busy {
+                    named = Some(format!("{} did not report ready within {} s and is {}", procs[i].describe_stall(), READY_TIMEOUT.as_secs(), if v == liveness::Verdict::Stopped { "stopped" } else { "asleep, using no CPU" }));
+                }
+            }
+            if named.is_none() && start.elapsed() > stall.max(READY_TIMEOUT) {
+                let labels: Vec<&str> = slow.iter().map(|&i| procs[i].label.as_str()).collect();
+                named = Some(format!("{} did not report ready within {} s (the stall limit: stall_timeout in the scenario, --stall-timeout)", labels.join(", "), lti::eig::sig(stall.max(READY_TIMEOUT).as_secs_f64())));
+            }
+            if let Some(why) = named {
+                return Err(LaunchError::Component(why));
+            }
         }
     }
     for p in procs.iter_mut() {
@@ -148,10 +172,12 @@ fn closed_before_ready(p: &mut Proc) -> LaunchError {
     LaunchError::Component(format!("{} (pid {}) closed its stdout before it reported ready: it failed to start", p.label, p.child.id()))
 }
 
-fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: &Readers, asm: &mut Assembly) -> Result<Stop, LaunchError> {
+fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: &Readers, asm: &mut Assembly, stall: Duration) -> Result<Stop, LaunchError> {
     let steps = cfg.plant.steps;
     let mut row = StepRow::new(cfg.layout, readers.observers.len(), readers.controller.is_some());
     let mut last_progress = Instant::now();
+    let pgids: Vec<u32> = procs.iter().map(|p| p.child.id()).collect();
+    let mut watch: Option<liveness::Watch> = None;
     loop {
         // In chunks, yielding the core between them: the ring's processes, spinning on it, get
         // it back within a chunk's work (tens of µs) instead of after the whole batch.
@@ -222,13 +248,35 @@ fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: 
         if procs.iter().all(|p| p.status.is_some()) && got == 0 {
             return Ok(Stop::Failed(format!("every component finished but only {} of {steps} steps arrived", asm.next)));
         }
-        if last_progress.elapsed() > STALL_TIMEOUT {
+        let quiet = last_progress.elapsed();
+        if quiet <= STALL_BLOCKED {
+            watch = None;
+        } else {
             let missing = asm.missing();
-            let who = missing.map_or_else(|| "a component".to_string(), |i| procs[i].describe_stall());
-            let hint = if missing == Some(0) { " (a plant blocked publishing to a component that stopped reading its samples shows as this too)" } else { "" };
-            stop_all(procs);
             let last = if asm.next == 0 { "no step completed".to_string() } else { format!("last completed step {}", asm.next - 1) };
-            return Ok(Stop::Failed(format!("{who} published no sample for step {} within {} s; {last}{hint}", asm.next, STALL_TIMEOUT.as_secs())));
+            let verdict = match missing {
+                Some(i) => watch.get_or_insert_with(|| liveness::Watch::new(&pgids)).judge(&pgids, i),
+                None => Some(liveness::Verdict::Blocked),
+            };
+            let why = match verdict {
+                None => None,
+                Some(liveness::Verdict::Busy) if quiet <= stall => None,
+                Some(liveness::Verdict::Busy) => Some(format!(
+                    "published no sample for step {} within {} s although it ran or waited for a core (the stall limit: stall_timeout in the scenario, --stall-timeout); {last}",
+                    asm.next,
+                    lti::eig::sig(stall.as_secs_f64())
+                )),
+                Some(v) => {
+                    let state = if v == liveness::Verdict::Stopped { "it is stopped" } else { "it is asleep and used no CPU for the last second" };
+                    let hint = if missing == Some(0) { " (a plant blocked publishing to a component that stopped reading its samples shows as this too)" } else { "" };
+                    Some(format!("published no sample for step {} within {} s and {state}; {last}{hint}", asm.next, STALL_BLOCKED.as_secs()))
+                }
+            };
+            if let Some(why) = why {
+                let who = missing.map_or_else(|| "a component".to_string(), |i| procs[i].describe_stall());
+                stop_all(procs);
+                return Ok(Stop::Failed(format!("{who} {why}")));
+            }
         }
         std::thread::sleep(POLL);
     }
