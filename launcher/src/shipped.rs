@@ -26,13 +26,13 @@ pub fn resolve(arg: &Path) -> Result<PathBuf, LaunchError> {
     if by_stem.is_file() {
         return Ok(by_stem);
     }
-    if let Ok(entries) = list(&dir)
-        && let Some(e) = entries.iter().find(|e| e.name.as_deref() == Some(&*text))
-    {
+    let entries = list(&dir).unwrap_or_default();
+    if let Some(e) = entries.iter().find(|e| e.name.as_deref() == Some(&*text)) {
         return Ok(e.file.clone());
     }
+    let hint = scenario::suggest::did_you_mean(&text, entries.iter().filter_map(|e| e.name.as_deref()));
     Err(LaunchError::BadInput(format!(
-        "{}: no such file, nor a shipped scenario of that name in {} (see `launcher list`)",
+        "{}: no such file, nor a shipped scenario of that name in {} (see `launcher list`){hint}",
         quoted(&text),
         dir.display()
     )))

@@ -47,7 +47,7 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<Scenario, ScenarioError> 
         // serde names an unknown key with the table's span (its header): point at the key's own
         // line, and suggest the known key it was likely meant to be.
         if let Some((key, known)) = unknown_key(&reason) {
-            let own = if field.is_empty() { key.clone() } else { format!("{field}.{key}") };
+            let own = if field.is_empty() || field == key || field.ends_with(&format!(".{key}")) { if field.is_empty() { key.clone() } else { field.clone() } } else { format!("{field}.{key}") };
             loc = at(&own).or(loc);
             reason += &crate::suggest::did_you_mean(&key, known.iter().map(String::as_str));
         }

@@ -280,3 +280,23 @@ fn only_regular_files_of_bounded_size_are_read() {
         }
     }
 }
+
+/// Issue 21: an unknown key is located at its own line (not its table's header), and an unknown
+/// key, kind or shipped scenario name close to a known one gets "did you mean …".
+#[test]
+fn unknown_keys_point_at_their_line_and_near_misses_are_suggested() {
+    let s = Scratch::new("did-you-mean");
+    // The second [[observer]]'s `poles` misspelt, on line 38 of the file.
+    let body = BASE.replacen("name = \"luenberger\"\nkind = \"luenberger\"\npoles", "name = \"luenberger\"\nkind = \"luenberger\"\npoels", 1);
+    let line = body.lines().position(|l| l.starts_with("poels")).unwrap() + 1;
+    let err = refused(&s, "key", &body);
+    assert!(err.contains(&format!("key.toml:{line}:")) && err.contains("unknown field `poels`") && err.contains("(did you mean 'poles'?)"), "{err}");
+    let err = refused(&s, "kind", &BASE.replacen("kind = \"luenberger\"", "kind = \"luenburger\"", 1));
+    assert!(err.contains("observer[2].kind") && err.contains("(did you mean 'luenberger'?)"), "{err}");
+    let err = refused(&s, "far", &BASE.replacen("kind = \"luenberger\"", "kind = \"xyz\"", 1));
+    assert!(!err.contains("did you mean"), "{err}");
+    let out = launcher(&s).args(["design", "seed002-sin"]).output().unwrap();
+    let (_, err) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("(did you mean 'seed002-sine'?)"), "{err}");
+}

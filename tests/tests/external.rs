@@ -78,6 +78,11 @@ fn a_command_that_does_not_exist_is_named() {
     let (code, err, _) = run_checked(&s, &path);
     assert_eq!(code, Some(3), "{err}");
     assert!(err.contains("cannot start observer 'bad'") && err.contains("no_such_program_uio"), "{err}");
+    // Nothing ran, so nothing is left: no recording, no summary, and a retry needs no --force.
+    assert!(!s.join("out/seed002-sine.rrd").exists() && !s.join("out/seed002-sine.summary.json").exists());
+    let (code, err, _) = run_checked(&s, &path);
+    assert_eq!(code, Some(3), "{err}");
+    assert!(!err.contains("already exists"), "{err}");
 }
 
 /// The built-in linear plant rebuilt from the protocol's configuration alone, run as an

@@ -212,6 +212,16 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
         salvage::recording_failed(&s.name, partial.as_deref(), &format!("{e}{why}"), steps_done)
     })?;
     metrics.finish();
+    // A run that failed before any step completed has nothing to show: it leaves no recording
+    // and no summary (a retry then needs no --force); the message says why.
+    if steps_done == 0 && !matches!(stop, Stop::Completed) {
+        if let Some(p) = &partial {
+            let _ = fs::remove_file(p);
+        }
+        let mut summary = Summary::new(s, plan, opts, &metrics, &latency, wall, &stop, None, diagnosis);
+        summary.realtime = realtime;
+        return Ok(Outcome { summary, rrd: None, summary_path: None, stop });
+    }
     // Failures after the run are of the run's outputs (a full disk, say): exit code 3, the file named.
     if let (Some(from), Some(to)) = (&partial, &rrd) {
         fs::rename(from, to).map_err(|e| LaunchError::Component(format!("{}: cannot rename the recording into place: {e}", to.display())))?;
