@@ -30,6 +30,9 @@ pub struct ObserverSummary {
     /// max |w − ŵ| over the tail, for an observer that estimates the unknown inputs.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tail_max_abs_input_error: Option<f64>,
+    /// In a run with faults, the figures before the first fault: its effect is in the run's tail.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fault_free: Option<recording::write::FaultFree>,
     /// Continuous error-dynamics eigenvalues, [re, im].
     pub poles: Vec<[f64; 2]>,
     /// Sampled observer eigenvalues, [re, im].
@@ -128,6 +131,7 @@ impl Summary {
                 max_abs_error: f.max_abs_error,
                 final_abs_error: f.final_abs_error,
                 tail_max_abs_input_error: f.tail_max_abs_input_error,
+                fault_free: f.fault_free,
                 poles: d.as_ref().map_or_else(Vec::new, |d| lti::re_im(&d.report.poles)),
                 discrete_poles: d.as_ref().map_or_else(Vec::new, |d| lti::re_im(&d.report.discrete_poles)),
             })
@@ -249,6 +253,9 @@ impl Summary {
             t += &format!("  {:<14} {:<16} {:>14} {:>14}\n", o.name, o.kind, figure(o.tail_max_abs_error), figure(o.tail_max_abs_residual));
             if let Some(w) = o.tail_max_abs_input_error {
                 t += &format!("  {:<31} {:>14}   (its unknown-input estimate)\n", "", format!("max|w − ŵ| {}", figure(Some(w))));
+            }
+            if let Some(ff) = &o.fault_free {
+                t += &format!("  {:<31} {:>14} {:>14}   (tail of the fault-free {} s before the first fault)\n", "", figure(Some(ff.tail_max_abs_error)), figure(Some(ff.tail_max_abs_residual)), sig(ff.until));
             }
         }
         let p = &self.latency_ns.step;

@@ -362,6 +362,20 @@ fn isolation_is_judged_over_the_whole_fault_and_transient_isolability_is_warned(
             assert_eq!(fig["isolated_at"].as_f64().unwrap(), k as f64 * sc.dt);
             assert_eq!(fig["first_isolation_correct"].as_bool().unwrap(), code == channel);
         }
+        // The observers' figures before the first fault (8 s = step 4000), from the recording:
+        // the UIO's error over the last quarter of that stretch, max_k max_i |x_i − x̂_i|.
+        let first = (8.0 / sc.dt).round() as usize;
+        let mut tail = 0.0f64;
+        for i in 1..=4 {
+            let (x, xh) = (&rec.series[&format!("/plant/x/{i}")].values, &rec.series[&format!("/observer/uio/xhat/{i}")].values);
+            for k in first - first / 4..first {
+                tail = tail.max((x[k] - xh[k]).abs());
+            }
+        }
+        let uio = sum["observers"].as_array().unwrap().iter().find(|o| o["name"] == "uio").unwrap();
+        assert_eq!(uio["fault_free"]["tail_max_abs_error"].as_f64().unwrap(), tail, "{uio}");
+        assert_eq!(uio["fault_free"]["until"].as_f64().unwrap(), 8.0);
+        assert!(tail < 1e-12 && uio["tail_max_abs_error"].as_f64().unwrap() > 1e-3, "the faults' effect is in the run's tail, not before: {uio}");
         // The bias: right at first, then "unknown" for most of its 6 s.
         let bias = &sum["diagnosis"]["faults"][0];
         assert!(bias["first_isolation_correct"].as_bool().unwrap() && bias["unknown_time"].as_f64().unwrap() > 4.0, "{bias}");

@@ -278,6 +278,9 @@ impl Session {
             None => None,
         };
         let mut metrics = Metrics::new(layout, s.model.c.clone(), s.observers.len(), s.steps);
+        if let Some(first) = s.faults.iter().flat_map(|f| f.active_steps(s.dt)).map(|(on, _)| on).min() {
+            metrics.fault_free_until(first, s.dt);
+        }
         for (o, e) in estimates.iter().enumerate() {
             if let Some(e) = e {
                 metrics.estimate_inputs(o, e.w.clone(), &e.w_c_phi, &e.w_c_gamma_b);

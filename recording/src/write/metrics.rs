@@ -23,6 +23,23 @@ pub struct ObserverFigures {
     pub final_abs_error: f64,
     /// max over the tail of max_j |w_j − ŵ_j|, for an observer that estimates w.
     pub tail_max_abs_input_error: Option<f64>,
+    /// The same figures over the fault-free stretch before the first fault, in a run with faults
+    /// that completed at least four of those steps.
+    pub fault_free: Option<FaultFree>,
+}
+
+/// An observer's figures over the steps [0, F) before the first fault (F its first step): its
+/// tail is that stretch's last quarter, [F − ⌊F/4⌋, F).
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct FaultFree {
+    /// F·dt: how long the stretch is, s.
+    pub until: f64,
+    /// max |x − x̂| over its last quarter.
+    pub tail_max_abs_error: f64,
+    /// max |y − Cx̂| over its last quarter.
+    pub tail_max_abs_residual: f64,
+    /// max |x − x̂| over the stretch.
+    pub max_abs_error: f64,
 }
 
 /// max(a, b) that propagates NaN (`f64::max` ignores it): a non-finite estimate must not score
@@ -56,6 +73,10 @@ pub struct Metrics {
     pub residual: Vec<Vec<f64>>,
     /// Per observer, its unknown-input estimate ŵ when it has one.
     pub what: Vec<Option<InputEstimate>>,
+    /// The first step a fault acts in, and per observer [tail max|e|, tail max|r|, max|e|] over
+    /// the steps before it ([`FaultFree`]).
+    fault_free: Option<(u64, Vec<[f64; 3]>)>,
+    dt: f64,
 }
 
 impl Metrics {
@@ -80,7 +101,16 @@ impl Metrics {
             error: vec![vec![0.0; layout.n]; observers],
             residual: vec![vec![0.0; layout.p]; observers],
             what: vec![None; observers],
+            fault_free: None,
+            dt: 0.0,
         }
+    }
+
+    /// The run's first fault acts from step `first` (of period dt): figures are kept for the
+    /// steps before it too.
+    pub fn fault_free_until(&mut self, first: u64, dt: f64) {
+        self.fault_free = Some((first, vec![[0.0; 3]; self.observers.len()]));
+        self.dt = dt;
     }
 
     /// Observer `o` estimates the unknown inputs: ŵ_k = W y_{k+1} − (WCΦ) x̂_k − (WCΓ_B) u_k.
@@ -102,6 +132,14 @@ impl Metrics {
             f.tail_max_abs_error = start.map(|s| if completed { exact[0] } else { e.max_from(s) });
             f.tail_max_abs_residual = start.map(|s| if completed { exact[1] } else { r.max_from(s) });
             f.tail_max_abs_input_error = what.as_ref().and_then(|w| start.map(|s| w.tail_max_abs_error(s, completed)));
+        }
+        if let Some((first, ff)) = &self.fault_free
+            && *first / 4 > 0
+            && self.steps >= *first
+        {
+            for (f, m) in self.observers.iter_mut().zip(ff) {
+                f.fault_free = Some(FaultFree { until: *first as f64 * self.dt, tail_max_abs_error: m[0], tail_max_abs_residual: m[1], max_abs_error: m[2] });
+            }
         }
     }
 
@@ -136,6 +174,16 @@ impl Metrics {
                 let x = &mut self.exact[o];
                 x[0] = nan_max(x[0], emax);
                 x[1] = nan_max(x[1], rmax);
+            }
+            if let Some((first, ff)) = &mut self.fault_free
+                && row.k < *first
+            {
+                let m = &mut ff[o];
+                if row.k >= *first - *first / 4 {
+                    m[0] = nan_max(m[0], emax);
+                    m[1] = nan_max(m[1], rmax);
+                }
+                m[2] = nan_max(m[2], emax);
             }
         }
         for ((a, b), d) in self.differences.iter_mut() {

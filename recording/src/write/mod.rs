@@ -14,7 +14,7 @@ mod what;
 pub use blueprint::blueprint;
 pub use file_sink::UncompressedFileSink;
 pub use latency::{histogram, Latency, Percentiles};
-pub use metrics::{nan_max, Metrics, ObserverFigures};
+pub use metrics::{nan_max, FaultFree, Metrics, ObserverFigures};
 pub use rrd::{RrdSink, SeriesId};
 pub use select::Selection;
 pub use what::InputEstimate;
