@@ -96,9 +96,36 @@ pub fn table(runs: &[BenchRun], wait: Wait) -> String {
         );
     }
     for (name, v) in ratios(runs) {
-        t += &format!("{name}: median {:.3} [{:.3} – {:.3}] over {} repetition(s)\n", v.1, v.0, v.2, v.3);
+        t += &sentence(&name, v);
     }
     t
+}
+
+/// A ratio of [`ratios`] as a sentence a reader understands: what is compared with what, its
+/// median over the repetitions and their range.
+fn sentence(name: &str, (min, median, max, n): (f64, f64, f64, usize)) -> String {
+    let pct = |x: f64| format!("{:.1} %", 100.0 * x);
+    let over = format!("(median of {n} repetition(s); range {} – {})", pct(min), pct(max));
+    let times = format!("(median of {n} repetition(s); range {min:.2} – {max:.2}×)");
+    let rec = |with: bool| if with { "with recording" } else { "without recording" };
+    match name {
+        "processes (no recording) / floor, steps/s" | "processes (recording) / floor, steps/s" => {
+            let with = name.contains("(recording)");
+            format!("across processes {}, the lockstep ring makes {} of the steps per second of a bare iceoryx2 ring (the floor) {over}\n", rec(with), pct(median))
+        }
+        "processes (no recording) / floor, step p50" | "processes (recording) / floor, step p50" => {
+            let with = name.contains("(recording)");
+            format!("across processes {}, a step's median time is {median:.2}× the floor's {times}\n", rec(with))
+        }
+        "processes / in-process, steps/s (no recording)" => {
+            format!("without recording, running across processes makes {} of the steps per second of running in one process {over}\n", pct(median))
+        }
+        "in-process: share of steps/s recording costs" | "processes: share of steps/s recording costs" => {
+            let m = if name.starts_with("in-process") { "in one process" } else { "across processes" };
+            format!("{m}, recording costs {} of the steps per second a run makes without it {over}\n", pct(median))
+        }
+        _ => format!("{name}: median {median:.3} [{min:.3} – {max:.3}] over {n} repetition(s)\n"),
+    }
 }
 
 /// Ratios per repetition (a repetition starts at each floor run, or is the whole list without
@@ -145,4 +172,20 @@ pub fn ratios(runs: &[BenchRun]) -> Vec<(String, (f64, f64, f64, usize))> {
             (n, (v[0], v[(v.len() - 1) / 2], v[v.len() - 1], v.len()))
         })
         .collect()
+}
+
+#[cfg(test)]
+mod sentence_tests {
+    use super::sentence;
+
+    /// Each ratio reads as a sentence with its median and range, not as an algebraic name.
+    #[test]
+    fn ratios_read_as_sentences() {
+        let s = sentence("in-process: share of steps/s recording costs", (0.78, 0.791, 0.80, 3));
+        assert_eq!(s, "in one process, recording costs 79.1 % of the steps per second a run makes without it (median of 3 repetition(s); range 78.0 % – 80.0 %)\n");
+        let s = sentence("processes (recording) / floor, steps/s", (0.5, 0.52, 0.55, 3));
+        assert!(s.starts_with("across processes with recording, the lockstep ring makes 52.0 % of the steps per second of a bare iceoryx2 ring"), "{s}");
+        let s = sentence("processes (no recording) / floor, step p50", (1.1, 1.25, 1.4, 2));
+        assert!(s.contains("a step's median time is 1.25× the floor's"), "{s}");
+    }
 }
