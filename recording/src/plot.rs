@@ -157,7 +157,13 @@ fn views(r: &Recording, s: Option<&Scenario>, observers: &[String]) -> Vec<View>
     banks.dedup();
     for d in banks {
         let series = [recorded(&format!("/diagnosis/{d}/evaluation/")), recorded(&format!("/diagnosis/{d}/threshold/"))].concat();
-        out.push(View { file: format!("diagnosis_{}.png", sanitize(d)), title: format!("residual evaluations J and thresholds ({d})"), y_label: "J".into(), scale: Scale::Linear, series });
+        out.push(View {
+            file: format!("diagnosis_{}.png", sanitize(d)),
+            title: format!("residual evaluations J (solid) and their thresholds (dashed, same colour), log scale ({d})"),
+            y_label: "J".into(),
+            scale: Scale::Log,
+            series,
+        });
         let series = [recorded(&format!("/diagnosis/{d}/alarm/")), recorded(&format!("/diagnosis/{d}/isolated"))].concat();
         out.push(View { file: format!("alarms_{}.png", sanitize(d)), title: format!("alarms and isolated channel ({d}; 0 none, −1 unknown)"), y_label: "alarm, channel".into(), scale: Scale::Linear, series });
     }
@@ -228,12 +234,15 @@ pub fn figures(r: &Recording, selection: &PlotSelection) -> Result<Vec<(String, 
                 },
             };
             let latency = path.starts_with("/latency/");
-            let y = |v: f64| if latency { (v * 1e-3).max(LATENCY_FLOOR_US).log10() } else { v };
+            // J spans decades (rounding before a fault, its size after): on a log axis, 0 at the floor.
+            let threshold = path.starts_with("/diagnosis/") && path.contains("/threshold/");
+            let evaluation = threshold || (path.starts_with("/diagnosis/") && path.contains("/evaluation/"));
+            let y = |v: f64| if latency { (v * 1e-3).max(LATENCY_FLOOR_US).log10() } else if evaluation { signals::log10_floored(v) } else { v };
             let points: Vec<(f64, f64)> = series.steps.iter().zip(&series.values).map(|(&k, &v)| (x_of(k), y(v))).filter(|p| sel.time(p.0) && p.1.is_finite()).collect();
             if points.is_empty() {
                 continue;
             }
-            curves.push(Curve { label: label.clone(), line: palette::line(path, &colours), points: decimate(&points, width) });
+            curves.push(Curve { label: label.clone(), line: palette::line(path, &colours), points: decimate(&points, width), dashed: threshold });
         }
         if !curves.is_empty() {
             out.push((view.file, Figure { title: view.title, y_label: view.y_label, x_label: x_label.into(), scale: view.scale, curves }));

@@ -196,3 +196,24 @@ fn names_and_units_label_plots_and_csv_headers() {
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("named.toml") && err.contains("plant.output_names") && err.contains("has 1 entry, C has 2 rows"), "{err}");
 }
+
+/// Issue 21: the diagnosis view draws J on a log axis (its values log10, 0 at the floor), and
+/// each threshold dashed in the colour of the evaluation it bounds.
+#[test]
+fn the_diagnosis_view_has_j_on_a_log_axis_and_dashed_thresholds_in_their_colours() {
+    let s = Scratch::new("plot-diagnosis");
+    let out = run(&s, &scenario("seed002-actuator-faults"), &["--mode", "in-process"]);
+    assert!(out.status.success(), "{:?}", text(&out));
+    let r = recording::read::read(&s.join("out/seed002-actuator-faults.rrd")).unwrap();
+    let figs = figures(&r, &PlotSelection::default()).unwrap();
+    let (_, fig) = figs.iter().find(|(f, _)| f == "diagnosis_gos.png").expect("a diagnosis view");
+    assert_eq!(fig.scale, Scale::Log);
+    for i in 1..=2 {
+        let j = fig.curves.iter().find(|c| c.label.starts_with(&format!("J{i}"))).unwrap();
+        let t = fig.curves.iter().find(|c| c.label.starts_with(&format!("threshold {i}"))).unwrap();
+        assert!(t.dashed && !j.dashed);
+        assert_eq!(t.line.color, j.line.color, "threshold {i}");
+        let raw = r.series[&format!("/diagnosis/gos/threshold/{i}")].values[0];
+        assert_eq!(t.points[0].1, raw.log10(), "threshold {i} on the log axis");
+    }
+}

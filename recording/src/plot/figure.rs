@@ -36,6 +36,48 @@ pub struct Curve {
     pub line: Line,
     /// (x, y) points.
     pub points: Vec<(f64, f64)>,
+    /// Drawn dashed (a threshold beside the series it bounds, in that series' colour).
+    pub dashed: bool,
+}
+
+/// Dash and gap lengths of a dashed curve, pixels.
+const DASH: (f64, f64) = (12.0, 7.0);
+
+/// The pieces of a polyline (in pixels) that a dash pattern draws.
+fn dashes(points: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
+    let mut out: Vec<Vec<(f64, f64)>> = Vec::new();
+    let mut on = true;
+    let mut left = DASH.0;
+    let mut piece: Vec<(f64, f64)> = points.first().map_or_else(Vec::new, |&p| vec![p]);
+    for pair in points.windows(2) {
+        let (mut a, b) = (pair[0], pair[1]);
+        let mut len = ((b.0 - a.0).powi(2) + (b.1 - a.1).powi(2)).sqrt();
+        if !len.is_finite() {
+            continue;
+        }
+        while len > left {
+            let t = left / len;
+            let cut = (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1));
+            if on {
+                piece.push(cut);
+                out.push(std::mem::take(&mut piece));
+            } else {
+                piece = vec![cut];
+            }
+            on = !on;
+            len -= left;
+            left = if on { DASH.0 } else { DASH.1 };
+            a = cut;
+        }
+        left -= len;
+        if on {
+            piece.push(b);
+        }
+    }
+    if on && piece.len() > 1 {
+        out.push(piece);
+    }
+    out
 }
 
 /// What one PNG shows.
@@ -120,11 +162,21 @@ pub fn draw(path: &Path, fig: &Figure) -> Result<bool, String> {
     let inner = Rect { x0: plot.x0 + 1, y0: plot.y0 + 1, x1: plot.x1 - 1, y1: plot.y1 - 1 };
     for c in &fig.curves {
         let pts: Vec<(f64, f64)> = c.points.iter().map(|&p| map(p)).collect();
-        polyline(&mut canvas, inner, &pts, c.line.color, c.line.width as f64);
+        if c.dashed {
+            for piece in dashes(&pts) {
+                polyline(&mut canvas, inner, &piece, c.line.color, c.line.width as f64);
+            }
+        } else {
+            polyline(&mut canvas, inner, &pts, c.line.color, c.line.width as f64);
+        }
     }
     let legend_clip = Rect { x0: SIZE.0 as i32 - LEGEND_W as i32, y0: 0, x1: SIZE.0 as i32 - 1, y1: SIZE.1 as i32 - 1 };
     for (c, (x, y)) in fig.curves.iter().zip(legend) {
-        polyline(&mut canvas, legend_clip, &[(x as f64, y as f64), (x as f64 + 30.0, y as f64)], c.line.color, c.line.width as f64 + 0.5);
+        let (x, y) = (x as f64, y as f64);
+        let sample = if c.dashed { vec![vec![(x, y), (x + 11.0, y)], vec![(x + 19.0, y), (x + 30.0, y)]] } else { vec![vec![(x, y), (x + 30.0, y)]] };
+        for piece in sample {
+            polyline(&mut canvas, legend_clip, &piece, c.line.color, c.line.width as f64 + 0.5);
+        }
     }
     let mut out = BitMapBackend::new(path, SIZE);
     out.blit_bitmap((0, 0), SIZE, &buf).map_err(|e| e.to_string())?;
@@ -183,6 +235,14 @@ fn frame(buf: &mut [u8], fig: &Figure, (x0, x1, y0, y1): (f64, f64, f64, f64)) -
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A dash pattern along a straight line: pieces of 12 px every 19 px, the last one cut.
+    #[test]
+    fn a_dashed_line_is_cut_into_dashes() {
+        let pieces = dashes(&[(0.0, 0.0), (20.0, 0.0), (50.0, 0.0)]);
+        let spans: Vec<(f64, f64)> = pieces.iter().map(|p| (p[0].0, p[p.len() - 1].0)).collect();
+        assert_eq!(spans, [(0.0, 12.0), (19.0, 31.0), (38.0, 50.0)]);
+    }
 
     /// Rounding-level errors get readable ticks, not 0.000000000000002 or a row of zeros.
     #[test]
