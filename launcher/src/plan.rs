@@ -96,6 +96,19 @@ pub fn complete(s: &Scenario, banks: Vec<Bank>, own: Vec<Option<Designed>>) -> R
             if c.feedforward {
                 fb.feedforward = Some(feedforward(s, c, &observers).map_err(|reason| PlanError { error: locate("controller.feedforward".into(), reason), conditions: vec![], observer: None })?);
             }
+            // A controller that reads the plant's samples (for ŵ, or measured tracked outputs) is
+            // one more subscriber to them, beside every observer and the recorder.
+            let reads_plant = fb.feedforward.is_some() || fb.integral.as_ref().is_some_and(|(_, _, m)| m.is_some());
+            if reads_plant && s.observers.len() >= scenario::limits::MAX_OBSERVERS {
+                let field = if c.feedforward { "controller.feedforward" } else { "controller.integral" };
+                let reason = format!(
+                    "this controller reads the plant's samples, as every observer does: with {} observers (bank members included) they would have more than the {} subscribers a service allows (one is the recorder); at most {} observers here",
+                    s.observers.len(),
+                    lockstep::settings::MAX_SUBSCRIBERS,
+                    scenario::limits::MAX_OBSERVERS - 1
+                );
+                return Err(PlanError { error: locate(field.into(), reason), conditions: vec![], observer: None });
+            }
             Some(fb)
         }
         None => None,

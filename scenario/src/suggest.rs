@@ -58,6 +58,6 @@ mod tests {
         assert_eq!(closest("Phi", ["A", "B", "Phi2"]), Some("Phi2"));
         assert_eq!(closest("zzz", ["poles", "gain"]), None);
         assert_eq!(did_you_mean("xyz", ["poles"]), "");
-        assert_eq!(did_you_mean("gian", ["gain"]), " (did you mean \"gain\"?)");
+        assert_eq!(did_you_mean("gian", ["gain"]), " (did you mean 'gain'?)");
     }
 }

@@ -124,3 +124,21 @@ fn feedforward_cancels_a_matched_unknown_input_and_refuses_an_unmatched_one() {
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("'luenberger' gives no estimate ŵ"), "{err}");
 }
+
+/// A controller that reads the plant's samples (integral action on a measured output) is one
+/// more subscriber to them: with 7 observers there would be 9 (the recorder too), more than a
+/// service allows — refused by name before anything runs.
+#[test]
+fn a_controller_reading_the_plant_counts_against_the_subscriber_limit() {
+    let s = Scratch::new("ctl-limit");
+    let text = std::fs::read_to_string(scenario("vehicle-lateral-integral")).unwrap();
+    let extra: String = (1..=5).map(|i| format!("[[observer]]\nname = \"l{i}\"\nkind = \"luenberger\"\npoles = [-8.0, -9.0, -10.0, -11.0]\n\n")).collect();
+    let text = text.replacen("[controller]", &format!("{extra}[controller]"), 1);
+    let path = s.join("many.toml");
+    std::fs::write(&path, text.split("[expect]").next().unwrap()).unwrap();
+    let out = launcher(&s).arg("run").arg(&path).arg("--out").arg(s.join("out")).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("controller.integral") && err.contains("at most 6 observers here"), "{err}");
+    assert!(!s.join("out").exists() || std::fs::read_dir(s.join("out")).unwrap().next().is_none());
+}
