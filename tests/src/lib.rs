@@ -185,3 +185,15 @@ pub fn variant(s: &Scratch, name: &str, seconds: f64, keep_expect: bool) -> Path
     std::fs::write(&p, out).unwrap();
     p
 }
+
+/// Runs `launcher run <path> --out <scratch>/out <args>`; returns its exit code, its stderr and
+/// how long it took, and asserts that it left nothing behind (processes, shared memory).
+pub fn run_checked(s: &Scratch, path: &Path, args: &[&str]) -> (Option<i32>, String, std::time::Duration) {
+    let started = std::time::Instant::now();
+    let child = launcher(s).arg("run").arg(path).arg("--out").arg(s.join("out")).args(args).stdout(std::process::Stdio::piped()).stderr(std::process::Stdio::piped()).spawn().unwrap();
+    let pid = child.id();
+    let out = child.wait_with_output().unwrap();
+    let took = started.elapsed();
+    assert_clean(s, pid);
+    (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned(), took)
+}

@@ -1,7 +1,7 @@
 //! Issue 11: components we did not write join a run through PROTOCOL.md — and one that breaks
 //! it is named, stops the run quickly, and leaves nothing behind.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use tests::*;
 
@@ -14,17 +14,6 @@ fn with_bad_observer(s: &Scratch, seconds: u32, command: &str, params: &str) -> 
     let p = s.join("bad.toml");
     std::fs::write(&p, text).unwrap();
     p
-}
-
-/// Runs `path`; returns exit code, stderr, how long it took; asserts nothing is left behind.
-fn run_checked(s: &Scratch, path: &std::path::Path) -> (Option<i32>, String, Duration) {
-    let started = Instant::now();
-    let child = launcher(s).arg("run").arg(path).arg("--out").arg(s.join("out")).stdout(std::process::Stdio::piped()).stderr(std::process::Stdio::piped()).spawn().unwrap();
-    let pid = child.id();
-    let out = child.wait_with_output().unwrap();
-    let took = started.elapsed();
-    assert_clean(s, pid);
-    (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned(), took)
 }
 
 #[test]
@@ -44,7 +33,7 @@ fn a_component_that_breaks_the_protocol_is_named_and_nothing_is_left() {
     for (fault, want) in cases {
         let s = Scratch::new(&format!("bad-{fault}"));
         let path = with_bad_observer(&s, 600, r#"["faulty_observer"]"#, &format!("{{ fault = \"{fault}\" }}"));
-        let (code, err, took) = run_checked(&s, &path);
+        let (code, err, took) = run_checked(&s, &path, &[]);
         assert_eq!(code, Some(3), "{fault}: {err}");
         assert!(want.iter().all(|w| err.contains(w)), "{fault}: {err}");
         assert!(took < Duration::from_secs(5), "{fault}: took {took:?}");
@@ -55,7 +44,7 @@ fn a_component_that_breaks_the_protocol_is_named_and_nothing_is_left() {
 fn a_hung_component_is_named_within_the_stall_timeout() {
     let s = Scratch::new("bad-hang");
     let path = with_bad_observer(&s, 600, r#"["faulty_observer"]"#, r#"{ fault = "hang" }"#);
-    let (code, err, took) = run_checked(&s, &path);
+    let (code, err, took) = run_checked(&s, &path, &[]);
     assert_eq!(code, Some(3), "{err}");
     assert!(err.contains("observer 'bad' (pid") && err.contains("published no sample for step 100"), "{err}");
     assert!(took < Duration::from_secs(9), "took {took:?}");
@@ -65,7 +54,7 @@ fn a_hung_component_is_named_within_the_stall_timeout() {
 fn a_component_that_never_says_ready_is_named() {
     let s = Scratch::new("bad-never-ready");
     let path = with_bad_observer(&s, 10, r#"["faulty_observer"]"#, r#"{ fault = "never_ready" }"#);
-    let (code, err, took) = run_checked(&s, &path);
+    let (code, err, took) = run_checked(&s, &path, &[]);
     assert_eq!(code, Some(3), "{err}");
     assert!(err.contains("observer 'bad' (pid") && err.contains("did not report ready within 20 s and is asleep, using no CPU"), "{err}");
     assert!(took < Duration::from_secs(25), "took {took:?}");
@@ -75,12 +64,12 @@ fn a_component_that_never_says_ready_is_named() {
 fn a_command_that_does_not_exist_is_named() {
     let s = Scratch::new("bad-command");
     let path = with_bad_observer(&s, 10, r#"["./no_such_program_uio"]"#, "{}");
-    let (code, err, _) = run_checked(&s, &path);
+    let (code, err, _) = run_checked(&s, &path, &[]);
     assert_eq!(code, Some(3), "{err}");
     assert!(err.contains("cannot start observer 'bad'") && err.contains("no_such_program_uio"), "{err}");
     // Nothing ran, so nothing is left: no recording, no summary, and a retry needs no --force.
     assert!(!s.join("out/seed002-sine.rrd").exists() && !s.join("out/seed002-sine.summary.json").exists());
-    let (code, err, _) = run_checked(&s, &path);
+    let (code, err, _) = run_checked(&s, &path, &[]);
     assert_eq!(code, Some(3), "{err}");
     assert!(!err.contains("already exists"), "{err}");
 }
@@ -126,7 +115,7 @@ fn a_python_component_that_hangs_in_its_step_is_named() {
     )
     .unwrap();
     let path = with_bad_observer(&s, 600, r#"["python3", "hang.py"]"#, "{}");
-    let (code, err, took) = run_checked(&s, &path);
+    let (code, err, took) = run_checked(&s, &path, &[]);
     assert_eq!(code, Some(3), "{err}");
     assert!(err.contains("observer 'bad' (pid") && err.contains("published no sample for step 100"), "{err}");
     assert!(took < Duration::from_secs(12), "took {took:?}");
@@ -143,7 +132,7 @@ fn the_kit_refuses_another_protocol_version() {
     let text = text.replacen("x0 = [1.0, -1.0, 2.0]\n", &format!("x0 = [1.0, -1.0, 2.0]\n{process}"), 1);
     let path = s.join("version.toml");
     std::fs::write(&path, text).unwrap();
-    let (code, err, _) = run_checked(&s, &path);
+    let (code, err, _) = run_checked(&s, &path, &[]);
     assert_eq!(code, Some(3), "{err}");
     assert!(err.contains("plant (pid") && err.contains("exited with status 2") && err.contains("before the run began") && err.contains("protocol version 2, this component 1"), "{err}");
 }
@@ -167,7 +156,7 @@ fn forged_stamps_break_the_protocol() {
     for (fault, want) in [("taken_max", "took its input at 18446744073709551615 ns, after it sent the sample"), ("nan_time", "sim_time is NaN")] {
         let s = Scratch::new(&format!("bad-{fault}"));
         let path = with_bad_observer(&s, 10, r#"["faulty_observer"]"#, &format!("{{ fault = \"{fault}\" }}"));
-        let (code, err, took) = run_checked(&s, &path);
+        let (code, err, took) = run_checked(&s, &path, &[]);
         assert_eq!(code, Some(3), "{fault}: {err}");
         assert!(err.contains("observer 'bad' broke the protocol at step 100") && err.contains(want), "{fault}: {err}");
         assert!(took < Duration::from_secs(5), "{fault}: took {took:?}");
@@ -180,7 +169,7 @@ fn forged_stamps_break_the_protocol() {
 fn a_component_that_closes_its_stdout_before_ready_is_named_at_once() {
     let s = Scratch::new("bad-close-stdout");
     let path = with_bad_observer(&s, 10, r#"["faulty_observer"]"#, r#"{ fault = "close_stdout" }"#);
-    let (code, err, took) = run_checked(&s, &path);
+    let (code, err, took) = run_checked(&s, &path, &[]);
     assert_eq!(code, Some(3), "{err}");
     assert!(err.contains("observer 'bad' (pid") && err.contains("closed its stdout before it reported ready"), "{err}");
     assert!(took < Duration::from_secs(3), "took {took:?}");

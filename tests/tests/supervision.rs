@@ -3,7 +3,7 @@
 //! running, or waiting for a core, it is waited for up to the stall limit (`stall_timeout`,
 //! `--stall-timeout`), and the message says which limit was hit.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use tests::*;
 
@@ -25,23 +25,13 @@ fn with_busy_observer(s: &Scratch, busy_s: f64, extra: &str) -> std::path::PathB
     p
 }
 
-fn run_timed(s: &Scratch, path: &std::path::Path, args: &[&str]) -> (Option<i32>, String, Duration) {
-    let started = Instant::now();
-    let child = launcher(s).arg("run").arg(path).arg("--out").arg(s.join("out")).args(args).stdout(std::process::Stdio::piped()).stderr(std::process::Stdio::piped()).spawn().unwrap();
-    let pid = child.id();
-    let out = child.wait_with_output().unwrap();
-    let took = started.elapsed();
-    assert_clean(s, pid);
-    (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned(), took)
-}
-
 /// A step that runs for 8 s, longer than the 5 s after which a blocked component is named, is
 /// waited for: the run completes.
 #[test]
 fn a_component_that_runs_long_is_waited_for() {
     let s = Scratch::new("busy-ok");
     let path = with_busy_observer(&s, 8.0, "");
-    let (code, err, took) = run_timed(&s, &path, &[]);
+    let (code, err, took) = run_checked(&s, &path, &[]);
     assert_eq!(code, Some(0), "{err}");
     assert!(took >= Duration::from_secs(8), "took {took:?}");
 }
@@ -53,7 +43,7 @@ fn a_component_past_the_stall_limit_is_named_with_the_limit() {
     for (extra, args) in [("", &["--stall-timeout", "5"][..]), ("stall_timeout = 5.0\n", &[][..]), ("stall_timeout = 5.0\n", &["--stall-timeout", "30"][..])] {
         let s = Scratch::new("busy-limit");
         let path = with_busy_observer(&s, 12.0, extra);
-        let (code, err, took) = run_timed(&s, &path, args);
+        let (code, err, took) = run_checked(&s, &path, args);
         if args.contains(&"30") {
             assert_eq!(code, Some(0), "{err}");
             continue;
@@ -65,7 +55,7 @@ fn a_component_past_the_stall_limit_is_named_with_the_limit() {
     // A limit below the 5 s of the blocked check is refused, naming the option.
     let s = Scratch::new("busy-bad-limit");
     let path = with_busy_observer(&s, 0.0, "");
-    let (code, err, _) = run_timed(&s, &path, &["--stall-timeout", "1"]);
+    let (code, err, _) = run_checked(&s, &path, &["--stall-timeout", "1"]);
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("--stall-timeout: 1 s must be between 5 s"), "{err}");
 }
@@ -84,7 +74,7 @@ fn seed002_runs_finish_under_a_cpu_hog_on_both_cores() {
             // The variant lives in the scratch directory: its components by absolute path.
             let text = std::fs::read_to_string(&path).unwrap().replace("\"../components/", &format!("\"{}/components/", repo().display()));
             std::fs::write(&path, text).unwrap();
-            let (code, err, _) = run_timed(&s, &path, &[]);
+            let (code, err, _) = run_checked(&s, &path, &[]);
             assert_eq!(code, Some(0), "{name} under load: {err}");
             if name.starts_with("cartpole") {
                 continue;
