@@ -128,8 +128,9 @@ fn handshake(procs: &mut [Proc], rx: &mpsc::Receiver<(usize, Option<String>)>, s
             Ok(_) | Err(mpsc::RecvTimeoutError::Timeout) => {}
             Err(mpsc::RecvTimeoutError::Disconnected) => {}
         }
-        if start.elapsed() > READY_TIMEOUT {
-            let slow: Vec<usize> = (0..procs.len()).filter(|&i| !ready[i]).collect();
+        let slow: Vec<usize> = (0..procs.len()).filter(|&i| !ready[i]).collect();
+        // (All may have become ready in this pass: the loop then ends.)
+        if start.elapsed() > READY_TIMEOUT && !slow.is_empty() {
             let w = watch.get_or_insert_with(|| liveness::Watch::new(&pgids));
             // One slow component judged per look, in turn.
             let mut named = None;
