@@ -21,6 +21,7 @@ fi
 # changes. Its bin/ goes first on PATH, so the launcher's `python3` is the environment's.
 venv="${UIO_VENV:-$PWD/.venv}"
 stamp="$venv/.uio-installed"
+"$venv/bin/python3" -c 'import fmpy' 2>/dev/null || rm -f "$stamp"  # test FMUs (issue 22): fmpy
 if [ ! -x "$venv/bin/python3" ] || [ ! -e "$stamp" ] \
    || [ -n "$(find python/pyproject.toml python/uio_component -newer "$stamp" -print -quit)" ]; then
   if ! python3 -c 'import ensurepip, venv' 2>/dev/null; then
@@ -31,7 +32,7 @@ if [ ! -x "$venv/bin/python3" ] || [ ! -e "$stamp" ] \
   fi
   echo "preparing the Python environment $venv"
   [ -x "$venv/bin/python3" ] || python3 -m venv "$venv"
-  "$venv/bin/pip" install -q --disable-pip-version-check ./python pytest scipy
+  "$venv/bin/pip" install -q --disable-pip-version-check ./python pytest scipy fmpy  # fmpy: test FMUs (issue 22)
   touch "$stamp"
 fi
 export PATH="$venv/bin:$PATH"
@@ -44,6 +45,9 @@ trap 'rm -f "$log"' EXIT
 cargo test --release --workspace 2>&1 | tee "$log"
 # The same design tests with the LMI solver compiled in.
 cargo test --release -p observer --features lmi 2>&1 | tee -a "$log"
+
+# test FMUs (issue 22): FMI 2.0/3.0 co-simulation FMUs from fmu/testfmus, for test_fmu_testfmus.py
+export UIO_TEST_FMUS="${CARGO_TARGET_DIR:-$PWD/target}/testfmus"; fmu/testfmus/build.sh "$UIO_TEST_FMUS"
 
 # The Python kit and components.
 python -m pytest -q python/tests 2>&1 | tee -a "$log"
