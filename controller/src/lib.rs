@@ -11,6 +11,7 @@
 pub mod design;
 pub mod shell;
 
+use lti::input_estimate::InputEstimateStep;
 use lti::kernel::{mul_acc, mul_into};
 use lti::signal::Signal;
 use lti::MatData;
@@ -36,6 +37,14 @@ pub struct ControllerConfig {
     /// Cancellation of the unknown input, if asked.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub feedforward: Option<FeedforwardConfig>,
+}
+
+impl ControllerConfig {
+    /// Whether the controller reads the plant's samples as well as its observer's: for ŵ, or for
+    /// measured tracked outputs.
+    pub fn reads_plant(&self) -> bool {
+        self.feedforward.is_some() || self.integral.as_ref().is_some_and(|i| i.y.is_some())
+    }
 }
 
 /// The integrators ξ_{k+1} = ξ_k + dt (r_k − z_k) and their gain. The tracked outputs z = C_t x
@@ -80,6 +89,7 @@ pub struct Controller {
     u: DVector<f64>,
     integral: Option<Integral>,
     feedforward: Option<Feedforward>,
+    reads_plant: bool,
 }
 
 #[derive(Debug, Clone)]
@@ -93,14 +103,10 @@ struct Integral {
 
 #[derive(Debug, Clone)]
 struct Feedforward {
-    mw: DMatrix<f64>,
-    neg_mw_c_phi: DMatrix<f64>,
-    neg_mw_c_gamma_b: DMatrix<f64>,
+    /// Mŵ_{k−1}, with M folded into W, WCΦ and WCΓ_B.
+    m_what: InputEstimateStep,
     y: std::ops::Range<usize>,
     u_prev: std::ops::Range<usize>,
-    prev_xhat: Vec<f64>,
-    started: bool,
-    mw_hat: DVector<f64>,
 }
 
 impl Controller {
@@ -137,15 +143,15 @@ impl Controller {
                 if mw.shape() != (l, y.len()) || a.shape() != (l, nx) || b.shape() != (l, l) || u_prev.len() != l {
                     return Err("feedforward: MW, MWCΦ, MWCΓ_B and the sample's ranges do not conform".to_string());
                 }
-                Ok(Feedforward { mw, neg_mw_c_phi: -a, neg_mw_c_gamma_b: -b, y, u_prev, prev_xhat: vec![0.0; nx], started: false, mw_hat: DVector::zeros(l) })
+                Ok(Feedforward { m_what: InputEstimateStep::new(mw, &a, &b), y, u_prev })
             })
             .transpose()?;
-        Ok(Self { gx: DVector::zeros(l), u: DVector::zeros(l), r: DVector::zeros(l), g, n, references: cfg.references.clone(), dt: cfg.dt, integral, feedforward })
+        Ok(Self { gx: DVector::zeros(l), u: DVector::zeros(l), r: DVector::zeros(l), g, n, references: cfg.references.clone(), dt: cfg.dt, integral, feedforward, reads_plant: cfg.reads_plant() })
     }
 
     /// Whether it reads the plant's sample (for ŵ, or measured tracked outputs).
     pub fn reads_plant(&self) -> bool {
-        self.feedforward.is_some() || self.integral.as_ref().is_some_and(|i| i.y.is_some())
+        self.reads_plant
     }
 
     /// u_k = N r(t_k) − G x̂_k (− G_ξ ξ_k − M ŵ_{k−1}); `plant` is the plant's sample k, read only
@@ -169,16 +175,11 @@ impl Controller {
         }
         if let Some(f) = &mut self.feedforward {
             // M ŵ_{k−1} once there is an x̂_{k−1}; nothing is cancelled at k = 0.
-            if f.started {
-                mul_into(f.mw_hat.as_mut_slice(), &f.mw, &plant[f.y.clone()]);
-                mul_acc(f.mw_hat.as_mut_slice(), &f.neg_mw_c_phi, &f.prev_xhat);
-                mul_acc(f.mw_hat.as_mut_slice(), &f.neg_mw_c_gamma_b, &plant[f.u_prev.clone()]);
-                for (gx, m) in self.gx.iter_mut().zip(f.mw_hat.iter()) {
+            if f.m_what.push(&plant[f.y.clone()], &plant[f.u_prev.clone()], xhat) {
+                for (gx, m) in self.gx.iter_mut().zip(&f.m_what.value) {
                     *gx += m;
                 }
             }
-            f.prev_xhat.copy_from_slice(xhat);
-            f.started = true;
         }
         for (u, gx) in self.u.iter_mut().zip(self.gx.iter()) {
             *u -= gx;

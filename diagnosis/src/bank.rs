@@ -20,7 +20,7 @@ use observer::{design, Designed, Spec};
 use crate::covariance::residual_covariance;
 use crate::evaluate::threshold_for;
 use crate::spec::{Channels, DiagnoserSpec, MemberKind, Scheme};
-use crate::structure::{reacts, steady_state, FaultInput, BLIND};
+use crate::structure::{reacts, FaultInput, SteadyState, BLIND};
 
 /// One residual generator.
 #[derive(Debug, Clone)]
@@ -51,7 +51,7 @@ pub struct Bank {
     /// Computed structure matrix: `structure[i][j]` = 1 if residual i reacts to channel j.
     pub structure: Vec<Vec<u8>>,
     /// The steady-state structure: `steady[i][j]` = 1 if residual i stays away from 0 under a
-    /// constant fault on channel j ([`crate::structure::steady_state`]); `None` when a member's
+    /// constant fault on channel j ([`crate::structure::SteadyState`]); `None` when a member's
     /// state is not a function of x (its T cannot be formed).
     pub steady: Option<Vec<Vec<u8>>>,
     /// Labels of the channels it watches, e.g. "u1", "y3", "f2".
@@ -173,7 +173,7 @@ pub fn design_bank(spec: &DiagnoserSpec, model: &Model, ff: &Mat, dt: f64, noise
     // Under a constant fault: which residuals stay away from zero.
     let steady: Option<Vec<Vec<u8>>> = members
         .iter()
-        .map(|mb| inputs.iter().map(|inp| steady_state(&dm.a, &dm.c, &mb.designed.runtime, &mb.outputs, inp).map(|g| u8::from(g > BLIND))).collect::<Option<Vec<u8>>>())
+        .map(|mb| SteadyState::new(&dm.a, &dm.c, &mb.designed.runtime, &mb.outputs).map(|ss| inputs.iter().map(|inp| u8::from(ss.response(inp) > BLIND)).collect()))
         .collect();
     for (i, mb) in members.iter_mut().enumerate() {
         if let Some((qd, r)) = noise {

@@ -69,9 +69,8 @@ pub fn sensitivity(phi: &Mat, c: &Mat, obs: &LinearObserver, outputs: &[usize], 
     worst
 }
 
-/// The relative steady-state response of the residual to a constant fault: ≈ ε when it returns
-/// to zero once the transient has passed (a UIO member's residual under a sensor bias, say),
-/// O(1e-3 … 1) when it stays; `None` when it cannot be formed.
+/// A member's residual in steady state: its DC response to each constant fault, formed once per
+/// member (T, (I − F)⁻¹, SCP) and then per fault.
 ///
 /// The observer's state tracks z → Tx, with T from its unbiased output map PT + QC = I
 /// (T = P⁺(I − QC), P of full column rank) and checked against TΦ − FT = KC. Then ζ = z − Tx
@@ -81,32 +80,49 @@ pub fn sensitivity(phi: &Mat, c: &Mat, obs: &LinearObserver, outputs: &[usize], 
 /// ```text
 /// r_ss = D_f − SCP (I − F)⁻¹ b,      b = −Tγ (through the state)  or  K e_j (on output j).
 /// ```
-///
-/// It is measured relative to ‖D_f‖ + ‖SCP‖‖(I − F)⁻¹‖‖b‖ (with ‖T‖‖γ‖ for ‖Tγ‖), the size the
-/// terms that form it would have without cancellation.
-pub fn steady_state(phi: &Mat, c: &Mat, obs: &LinearObserver, outputs: &[usize], input: &FaultInput) -> Option<f64> {
-    let Residual { f, k, p, q, s, i_cq, cp } = Residual::new(c, obs, outputs);
-    let n = phi.nrows();
-    let t = lti::pinv::pinv(&p) * (Mat::identity(n, n) - &q * c);
-    // T must make z an estimate of Tx: TΦ − FT = KC (and PT + QC = I).
-    let sylvester = (&t * phi - &f * &t - &k * c).norm();
-    let unbiased = (&p * &t + &q * c - Mat::identity(n, n)).norm();
-    let scale = (t.norm() * (phi.norm() + f.norm()) + k.norm() * c.norm()).max(1.0);
-    if sylvester > 1e-8 * scale || unbiased > 1e-8 * (1.0 + p.norm() * t.norm()) {
-        return None;
+#[derive(Debug, Clone)]
+pub struct SteadyState {
+    t: Mat,
+    k: Mat,
+    s_i_cq: Mat,
+    scp: Mat,
+    resolvent: Mat,
+}
+
+impl SteadyState {
+    /// For observer `obs` of the sampled plant (Φ, C), residual on `outputs`; `None` when its
+    /// state is not a function of x (no T) or F has an eigenvalue at 1.
+    pub fn new(phi: &Mat, c: &Mat, obs: &LinearObserver, outputs: &[usize]) -> Option<Self> {
+        let Residual { f, k, p, q, s, i_cq, cp } = Residual::new(c, obs, outputs);
+        let n = phi.nrows();
+        let t = lti::pinv::pinv(&p) * (Mat::identity(n, n) - &q * c);
+        // T must make z an estimate of Tx: TΦ − FT = KC (and PT + QC = I).
+        let sylvester = (&t * phi - &f * &t - &k * c).norm();
+        let unbiased = (&p * &t + &q * c - Mat::identity(n, n)).norm();
+        let scale = (t.norm() * (phi.norm() + f.norm()) + k.norm() * c.norm()).max(1.0);
+        if sylvester > 1e-8 * scale || unbiased > 1e-8 * (1.0 + p.norm() * t.norm()) {
+            return None;
+        }
+        let r = f.nrows();
+        let resolvent = (Mat::identity(r, r) - &f).try_inverse()?;
+        Some(SteadyState { scp: &s * &cp, s_i_cq: &s * &i_cq, t, k, resolvent })
     }
-    let r = f.nrows();
-    let resolvent = (Mat::identity(r, r) - &f).try_inverse()?;
-    let (b, b_scale, direct) = match input {
-        FaultInput::State(g) => (-(&t * g), t.norm() * g.norm(), DVector::zeros(outputs.len())),
-        FaultInput::Output(j) => (k.column(*j).into_owned(), k.column(*j).norm(), &s * i_cq.column(*j)),
-    };
-    let scp = &s * &cp;
-    let through = &scp * (&resolvent * &b);
-    let rss = &direct - &through;
-    // The size the response would have if nothing cancelled (a decoupled Tγ is rounding of ‖T‖‖γ‖).
-    let size = direct.norm() + scp.norm() * resolvent.norm() * b_scale;
-    Some(if size > 0.0 { rss.norm() / size } else { 0.0 })
+
+    /// The relative steady-state response to a constant fault: ≈ ε when the residual returns to
+    /// zero once the transient has passed (a UIO member's under a sensor bias, say), O(1e-3 … 1)
+    /// when it stays. Measured relative to ‖D_f‖ + ‖SCP‖‖(I − F)⁻¹‖‖b‖ (with ‖T‖‖γ‖ for ‖Tγ‖),
+    /// the size the terms that form it would have without cancellation.
+    pub fn response(&self, input: &FaultInput) -> f64 {
+        let (b, b_scale, direct) = match input {
+            FaultInput::State(g) => (-(&self.t * g), self.t.norm() * g.norm(), DVector::zeros(self.scp.nrows())),
+            FaultInput::Output(j) => (self.k.column(*j).into_owned(), self.k.column(*j).norm(), self.s_i_cq.column(*j).into_owned()),
+        };
+        let through = &self.scp * (&self.resolvent * &b);
+        let rss = &direct - &through;
+        // The size the response would have if nothing cancelled (a decoupled Tγ is rounding of ‖T‖‖γ‖).
+        let size = direct.norm() + self.scp.norm() * self.resolvent.norm() * b_scale;
+        if size > 0.0 { rss.norm() / size } else { 0.0 }
+    }
 }
 
 /// Whether the residual reacts to the fault.

@@ -270,9 +270,9 @@ fn main() -> ExitCode {
                 Err(e) => return fail(&e),
             };
             if let Some(t) = stall_timeout {
-                match scenario::limits::stall_timeout("--stall-timeout", t) {
+                match scenario::limits::stall_timeout(t) {
                     Ok(t) => s.stall_timeout = t,
-                    Err(e) => return fail(&LaunchError::BadInput(e)),
+                    Err(e) => return fail(&LaunchError::BadInput(format!("--stall-timeout: {e}"))),
                 }
             }
             if let Some(x) = realtime

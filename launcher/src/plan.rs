@@ -98,8 +98,7 @@ pub fn complete(s: &Scenario, banks: Vec<Bank>, own: Vec<Option<Designed>>) -> R
             }
             // A controller that reads the plant's samples (for ŵ, or measured tracked outputs) is
             // one more subscriber to them, beside every observer and the recorder.
-            let reads_plant = fb.feedforward.is_some() || fb.integral.as_ref().is_some_and(|(_, _, m)| m.is_some());
-            if reads_plant && s.observers.len() >= scenario::limits::MAX_OBSERVERS {
+            if fb.reads_plant() && s.observers.len() >= scenario::limits::MAX_OBSERVERS {
                 let field = if c.feedforward { "controller.feedforward" } else { "controller.integral" };
                 let reason = format!(
                     "this controller reads the plant's samples, as every observer does: with {} observers (bank members included) they would have more than the {} subscribers a service allows (one is the recorder); at most {} observers here",

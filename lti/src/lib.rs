@@ -11,7 +11,8 @@
 //! * [`model`], [`discretize`], [`expm`] — the plant model, its exact zero-order-hold sampling and
 //!   the matrix exponential behind it;
 //! * [`van_loan`] — the discrete covariance of continuous white process noise over a step;
-//! * [`signal`] — the known-input and disturbance signals of a scenario.
+//! * [`signal`] — the known-input and disturbance signals of a scenario;
+//! * [`input_estimate`] — the unknown input ŵ, one sample late, from an observer's estimate.
 
 pub mod dare;
 pub(crate) mod dd;
@@ -20,6 +21,7 @@ pub mod eig;
 pub mod error;
 pub mod expm;
 pub mod householder;
+pub mod input_estimate;
 pub mod kernel;
 pub mod lyapunov;
 pub mod model;

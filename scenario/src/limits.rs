@@ -30,11 +30,12 @@ pub const STALL_TIMEOUT: f64 = 60.0;
 /// The largest stall limit accepted, s (a day).
 pub const MAX_STALL_TIMEOUT: f64 = 86_400.0;
 
-/// A stall limit: at least the 5 s after which a blocked component is named, at most a day.
-pub fn stall_timeout(field: &str, v: f64) -> Result<f64, String> {
+/// A stall limit: at least the 5 s after which a blocked component is named, at most a day; the
+/// reason otherwise (the caller names the field or option).
+pub fn stall_timeout(v: f64) -> Result<f64, String> {
     if v.is_finite() && (5.0..=MAX_STALL_TIMEOUT).contains(&v) {
         Ok(v)
     } else {
-        Err(format!("{field}: {v} s must be between 5 s (when a stopped or blocked component is named) and {MAX_STALL_TIMEOUT} s"))
+        Err(format!("{v} s must be between 5 s (when a stopped or blocked component is named) and {MAX_STALL_TIMEOUT} s"))
     }
 }

@@ -358,7 +358,7 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
     };
     let stall_timeout = match raw.stall_timeout {
         None => crate::limits::STALL_TIMEOUT,
-        Some(v) => crate::limits::stall_timeout("stall_timeout", v).map_err(|r| bad("stall_timeout", r.split_once(": ").map_or(r.clone(), |(_, x)| x.to_string())))?,
+        Some(v) => crate::limits::stall_timeout(v).map_err(|r| bad("stall_timeout", r))?,
     };
     let mut taken = seen.clone();
     let diagnosers = super::fault_diagnosis::diagnosers(&raw.diagnoser, &model, &ff, noise.as_ref(), &mut taken)?;

@@ -106,6 +106,11 @@ impl FeedbackDesign {
         self.unstable.is_empty() && self.discrete_closed_loop.iter().all(|z| z.norm() < 1.0)
     }
 
+    /// Whether the controller will read the plant's samples (for ŵ, or measured tracked outputs).
+    pub fn reads_plant(&self) -> bool {
+        self.feedforward.is_some() || self.integral.as_ref().is_some_and(|(_, _, m)| m.is_some())
+    }
+
     /// "unstable closed loop: eig(A − BG) has +122.271" style description, if unstable.
     pub fn instability(&self) -> Option<String> {
         if !self.unstable.is_empty() {

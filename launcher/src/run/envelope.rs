@@ -3,6 +3,7 @@
 
 use std::collections::BTreeMap;
 
+use controller::ControllerConfig;
 use lockstep::component::{ComponentConfig, Iceoryx2Place, PublishSpec, ReadSpec, Role};
 use lockstep::{PlantLayout, RunSpace, Wait, FOLLOWER_LAG, PROTOCOL_VERSION};
 use scenario::{Named, ProcessSpec, Scenario};
@@ -143,7 +144,7 @@ pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> V
         let publishes = PublishSpec { service: "controller".into(), len: lay.l, names: names(&s.names.input).iter().enumerate().map(|(i, _)| format!("u{}", i + 1)).collect() };
         let mut reads = vec![ReadSpec { service: format!("observer/{}", c.observer), len: lay.n, lag: 0, sleep_us: None, fields: BTreeMap::new() }];
         // ŵ is made from the plant's y_k and u_{k−1}, and measured tracked outputs from its y_k.
-        if cfg.controller.as_ref().is_some_and(|cc| cc.feedforward.is_some() || cc.integral.as_ref().is_some_and(|i| i.y.is_some())) {
+        if cfg.controller.as_ref().is_some_and(ControllerConfig::reads_plant) {
             reads.push(plant_read(None));
         }
         let (program, params) = match (&c.process, &cfg.controller) {

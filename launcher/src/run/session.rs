@@ -441,7 +441,7 @@ impl Session {
             sink.row(g, k - 1, (k - 1) as f64 * self.dt);
             for (oc, what) in ch.observers.iter().zip(&self.metrics.what) {
                 if let (Some(oc), Some(what)) = (oc, what) {
-                    put(sink, &oc.what, &what.value);
+                    put(sink, &oc.what, what.value());
                 }
             }
         }

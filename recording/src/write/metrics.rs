@@ -73,10 +73,9 @@ pub struct Metrics {
     pub residual: Vec<Vec<f64>>,
     /// Per observer, its unknown-input estimate ŵ when it has one.
     pub what: Vec<Option<InputEstimate>>,
-    /// The first step a fault acts in, and per observer [tail max|e|, tail max|r|, max|e|] over
-    /// the steps before it ([`FaultFree`]).
-    fault_free: Option<(u64, Vec<[f64; 3]>)>,
-    dt: f64,
+    /// The first step a fault acts in, its time, and per observer [tail max|e|, tail max|r|,
+    /// max|e|] over the steps before it ([`FaultFree`]).
+    fault_free: Option<(u64, f64, Vec<[f64; 3]>)>,
 }
 
 impl Metrics {
@@ -102,15 +101,13 @@ impl Metrics {
             residual: vec![vec![0.0; layout.p]; observers],
             what: vec![None; observers],
             fault_free: None,
-            dt: 0.0,
         }
     }
 
     /// The run's first fault acts from step `first` (of period dt): figures are kept for the
     /// steps before it too.
     pub fn fault_free_until(&mut self, first: u64, dt: f64) {
-        self.fault_free = Some((first, vec![[0.0; 3]; self.observers.len()]));
-        self.dt = dt;
+        self.fault_free = Some((first, first as f64 * dt, vec![[0.0; 3]; self.observers.len()]));
     }
 
     /// Observer `o` estimates the unknown inputs: ŵ_k = W y_{k+1} − (WCΦ) x̂_k − (WCΓ_B) u_k.
@@ -133,12 +130,12 @@ impl Metrics {
             f.tail_max_abs_residual = start.map(|s| if completed { exact[1] } else { r.max_from(s) });
             f.tail_max_abs_input_error = what.as_ref().and_then(|w| start.map(|s| w.tail_max_abs_error(s, completed)));
         }
-        if let Some((first, ff)) = &self.fault_free
+        if let Some((first, until, ff)) = &self.fault_free
             && *first / 4 > 0
             && self.steps >= *first
         {
             for (f, m) in self.observers.iter_mut().zip(ff) {
-                f.fault_free = Some(FaultFree { until: *first as f64 * self.dt, tail_max_abs_error: m[0], tail_max_abs_residual: m[1], max_abs_error: m[2] });
+                f.fault_free = Some(FaultFree { until: *until, tail_max_abs_error: m[0], tail_max_abs_residual: m[1], max_abs_error: m[2] });
             }
         }
     }
@@ -175,7 +172,7 @@ impl Metrics {
                 x[0] = nan_max(x[0], emax);
                 x[1] = nan_max(x[1], rmax);
             }
-            if let Some((first, ff)) = &mut self.fault_free
+            if let Some((first, _, ff)) = &mut self.fault_free
                 && row.k < *first
             {
                 let m = &mut ff[o];

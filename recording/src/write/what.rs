@@ -8,25 +8,18 @@
 //! recorded at t_k, beside the w_k it estimates; its error is w_k − ŵ_k with w_k the plant's
 //! recorded w(t_k) — the value held over the step for steps and piecewise inputs.
 
-use lti::kernel::{mul_acc, mul_into};
+use lti::input_estimate::InputEstimateStep;
 use lti::Mat;
 
 use super::metrics::nan_max;
 use super::tail::BlockMax;
 
-/// One observer's ŵ, step by step.
+/// One observer's ŵ, step by step, and its error against the recorded w.
 #[derive(Debug, Clone)]
 pub struct InputEstimate {
-    w: Mat,
-    /// −WCΦ and −WCΓ_B, so that one pass of products and sums forms ŵ.
-    neg_w_c_phi: Mat,
-    neg_w_c_gamma_b: Mat,
-    prev_xhat: Vec<f64>,
+    step: InputEstimateStep,
     prev_w: Vec<f64>,
-    started: bool,
-    /// ŵ_{k−1}, completed by the last row (valid when `ready`).
-    pub value: Vec<f64>,
-    /// Whether `value` holds ŵ_{k−1} (false at the first row).
+    /// Whether `value()` holds ŵ_{k−1} (false at the first row).
     pub ready: bool,
     /// max_j |w_j − ŵ_j| of each completed estimate, by the step it estimates.
     errors: BlockMax,
@@ -37,40 +30,27 @@ pub struct InputEstimate {
 impl InputEstimate {
     /// From W, WCΦ, WCΓ_B, for a run of `steps` steps whose tail starts at `planned_tail`.
     pub fn new(w: Mat, w_c_phi: &Mat, w_c_gamma_b: &Mat, steps: u64, planned_tail: u64) -> Self {
-        let (q, n) = (w.nrows(), w_c_phi.ncols());
-        InputEstimate {
-            w,
-            neg_w_c_phi: -w_c_phi,
-            neg_w_c_gamma_b: -w_c_gamma_b,
-            prev_xhat: vec![0.0; n],
-            prev_w: vec![0.0; q],
-            started: false,
-            value: vec![0.0; q],
-            ready: false,
-            errors: BlockMax::new(steps),
-            exact_tail: 0.0,
-            planned_tail,
-        }
+        let q = w.nrows();
+        InputEstimate { step: InputEstimateStep::new(w, w_c_phi, w_c_gamma_b), prev_w: vec![0.0; q], ready: false, errors: BlockMax::new(steps), exact_tail: 0.0, planned_tail }
+    }
+
+    /// ŵ_{k−1}, completed by the last row (valid when `ready`).
+    pub fn value(&self) -> &[f64] {
+        &self.step.value
     }
 
     /// Row k: y_k, u_{k−1} (what the plant held over step k − 1), w(t_k) and x̂_k.
     pub fn push(&mut self, k: u64, y: &[f64], u_prev: &[f64], w: &[f64], xhat: &[f64]) {
-        self.ready = self.started;
-        if self.started {
-            mul_into(&mut self.value, &self.w, y);
-            mul_acc(&mut self.value, &self.neg_w_c_phi, &self.prev_xhat);
-            mul_acc(&mut self.value, &self.neg_w_c_gamma_b, u_prev);
-            let err = self.value.iter().zip(&self.prev_w).fold(0.0, |m, (a, b)| nan_max(m, (a - b).abs()));
+        self.ready = self.step.push(y, u_prev, xhat);
+        if self.ready {
+            let err = self.step.value.iter().zip(&self.prev_w).fold(0.0, |m, (a, b)| nan_max(m, (a - b).abs()));
             self.errors.push(k - 1, err);
             if k > self.planned_tail {
                 self.exact_tail = nan_max(self.exact_tail, err);
             }
         }
-        self.prev_xhat.copy_from_slice(xhat);
         self.prev_w.copy_from_slice(w);
-        self.started = true;
     }
-
     /// max |w − ŵ| over the tail [start, …) of the estimates completed; exact for a completed run.
     pub fn tail_max_abs_error(&self, start: u64, completed: bool) -> f64 {
         if completed { self.exact_tail } else { self.errors.max_from(start) }

@@ -1,0 +1,75 @@
+//! The unknown input, one sample late, from an observer's estimate (the recursion of
+//! `observer::design::InputEstimator`):
+//!
+//! ```text
+//! ŵ_{k−1} = W y_k − (WCΦ) x̂_{k−1} − (WCΓ_B) u_{k−1}
+//! ```
+//!
+//! It needs y_k, so ŵ_{k−1} completes with sample k. A left factor M may be folded into all three
+//! matrices (MW, MWCΦ, MWCΓ_B) to get Mŵ directly — the controller's cancellation of w. One pass
+//! of products and sums, in a fixed order, so the recorder and the controller form the same bits.
+
+use crate::kernel::{mul_acc, mul_into};
+use crate::Mat;
+
+/// ŵ_{k−1} from sample k, step by step.
+#[derive(Debug, Clone)]
+pub struct InputEstimateStep {
+    w: Mat,
+    /// −WCΦ and −WCΓ_B, so that one pass of products and sums forms ŵ.
+    neg_w_c_phi: Mat,
+    neg_w_c_gamma_b: Mat,
+    prev_xhat: Vec<f64>,
+    started: bool,
+    /// ŵ_{k−1}, completed by the last sample (valid once [`Self::push`] returned true).
+    pub value: Vec<f64>,
+}
+
+impl InputEstimateStep {
+    /// From W (q×p), WCΦ (q×n) and WCΓ_B (q×l).
+    pub fn new(w: Mat, w_c_phi: &Mat, w_c_gamma_b: &Mat) -> Self {
+        let (q, n) = (w.nrows(), w_c_phi.ncols());
+        InputEstimateStep { w, neg_w_c_phi: -w_c_phi, neg_w_c_gamma_b: -w_c_gamma_b, prev_xhat: vec![0.0; n], started: false, value: vec![0.0; q] }
+    }
+
+    /// Sample k: y_k, the u_{k−1} the plant held over step k − 1, and x̂_k. Returns whether
+    /// `value` now holds ŵ_{k−1} (false at the first sample).
+    pub fn push(&mut self, y: &[f64], u_prev: &[f64], xhat: &[f64]) -> bool {
+        let ready = self.started;
+        if ready {
+            mul_into(&mut self.value, &self.w, y);
+            mul_acc(&mut self.value, &self.neg_w_c_phi, &self.prev_xhat);
+            mul_acc(&mut self.value, &self.neg_w_c_gamma_b, u_prev);
+        }
+        self.prev_xhat.copy_from_slice(xhat);
+        self.started = true;
+        ready
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// For x_{k+1} = Φx_k + Γ_Bu_k + Γ_Ew_k, y = Cx and x̂ = x, the recursion gives back w_{k−1}.
+    #[test]
+    fn it_recovers_the_unknown_input_of_a_sampled_plant() {
+        let phi = Mat::from_row_slice(2, 2, &[0.9, 0.1, 0.0, 0.8]);
+        let (gb, ge, c) = (Mat::from_row_slice(2, 1, &[0.0, 1.0]), Mat::from_row_slice(2, 1, &[1.0, 0.5]), Mat::identity(2, 2));
+        let w = crate::pinv::pinv(&(&c * &ge));
+        let mut est = InputEstimateStep::new(w.clone(), &(&w * &c * &phi), &(&w * &c * &gb));
+        let mut x = nalgebra::DVector::from_vec(vec![1.0, -1.0]);
+        let mut u_prev = [0.0];
+        let mut w_prev = 0.0;
+        for k in 0..20 {
+            let y = &c * &x;
+            if est.push(y.as_slice(), &u_prev, x.as_slice()) {
+                assert!((est.value[0] - w_prev).abs() < 1e-12, "step {k}: {} vs {w_prev}", est.value[0]);
+            }
+            let (u, wk) = ((k as f64).sin(), 0.3 * k as f64);
+            x = &phi * &x + &gb * u + &ge * wk;
+            u_prev = [u];
+            w_prev = wk;
+        }
+    }
+}
