@@ -89,9 +89,8 @@ pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> V
         signals: Value::Null,
         params,
         pace_s: None,
-        // Above the launcher's stall limit: it names a stall first, and a component waits for a
-        // starved peer as long as the launcher does.
-        inlet_timeout_s: Some(s.stall_timeout + super::processes::STALL_BLOCKED.as_secs_f64()),
+        // Set below for the components on this host.
+        inlet_timeout_s: None,
     };
     let plant_read = |sleep_us| ReadSpec { service: "plant".into(), len: lay.len(), lag: 0, sleep_us, fields: fields(lay) };
     let estimate = |name: &str| PublishSpec { service: format!("observer/{name}"), len: lay.n, names: names(&s.names.state) };
@@ -160,6 +159,12 @@ pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> V
         if let (Program::Builtin(kind), Some(r)) = (&c.program, s.remote.get(&c.config.name)) {
             c.label = format!("{} (on host {})", c.label, r.host);
             c.program = Program::Remote(kind, r.clone());
+        } else {
+            // Above the launcher's stall limit: it names a stall first, and a component waits
+            // for a starved peer as long as the launcher does. Not on another host: the
+            // launcher cannot see that host's kernel, names a stall there after 5 s, and a
+            // component left waiting there (its run gone) would spin the default 10 s only.
+            c.config.inlet_timeout_s = Some(s.stall_timeout + super::processes::STALL_BLOCKED.as_secs_f64());
         }
     }
     out
