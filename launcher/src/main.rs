@@ -13,6 +13,8 @@ use launcher::{design_report, plan, run};
 use scenario::Scenario;
 use lockstep::Wait;
 
+mod export_fmu;
+
 #[derive(Parser)]
 #[command(name = "launcher", version, about = "Design and co-simulate unknown input observers for LTI plants")]
 struct Cli {
@@ -202,6 +204,20 @@ enum Command {
         /// Output directory.
         #[arg(long)]
         csv: PathBuf,
+    },
+    /// Write one of a scenario's observers as an FMI co-simulation FMU, DIR/<observer>_fmi<2|3>.fmu.
+    ExportFmu {
+        /// The scenario file, or the name of a shipped scenario (see `list`).
+        scenario: PathBuf,
+        /// The observer's name.
+        #[arg(long)]
+        observer: String,
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+        /// FMI version.
+        #[arg(long, value_parser = ["2", "3"], default_value = "3")]
+        fmi: String,
     },
     /// Run one component (used by the launcher when the component binaries are not beside it).
     #[command(hide = true, disable_help_flag = true)]
@@ -483,6 +499,16 @@ fn main() -> ExitCode {
                     ExitCode::SUCCESS
                 }
                 Err(e) => fail(&LaunchError::BadInput(e)),
+            }
+        }
+        Command::ExportFmu { scenario, observer, out, fmi } => {
+            let fmi = if fmi == "2" { fmu_export::Fmi::V2 } else { fmu_export::Fmi::V3 };
+            match load(&scenario).and_then(|s| export_fmu::export_fmu(&s, &observer, &out, fmi)) {
+                Ok(path) => {
+                    println!("{}", path.display());
+                    ExitCode::SUCCESS
+                }
+                Err(e) => fail(&e),
             }
         }
         Command::Component { kind, args } => component(&kind, args),
