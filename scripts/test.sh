@@ -6,11 +6,14 @@ cd "$(dirname "$0")/.."
 
 # The Hui–Żak LMI path (feature observer/lmi) links the system OpenBLAS, which needs gfortran's
 # runtime to link against. Debian package names; installed once per machine.
+# The FMU plant (fmu/plant) imports FMUs through the `fmi` crate, whose FFI bindings bindgen
+# makes at build time from libclang.
 need=()
 ldconfig -p | grep -q 'libopenblas\.so ' || need+=(libopenblas-dev)
 ldconfig -p | grep -q 'libgfortran\.so ' || need+=(libgfortran-12-dev)
+ldconfig -p | grep -Eq 'libclang(-[0-9.]+)?\.so ' || need+=(libclang-dev)
 if [ ${#need[@]} -gt 0 ]; then
-  echo "installing ${need[*]} (for the LMI design path)"
+  echo "installing ${need[*]} (for the LMI design path and the FMU import's bindings)"
   sudo=""; [ "$(id -u)" -eq 0 ] || sudo="sudo"
   $sudo apt-get install -y --no-install-recommends "${need[@]}" >/dev/null \
     || { $sudo apt-get update >/dev/null && $sudo apt-get install -y --no-install-recommends "${need[@]}" >/dev/null; }
@@ -39,6 +42,8 @@ export PATH="$venv/bin:$PATH"
 
 # The multi-process tests start the component binaries: build them all first.
 cargo build --release --workspace --bins
+# The observer FMUs' library (a cdylib, which --bins does not build), for `launcher export-fmu`.
+cargo build --release -p fmu-observer
 
 log=$(mktemp)
 trap 'rm -f "$log"' EXIT

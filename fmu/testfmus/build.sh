@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Test FMUs (issue 22): builds OUTDIR/{lti_plant,dc_motor}_{fmi2,fmi3}.fmu — FMI 2.0 and 3.0
+# Test FMUs (issue 22): builds OUTDIR/{lti_plant,dc_motor,faulty}_{fmi2,fmi3}.fmu — FMI 2.0 and 3.0
 # co-simulation FMUs for linux x86_64 — from the C sources next to this script, against the
 # FMI headers that FMPy ships, and validates each with FMPy. Idempotent (each FMU is rebuilt
 # and replaced atomically); takes a second or two.
@@ -24,7 +24,7 @@ trap 'rm -rf "$tmp"' EXIT
 # -ffp-contract=off: no fused multiply-add, so lti_plant's sums round exactly as documented.
 cflags=(-O2 -fPIC -ffp-contract=off -fvisibility=hidden -Wall -Wextra -Werror -I"$src" -I"$headers")
 
-for model in lti_plant dc_motor; do
+for model in lti_plant dc_motor faulty; do
   "$cc" "${cflags[@]}" -o "$tmp/describe_$model" "$src/describe.c" "$src/$model.c" -lm
   for fmi in 2 3; do
     if [ "$fmi" = 2 ]; then platform=linux64; else platform=x86_64-linux; fi
@@ -55,4 +55,4 @@ for path in sys.argv[1:]:
     fmu.freeInstance()
 EOF
 mv -f "$tmp"/*.fmu "$out"/
-echo "build.sh: $(cd "$out" && ls {lti_plant,dc_motor}_fmi{2,3}.fmu | tr '\n' ' ')in $out"
+echo "build.sh: $(cd "$out" && ls {lti_plant,dc_motor,faulty}_fmi{2,3}.fmu | tr '\n' ' ')in $out"

@@ -5,9 +5,11 @@ mod config;
 pub mod fault;
 pub mod noise;
 mod plant;
+pub mod sensing;
 pub mod shell;
 
 pub use config::PlantConfig;
 pub use fault::Fault;
 pub use noise::Noise;
 pub use plant::{Divergence, Plant};
+pub use sensing::Sensing;

@@ -30,8 +30,9 @@ use lti::signal::{locate, Signal, Switch};
 use nalgebra::{DMatrix, DVector};
 
 use crate::config::PlantConfig;
-use crate::fault::{Kind, Scheduled, Target};
-use crate::noise::{Gaussian, Stream, FAULT_BASE, MEASUREMENT, PROCESS};
+use crate::fault::Target;
+use crate::noise::{Gaussian, PROCESS};
+use crate::sensing::Sensing;
 
 /// A stretch of a step with its transition matrices.
 #[derive(Debug, Clone)]
@@ -92,13 +93,11 @@ pub struct Plant {
     x_next: DVector<f64>,
     xi: DVector<f64>,
     out: Vec<f64>,
-    faults: Vec<Scheduled>,
+    /// Faults and measurement noise (shared with every plant that applies them).
+    sensing: Sensing,
     /// Per fault acting through the state equation: (fault index, Γ₀ column, Γ₁ column).
     state_faults: Vec<(usize, DVector<f64>, DVector<f64>)>,
-    /// Per fault: its noise stream (sensor noise bursts only).
-    bursts: Vec<Option<Stream>>,
     process_noise: Option<Gaussian>,
-    measurement_noise: Option<Gaussian>,
     /// The input applied over the step (the commanded one changed by actuator faults).
     u_applied: Vec<f64>,
 }
@@ -198,22 +197,12 @@ impl Plant {
                 (i, gamma.column(0).into_owned(), gamma.column(1).into_owned())
             })
             .collect();
-        let seed = cfg.noise.as_ref().map_or(0, |z| z.seed);
-        let bursts = cfg
-            .faults
-            .iter()
-            .enumerate()
-            .map(|(i, f)| (f.kind == Kind::Noise).then(|| Stream::new(seed, FAULT_BASE + i as u64)))
-            .collect();
-        let (process_noise, measurement_noise) = match &cfg.noise {
-            Some(z) => {
-                if (z.qd.rows, z.qd.cols) != (n, n) || (z.r.rows, z.r.cols) != (p, p) {
-                    return Err("plant configuration: the noise covariances do not conform".into());
-                }
-                (Gaussian::new(&z.qd, z.seed, PROCESS), Gaussian::new(&z.r, z.seed, MEASUREMENT))
-            }
-            None => (None, None),
+        let process_noise = match &cfg.noise {
+            Some(z) if (z.qd.rows, z.qd.cols) != (n, n) => return Err("plant configuration: the noise covariances do not conform".into()),
+            Some(z) => Gaussian::new(&z.qd, z.seed, PROCESS),
+            None => None,
         };
+        let sensing = Sensing::new(cfg)?;
         Ok(Self {
             dt: cfg.dt,
             bound: cfg.state_bound,
@@ -232,11 +221,9 @@ impl Plant {
             x_next: DVector::zeros(n),
             xi: DVector::zeros(m),
             out: vec![0.0; layout.len()],
-            faults: cfg.faults.iter().map(|f| Scheduled::new(f, cfg.dt)).collect(),
+            sensing,
             state_faults,
-            bursts,
             process_noise,
-            measurement_noise,
             u_applied: vec![0.0; l],
         })
     }
@@ -282,28 +269,8 @@ impl Plant {
         let y = &mut head[lay.y()];
         mul_into(y, &self.c, self.x.as_slice());
         mul_acc(y, &self.d, &tail[lay.v().start - lay.w().start..lay.v().end - lay.w().start]);
-        if let Some(g) = &mut self.measurement_noise {
-            g.add_to(y);
-        }
-        for (i, f) in self.faults.iter().enumerate() {
-            let (phi, _) = f.magnitude(k, dt);
-            let active = f.active(k);
-            if let (Target::Sensor(j), true) = (f.fault.target, active) {
-                match f.fault.kind {
-                    Kind::Stuck => y[j] = f.fault.value,
-                    Kind::Noise => y[j] += f.fault.value * self.bursts[i].as_mut().map_or(0.0, Stream::normal),
-                    _ => y[j] += phi,
-                }
-            }
-            let recorded = match f.fault.kind {
-                Kind::Additive | Kind::Bias | Kind::Drift => phi,
-                _ if active => f.fault.value,
-                _ => 0.0,
-            };
-            let at = lay.fault(i);
-            tail[at.start - lay.w().start] = if active { 1.0 } else { 0.0 };
-            tail[at.start + 1 - lay.w().start] = recorded;
-        }
+        let slots = lay.faults().start - lay.w().start;
+        self.sensing.sense(k, y, &mut tail[slots..]);
         &self.out
     }
 
@@ -318,14 +285,8 @@ impl Plant {
         let t = self.time(k);
         let lay = self.layout;
         self.out[lay.u_prev()].copy_from_slice(u);
-        self.u_applied.copy_from_slice(u);
-        for f in self.faults.iter().filter(|f| f.active(k)) {
-            match (f.fault.target, f.fault.kind) {
-                (Target::Actuator(i), Kind::Stuck) => self.u_applied[i] = f.fault.value,
-                (Target::Actuator(i), Kind::Gain) => self.u_applied[i] *= 1.0 - f.fault.value,
-                _ => {}
-            }
-        }
+        // Additive actuator faults act through the state equation below, integrated exactly.
+        self.sensing.actuate(k, u, &mut self.u_applied, false);
         let u = self.u_applied.as_slice();
         let pieces: &[Piece] = match self.splits.get(self.next_split) {
             Some((s, pieces)) if *s == k => {
@@ -351,7 +312,7 @@ impl Plant {
         // Faults through the state equation, over the whole step (superposition: the split of
         // a step at a disturbance's switching time does not concern them).
         for (i, g0, g1) in &self.state_faults {
-            let (phi, slope) = self.faults[*i].magnitude(k, self.dt);
+            let (phi, slope) = self.sensing.faults[*i].magnitude(k, self.dt);
             if phi != 0.0 || slope != 0.0 {
                 self.x.axpy(phi, g0, 1.0);
                 self.x.axpy(slope, g1, 1.0);

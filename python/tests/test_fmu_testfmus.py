@@ -32,13 +32,13 @@ from scipy.integrate import solve_ivp
 from conftest import REPO
 
 SOURCES = os.path.join(REPO, "fmu", "testfmus")
-NAMES = [f"{model}_fmi{v}" for model in ("lti_plant", "dc_motor") for v in (2, 3)]
+NAMES = [f"{model}_fmi{v}" for model in ("lti_plant", "dc_motor", "faulty") for v in (2, 3)]
 SCENARIO = os.path.join(REPO, "scenarios", "seed002-piecewise.toml")
 
 
 @pytest.fixture(scope="module")
 def fmu_dir(tmp_path_factory):
-    """A directory with the four up-to-date test FMUs."""
+    """A directory with the up-to-date test FMUs (each model in FMI 2.0 and 3.0)."""
     built = os.environ.get("UIO_TEST_FMUS")
     newest_source = max(os.path.getmtime(os.path.join(SOURCES, f)) for f in os.listdir(SOURCES))
     if built and all(

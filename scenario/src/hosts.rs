@@ -38,7 +38,7 @@ pub(crate) fn placements(raw: &RawScenario) -> Result<BTreeMap<String, Remote>, 
         out.insert(component.to_string(), Remote { host: h.clone(), endpoint: endpoint.clone() });
         Ok(())
     };
-    place("plant.host".into(), "plant", &raw.plant.host, raw.plant.process.is_some())?;
+    place("plant.host".into(), "plant", &raw.plant.host, raw.plant.process.is_some() || raw.plant.fmu.is_some())?;
     for (i, o) in raw.observer.iter().enumerate() {
         place(format!("observer[{}].host", i + 1), &o.name, &o.host, o.kind == "process")?;
     }

@@ -4,6 +4,7 @@
 //! (as a path such as `plant.A` or `observer[1].poles`), and the reason.
 
 mod fault_diagnosis;
+mod fmu_plant;
 mod hosts;
 pub mod limits;
 mod locate;
@@ -22,6 +23,7 @@ use lti::{Mat, Model};
 use observer::Spec;
 
 pub use fault_diagnosis::NoiseSpec;
+pub use fmu_plant::FMU_PLANT_PROGRAM;
 pub use hosts::Remote;
 pub use raw::RawExpect;
 pub use untrusted::{quoted, MAX_SCENARIO_BYTES};
@@ -65,6 +67,9 @@ pub struct Scenario {
     pub controller: Option<ControllerEntry>,
     /// Who simulates the true plant, when not the built-in exact linear plant.
     pub plant_process: Option<ProcessSpec>,
+    /// `[plant.fmu]`: the FMU that simulates the true plant (absolute path); `plant_process` is
+    /// then the component that runs it ([`FMU_PLANT_PROGRAM`]).
+    pub plant_fmu: Option<PathBuf>,
     /// What the run must achieve.
     pub expect: RawExpect,
     /// The file's text (to locate fields in later messages).

@@ -186,6 +186,8 @@ pub struct RawPlant {
     pub measurement_disturbance_units: Option<Vec<String>>,
     /// Who simulates the true plant, when not the built-in exact linear plant.
     pub process: Option<RawProcess>,
+    /// An FMU (FMI 2.0/3.0 co-simulation) simulates the true plant.
+    pub fmu: Option<RawFmu>,
     /// Fault distribution F_f (n×m): component faults act through its columns.
     #[serde(rename = "Ff")]
     pub ff: Option<Rows>,
@@ -199,6 +201,26 @@ pub struct RawPlant {
 pub struct RawProcess {
     pub command: Vec<String>,
     pub params: Option<toml::Table>,
+}
+
+/// `[plant.fmu]`: an FMU as the plant, its variables mapped by name.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawFmu {
+    /// The `.fmu` file, relative to the scenario's folder.
+    pub path: String,
+    /// FMU inputs receiving u, one per column of B.
+    pub inputs: Option<Vec<String>>,
+    /// FMU inputs receiving w, one per column of E.
+    pub disturbances: Option<Vec<String>>,
+    /// FMU outputs read as y, one per row of C.
+    pub outputs: Vec<String>,
+    /// FMU variables read as the true state x, one per state.
+    pub states: Vec<String>,
+    /// Start values of FMU parameters, by name.
+    pub parameters: Option<toml::Table>,
+    /// doStep calls per sample (default 1).
+    pub substeps: Option<u32>,
 }
 
 /// One pole as written: a real number, or [re, im] for a complex pair.

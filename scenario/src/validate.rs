@@ -198,7 +198,6 @@ pub(crate) fn check_name(field: &str, name: &str, why: &str) -> Result<(), Bad> 
 }
 
 fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
-    let _ = path;
     check_name("name", &raw.name, "it names the recording's files")?;
     let dt = finite("dt", raw.dt)?;
     let duration = finite("duration", raw.duration)?;
@@ -315,6 +314,21 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
     {
         return Err(bad(what, "faults and noise are applied by the built-in plant: an external plant (plant.process) models its own"));
     }
+    if p.fmu.is_some() {
+        // Actuator faults act on the FMU's inputs and sensor faults and measurement noise on its
+        // outputs; what acts inside (F_f, process noise) is the FMU's own.
+        if p.process.is_some() {
+            return Err(bad("plant.fmu", "one true plant: [plant.process] or [plant.fmu], not both"));
+        }
+        if let Some(i) = faults.iter().position(|f| matches!(f.target, plant::fault::Target::Component(_))) {
+            return Err(bad(format!("fault[{}].target", i + 1), "a component fault acts through F_f of the built-in plant: an FMU plant takes actuator and sensor faults"));
+        }
+        if raw.noise.as_ref().is_some_and(|z| z.process.is_some() || z.process_discrete.is_some()) {
+            return Err(bad("noise.process", "process noise enters the state, which an FMU plant keeps to itself: an FMU plant takes measurement noise only"));
+        }
+    }
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let fmu = super::fmu_plant::plant_fmu(&p.fmu, dir, &super::fmu_plant::Sizes { n, p: model.c.nrows(), l: model.b.ncols(), q: model.e.ncols() })?;
 
     // Observers.
     let mut seen = BTreeSet::new();
@@ -405,7 +419,11 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
         inputs,
         observers,
         controller,
-        plant_process: plant_process(&p.process)?,
+        plant_process: match &fmu {
+            Some((_, spec)) => Some(spec.clone()),
+            None => plant_process(&p.process)?,
+        },
+        plant_fmu: fmu.map(|(path, _)| path),
         expect,
         source: String::new(),
         seed: raw.seed.unwrap_or(0),

@@ -126,7 +126,12 @@ pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> V
         "faults": s.faults,
         "noise": cfg.plant.noise,
     });
-    out.push(Launchable { label: "plant".into(), program, config: plant });
+    // An FMU plant is named with its file: what fails is most likely the FMU's library.
+    let label = match &s.plant_fmu {
+        Some(f) => format!("plant (FMU {})", f.file_name().map_or_else(|| f.display().to_string(), |n| n.to_string_lossy().into_owned())),
+        None => "plant".into(),
+    };
+    out.push(Launchable { label, program, config: plant });
 
     for (o, (name, run)) in s.observers.iter().zip(&cfg.observers) {
         let sleep = is_follower(s, name).then_some(super::configs::FOLLOWER_SLEEP_US);

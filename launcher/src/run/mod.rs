@@ -3,6 +3,7 @@
 pub mod budget;
 mod configs;
 mod envelope;
+mod fmu_check;
 pub mod interrupt;
 mod in_process;
 mod processes;
@@ -159,11 +160,21 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
     {
         return Err(LaunchError::BadInput(format!("{}: controller: {why}; pass --allow-unstable to run it anyway", s.path.display())));
     }
+    if opts.mode == Mode::InProcess && s.plant_fmu.is_some() {
+        return Err(LaunchError::BadInput(format!(
+            "{}: the plant is an FMU: it runs in its own process ({}), so that a crash in the FMU's library cannot take the recording with it; --mode in-process runs only built-in components",
+            s.path.display(),
+            scenario::FMU_PLANT_PROGRAM
+        )));
+    }
     if opts.mode == Mode::InProcess
         && let Some(what) = external_component(s)
     {
         return Err(LaunchError::BadInput(format!("{}: {what} is an external process: --mode in-process runs only built-in components", s.path.display())));
     }
+    // An FMU that cannot be the plant (not a zip, model exchange only, a variable that is not
+    // there …) is refused before anything runs, by the component that would load it.
+    fmu_check::check(s)?;
     // A runs directory that is not private (a planted symlink, another user's) is refused
     // before any output exists: bad input, like a scenario's.
     if opts.mode == Mode::Processes {

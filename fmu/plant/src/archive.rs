@@ -1,0 +1,214 @@
+//! An FMU read as an archive, without loading its library: its FMI version, the co-simulation
+//! model identifier, whether a binary for this platform is there, and its variables. Every
+//! refusal is one line naming the file and the reason.
+
+use std::collections::BTreeMap;
+use std::io::Read;
+use std::path::Path;
+
+use fmi::schema::fmi2::{Causality as C2, Fmi2ModelDescription, ScalarVariableElement};
+use fmi::schema::fmi3::{AbstractVariableTrait, ArrayableVariableTrait, Causality as C3, Fmi3ModelDescription, Variable};
+use fmi::schema::minimal::MinModelDescription;
+use fmi::schema::traits::FmiModelDescription;
+
+/// FMI 2.0 or 3.0.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Version {
+    Two,
+    Three,
+}
+
+/// What a variable is for, in the words both standards share.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Causality {
+    Parameter,
+    CalculatedParameter,
+    Input,
+    Output,
+    Local,
+    Independent,
+    Other,
+}
+
+impl Causality {
+    pub fn name(self) -> &'static str {
+        match self {
+            Causality::Parameter => "a parameter",
+            Causality::CalculatedParameter => "a calculated parameter",
+            Causality::Input => "an input",
+            Causality::Output => "an output",
+            Causality::Local => "a local variable",
+            Causality::Independent => "the independent variable",
+            Causality::Other => "a structural parameter",
+        }
+    }
+}
+
+/// The value types the plant can exchange.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Type {
+    /// FMI 2 Real, FMI 3 Float64.
+    Real,
+    /// FMI 2 Integer, FMI 3 Int32.
+    Integer,
+    Boolean,
+    /// Anything else (named as the FMU's description does).
+    Other(&'static str),
+}
+
+impl Type {
+    pub fn name(self, v: Version) -> &'static str {
+        match (self, v) {
+            (Type::Real, Version::Two) => "Real",
+            (Type::Real, Version::Three) => "Float64",
+            (Type::Integer, Version::Two) => "Integer",
+            (Type::Integer, Version::Three) => "Int32",
+            (Type::Boolean, _) => "Boolean",
+            (Type::Other(s), _) => s,
+        }
+    }
+}
+
+/// One variable of the FMU.
+#[derive(Debug, Clone)]
+pub struct Var {
+    pub vr: u32,
+    pub causality: Causality,
+    pub ty: Type,
+    /// An array variable (FMI 3 dimensions): not exchanged as a scalar.
+    pub array: bool,
+}
+
+/// An FMU's description, as far as the plant needs it.
+#[derive(Debug, Clone)]
+pub struct Fmu {
+    pub version: Version,
+    pub model_identifier: String,
+    pub vars: BTreeMap<String, Var>,
+}
+
+/// Where this platform's binary sits in an FMU of `version`.
+pub fn binary_path(version: Version, model_identifier: &str) -> String {
+    let platform = match version {
+        Version::Two => "linux64",
+        Version::Three => "x86_64-linux",
+    };
+    format!("binaries/{platform}/{model_identifier}.so")
+}
+
+/// Reads and checks the archive at `path`.
+pub fn read(path: &Path) -> Result<Fmu, String> {
+    let at = |why: String| format!("{}: {why}", path.display());
+    let file = std::fs::File::open(path).map_err(|e| at(format!("cannot open: {e}")))?;
+    let mut zip = zip::ZipArchive::new(file).map_err(|e| at(format!("not an FMU: not a zip archive ({e})")))?;
+    let mut xml = String::new();
+    zip.by_name("modelDescription.xml")
+        .map_err(|_| at("not an FMU: no modelDescription.xml in the archive".into()))?
+        .read_to_string(&mut xml)
+        .map_err(|e| at(format!("modelDescription.xml: {e}")))?;
+    let min = MinModelDescription::deserialize(&xml).map_err(|e| at(format!("modelDescription.xml: {}", first_line(&e.to_string()))))?;
+    let version = match min.fmi_version.split('.').next() {
+        Some("2") => Version::Two,
+        Some("3") => Version::Three,
+        _ => return Err(at(format!("FMI version {} is not supported (FMI 2.0 and 3.0 co-simulation are)", min.fmi_version))),
+    };
+    let fmu = match version {
+        Version::Two => from_fmi2(&xml).map_err(at)?,
+        Version::Three => from_fmi3(&xml).map_err(at)?,
+    };
+    let binary = binary_path(version, &fmu.model_identifier);
+    if zip.index_for_name(&binary).is_none() {
+        let present: Vec<String> = zip.file_names().filter(|n| n.starts_with("binaries/") && !n.ends_with('/')).map(str::to_string).collect();
+        let has = if present.is_empty() { "none (a source-only FMU is not compiled here)".to_string() } else { present.join(", ") };
+        return Err(at(format!("no binary for this platform: {binary} is not in the archive (binaries: {has})")));
+    }
+    Ok(fmu)
+}
+
+fn first_line(s: &str) -> &str {
+    s.lines().next().unwrap_or(s)
+}
+
+fn no_cs(me: bool) -> String {
+    if me {
+        "model exchange only: the plant needs an FMU for co-simulation (model exchange, which needs our own integrator, is not supported)".into()
+    } else {
+        "no co-simulation interface in modelDescription.xml".into()
+    }
+}
+
+fn from_fmi2(xml: &str) -> Result<Fmu, String> {
+    let md = <Fmi2ModelDescription as FmiModelDescription>::deserialize(xml).map_err(|e| format!("modelDescription.xml (FMI 2.0): {}", first_line(&e.to_string())))?;
+    let Some(cs) = &md.co_simulation else { return Err(no_cs(md.model_exchange.is_some())) };
+    let mut vars = BTreeMap::new();
+    for v in md.get_model_variables() {
+        let causality = match v.causality {
+            C2::Parameter => Causality::Parameter,
+            C2::CalculatedParameter => Causality::CalculatedParameter,
+            C2::Input => Causality::Input,
+            C2::Output => Causality::Output,
+            C2::Local => Causality::Local,
+            C2::Independent => Causality::Independent,
+        };
+        let ty = match v.elem {
+            ScalarVariableElement::Real(_) => Type::Real,
+            ScalarVariableElement::Integer(_) => Type::Integer,
+            ScalarVariableElement::Boolean(_) => Type::Boolean,
+            ScalarVariableElement::String => Type::Other("String"),
+            ScalarVariableElement::Enumeration => Type::Other("Enumeration"),
+        };
+        vars.insert(v.name.clone(), Var { vr: v.value_reference, causality, ty, array: false });
+    }
+    Ok(Fmu { version: Version::Two, model_identifier: cs.model_identifier.clone(), vars })
+}
+
+fn from_fmi3(xml: &str) -> Result<Fmu, String> {
+    let md = <Fmi3ModelDescription as FmiModelDescription>::deserialize(xml).map_err(|e| format!("modelDescription.xml (FMI 3.0): {}", first_line(&e.to_string())))?;
+    let Some(cs) = &md.co_simulation else { return Err(no_cs(md.model_exchange.is_some())) };
+    let mut vars = BTreeMap::new();
+    for v in &md.model_variables.variables {
+        let ty = match v {
+            Variable::Float64(_) => Type::Real,
+            Variable::Int32(_) => Type::Integer,
+            Variable::Boolean(_) => Type::Boolean,
+            Variable::Float32(_) => Type::Other("Float32"),
+            Variable::Int8(_) => Type::Other("Int8"),
+            Variable::UInt8(_) => Type::Other("UInt8"),
+            Variable::Int16(_) => Type::Other("Int16"),
+            Variable::UInt16(_) => Type::Other("UInt16"),
+            Variable::UInt32(_) => Type::Other("UInt32"),
+            Variable::Int64(_) => Type::Other("Int64"),
+            Variable::UInt64(_) => Type::Other("UInt64"),
+            Variable::String(_) => Type::Other("String"),
+            Variable::Binary(_) => Type::Other("Binary"),
+            Variable::Clock(_) => Type::Other("Clock"),
+        };
+        let (a, array): (&dyn AbstractVariableTrait, bool) = match v {
+            Variable::Int8(x) => (x, !x.dimensions().is_empty()),
+            Variable::UInt8(x) => (x, !x.dimensions().is_empty()),
+            Variable::Int16(x) => (x, !x.dimensions().is_empty()),
+            Variable::UInt16(x) => (x, !x.dimensions().is_empty()),
+            Variable::Int32(x) => (x, !x.dimensions().is_empty()),
+            Variable::UInt32(x) => (x, !x.dimensions().is_empty()),
+            Variable::Int64(x) => (x, !x.dimensions().is_empty()),
+            Variable::UInt64(x) => (x, !x.dimensions().is_empty()),
+            Variable::Float32(x) => (x, !x.dimensions().is_empty()),
+            Variable::Float64(x) => (x, !x.dimensions().is_empty()),
+            Variable::Boolean(x) => (x, !x.dimensions().is_empty()),
+            Variable::String(x) => (x, !x.dimensions().is_empty()),
+            Variable::Binary(x) => (x, !x.dimensions().is_empty()),
+            Variable::Clock(x) => (x, false),
+        };
+        let causality = match a.causality() {
+            C3::Parameter => Causality::Parameter,
+            C3::CalculatedParameter => Causality::CalculatedParameter,
+            C3::Input => Causality::Input,
+            C3::Output => Causality::Output,
+            C3::Local => Causality::Local,
+            C3::Independent => Causality::Independent,
+            _ => Causality::Other,
+        };
+        vars.insert(a.name().to_string(), Var { vr: a.value_reference(), causality, ty, array });
+    }
+    Ok(Fmu { version: Version::Three, model_identifier: cs.model_identifier.clone(), vars })
+}

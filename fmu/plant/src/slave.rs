@@ -1,0 +1,117 @@
+//! A running co-simulation instance of an FMU, FMI 2.0 or 3.0, behind the few calls the plant
+//! makes: parameters before initialisation, Real/Float64 inputs and outputs, and doStep. Every
+//! failed call says which call, at what time, and what the FMU logged about it.
+
+use fmi::fmi2::import::Fmi2Import;
+use fmi::fmi2::instance::{CoSimulation as _, Common as _, InstanceCS as Cs2};
+use fmi::fmi3::import::Fmi3Import;
+use fmi::fmi3::instance::InstanceCS as Cs3;
+use fmi::fmi3::{CoSimulation as _, Common as _, Fmi3Model as _, GetSet as _};
+
+use crate::archive::Version;
+use crate::check::Start;
+use crate::log_capture;
+
+/// An instance; the import (the extracted archive) lives as long as it. Fields drop in order:
+/// the instance is freed before its library's folder goes.
+pub enum Slave {
+    Two { inst: Cs2, _import: Fmi2Import },
+    Three { inst: Cs3, _import: Fmi3Import },
+}
+
+fn failed(call: &str, t: f64, status: impl std::fmt::Debug) -> String {
+    format!("{call} at t = {t} returned {status:?}{}", log_capture::take())
+}
+
+impl Slave {
+    /// Extracts and instantiates the FMU at `path` for co-simulation, sets the parameters'
+    /// start values and initialises it at t = 0.
+    pub fn start(path: &str, version: Version, name: &str, parameters: &[(u32, Start)]) -> Result<Self, String> {
+        log_capture::install();
+        let mut s = match version {
+            Version::Two => {
+                let import: Fmi2Import = fmi::import::from_path(path).map_err(|e| format!("cannot extract: {e}"))?;
+                let inst = import.instantiate_cs(name, false, true).map_err(|e| format!("fmi2Instantiate failed ({e}){}", log_capture::take()))?;
+                Slave::Two { inst, _import: import }
+            }
+            Version::Three => {
+                let import: Fmi3Import = fmi::import::from_path(path).map_err(|e| format!("cannot extract: {e}"))?;
+                let inst = import.instantiate_cs(name, false, true, false, false, &[]).map_err(|e| format!("fmi3InstantiateCoSimulation failed ({e}){}", log_capture::take()))?;
+                Slave::Three { inst, _import: import }
+            }
+        };
+        s.initialise(parameters)?;
+        Ok(s)
+    }
+
+    fn initialise(&mut self, parameters: &[(u32, Start)]) -> Result<(), String> {
+        match self {
+            Slave::Two { inst: i, .. } => {
+                i.setup_experiment(None, 0.0, None).map_err(|e| failed("fmi2SetupExperiment", 0.0, e))?;
+                for (vr, v) in parameters {
+                    match v {
+                        Start::Real(x) => i.set_real(&[*vr], &[*x]).map(drop),
+                        Start::Integer(x) => i.set_integer(&[*vr], &[*x]).map(drop),
+                        Start::Boolean(b) => i.set_boolean(&[*vr], &[*b as i32]).map(drop),
+                    }
+                    .map_err(|e| failed("setting a parameter's start value", 0.0, e))?;
+                }
+                i.enter_initialization_mode().map_err(|e| failed("fmi2EnterInitializationMode", 0.0, e))?;
+                i.exit_initialization_mode().map_err(|e| failed("fmi2ExitInitializationMode", 0.0, e))?;
+            }
+            Slave::Three { inst: i, .. } => {
+                for (vr, v) in parameters {
+                    match v {
+                        Start::Real(x) => i.set_float64(&[*vr], &[*x]).map(drop),
+                        Start::Integer(x) => i.set_int32(&[*vr], &[*x]).map(drop),
+                        Start::Boolean(b) => i.set_boolean(&[*vr], &[*b]).map(drop),
+                    }
+                    .map_err(|e| failed("setting a parameter's start value", 0.0, e))?;
+                }
+                i.enter_initialization_mode(None, 0.0, None).map_err(|e| failed("fmi3EnterInitializationMode", 0.0, e))?;
+                i.exit_initialization_mode().map_err(|e| failed("fmi3ExitInitializationMode", 0.0, e))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Sets Real/Float64 inputs at time t.
+    pub fn set(&mut self, vrs: &[u32], values: &[f64], t: f64) -> Result<(), String> {
+        if vrs.is_empty() {
+            return Ok(());
+        }
+        match self {
+            Slave::Two { inst: i, .. } => i.set_real(vrs, values).map(drop).map_err(|e| failed("fmi2SetReal", t, e)),
+            Slave::Three { inst: i, .. } => i.set_float64(vrs, values).map(drop).map_err(|e| failed("fmi3SetFloat64", t, e)),
+        }
+    }
+
+    /// Reads Real/Float64 variables at time t.
+    pub fn get(&mut self, vrs: &[u32], out: &mut [f64], t: f64) -> Result<(), String> {
+        if vrs.is_empty() {
+            return Ok(());
+        }
+        match self {
+            Slave::Two { inst: i, .. } => i.get_real(vrs, out).map(drop).map_err(|e| failed("fmi2GetReal", t, e)),
+            Slave::Three { inst: i, .. } => i.get_float64(vrs, out).map(drop).map_err(|e| failed("fmi3GetFloat64", t, e)),
+        }
+    }
+
+    /// One communication step from t of length h.
+    pub fn step(&mut self, t: f64, h: f64) -> Result<(), String> {
+        match self {
+            Slave::Two { inst: i, .. } => i.do_step(t, h, true).map(drop).map_err(|e| failed("fmi2DoStep", t, e)),
+            Slave::Three { inst: i, .. } => {
+                let (mut event, mut terminate, mut early, mut last) = (false, false, false, t);
+                i.do_step(t, h, true, &mut event, &mut terminate, &mut early, &mut last).map_err(|e| failed("fmi3DoStep", t, e))?;
+                if terminate {
+                    return Err(format!("fmi3DoStep at t = {t} asked to terminate the simulation{}", log_capture::take()));
+                }
+                if early {
+                    return Err(format!("fmi3DoStep at t = {t} returned early at t = {last}: intermediate updates are not supported"));
+                }
+                Ok(())
+            }
+        }
+    }
+}
