@@ -9,6 +9,7 @@ pub mod error;
 pub mod limits;
 pub mod output;
 pub mod plan;
+pub mod replay;
 pub mod run;
 pub mod shipped;
 pub mod summary;

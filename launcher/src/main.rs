@@ -70,6 +70,21 @@ enum Command {
         #[arg(long, value_name = "S")]
         stall_timeout: Option<f64>,
     },
+    /// Run observers on a run's recorded plant samples: its own scenario's (or --scenario's,
+    /// same plant sizes), plant replayed from the recording, controller removed (open loop).
+    Replay {
+        /// The run's recording.
+        recording: PathBuf,
+        /// Another scenario whose observers and banks to run (default: the recorded one).
+        #[arg(long)]
+        scenario: Option<PathBuf>,
+        /// Output directory (default: `replay/` beside the recording).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Overwrite an existing replay recording.
+        #[arg(long)]
+        force: bool,
+    },
     /// Monte Carlo: run N noise realisations (seeds S, S+1, …) and write DIR/<name>.sweep.json
     /// with detection delays, isolation accuracy, false-alarm rates and tail errors.
     Sweep {
@@ -318,6 +333,36 @@ fn main() -> ExitCode {
                         }
                         Stop::Diverged(w) => fail(&LaunchError::Diverged(format!("{}: run stopped: {w}", s.name))),
                         Stop::Interrupted(sig) => fail(&LaunchError::Interrupted(format!("{}: run interrupted by {sig}; recording closed", s.name))),
+                        Stop::Failed(w) => fail(&LaunchError::Component(format!("{}: {w}", s.name))),
+                    }
+                }
+                Err(e) => fail(&e),
+            }
+        }
+        Command::Replay { recording, scenario, out, force } => {
+            let out = out.unwrap_or_else(|| recording.parent().unwrap_or(Path::new(".")).join("replay"));
+            let prepared = launcher::replay::scenario(&recording, scenario.as_deref()).and_then(|s| {
+                launcher::replay::refuse_overwrite(&recording, &out, &s.name)?;
+                let mut p = plan::plan(&s).map_err(|e| LaunchError::Scenario(e.error))?;
+                launcher::calibrate::calibrate(&s, &mut p)?;
+                Ok((s, p))
+            });
+            let (s, p) = match prepared {
+                Ok(x) => x,
+                Err(e) => return fail(&e),
+            };
+            let opts = Options { force, progress: true, pin: true, ..Options::quiet(&out, Mode::Processes, Wait::default_for_machine(), true) };
+            match run::run(&s, &p, &opts) {
+                Ok(o) => {
+                    print!("{}", o.summary.table());
+                    if let Some(rrd) = &o.rrd {
+                        println!("recording: {}", rrd.display());
+                    }
+                    match o.stop {
+                        Stop::Completed if o.summary.expectations_met() => ExitCode::SUCCESS,
+                        Stop::Completed => fail(&LaunchError::Expect(format!("{}: the replay missed its [expect] table", s.path.display()))),
+                        Stop::Diverged(w) => fail(&LaunchError::Diverged(format!("{}: replay stopped: {w}", s.name))),
+                        Stop::Interrupted(sig) => fail(&LaunchError::Interrupted(format!("{}: replay interrupted by {sig}; recording closed", s.name))),
                         Stop::Failed(w) => fail(&LaunchError::Component(format!("{}: {w}", s.name))),
                     }
                 }

@@ -109,6 +109,11 @@ pub struct Summary {
     /// recording, against which readers detect a damaged file.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub recording_digest: Option<BTreeMap<String, String>>,
+    /// `[plant.replay]`: the data file, its rows, the grid samples taken from it, those held by
+    /// `resample = "zoh"`, the cells held by `missing = "hold"`, and whether x is in the data
+    /// (`states: false`: the recorded "errors" are −x̂, not estimation errors).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub replay: Option<serde_json::Value>,
     /// The design's warnings (the ones `launcher design` prints), so the figures carry them.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
@@ -165,6 +170,7 @@ impl Summary {
             realtime: None,
             recording: rrd.map(|p| p.display().to_string()),
             recording_digest: None,
+            replay: None,
             warnings: plan.warnings.clone(),
         };
         summary.expectations = summary.check(s, matches!(stop, Stop::Completed));

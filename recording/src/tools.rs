@@ -4,7 +4,7 @@ use crate::read::Recording;
 use scenario::Scenario;
 
 /// The scenario text stored in a recording.
-fn recorded_text(r: &Recording) -> Option<&str> {
+pub fn recorded_text(r: &Recording) -> Option<&str> {
     let text = r.scenario.as_ref()?;
     Some(text.trim().strip_prefix("```toml")?.strip_suffix("```")?.trim_start_matches('\n'))
 }

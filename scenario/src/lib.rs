@@ -10,6 +10,7 @@ pub mod limits;
 mod locate;
 pub mod matrix_file;
 mod raw;
+mod replay_plant;
 pub mod suggest;
 pub mod untrusted;
 mod validate;
@@ -26,6 +27,7 @@ pub use fault_diagnosis::NoiseSpec;
 pub use fmu_plant::FMU_PLANT_PROGRAM;
 pub use hosts::Remote;
 pub use raw::RawExpect;
+pub use replay_plant::{replay_has_states, REPLAY_PLANT_PROGRAM};
 pub use untrusted::{quoted, MAX_SCENARIO_BYTES};
 
 /// A scenario that passed every check.
@@ -70,6 +72,9 @@ pub struct Scenario {
     /// `[plant.fmu]`: the FMU that simulates the true plant (absolute path); `plant_process` is
     /// then the component that runs it ([`FMU_PLANT_PROGRAM`]).
     pub plant_fmu: Option<PathBuf>,
+    /// `[plant.replay]`: the recorded data replayed as the true plant (absolute path);
+    /// `plant_process` is then the component that replays it ([`REPLAY_PLANT_PROGRAM`]).
+    pub plant_replay: Option<PathBuf>,
     /// What the run must achieve.
     pub expect: RawExpect,
     /// The file's text (to locate fields in later messages).

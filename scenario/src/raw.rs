@@ -188,6 +188,8 @@ pub struct RawPlant {
     pub process: Option<RawProcess>,
     /// An FMU (FMI 2.0/3.0 co-simulation) simulates the true plant.
     pub fmu: Option<RawFmu>,
+    /// Recorded data (a CSV log or a run's `.rrd`) is replayed as the true plant.
+    pub replay: Option<RawReplay>,
     /// Fault distribution F_f (n×m): component faults act through its columns.
     #[serde(rename = "Ff")]
     pub ff: Option<Rows>,
@@ -221,6 +223,28 @@ pub struct RawFmu {
     pub parameters: Option<toml::Table>,
     /// doStep calls per sample (default 1).
     pub substeps: Option<u32>,
+}
+
+/// `[plant.replay]`: recorded samples as the plant, a CSV's columns mapped by header name.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawReplay {
+    /// The `.csv` or `.rrd` file, relative to the scenario's folder.
+    pub path: String,
+    /// CSV: the time column (absent: the rows are uniform at dt).
+    pub time: Option<String>,
+    /// CSV columns read as u, one per column of B.
+    pub inputs: Option<Vec<String>>,
+    /// CSV columns read as y, one per row of C.
+    pub outputs: Option<Vec<String>>,
+    /// CSV columns read as w, one per column of E (absent: w = 0).
+    pub disturbances: Option<Vec<String>>,
+    /// CSV columns read as the true x, one per state (absent: no errors).
+    pub states: Option<Vec<String>>,
+    /// `"zoh"`: put non-uniform time stamps on the grid by zero-order hold.
+    pub resample: Option<String>,
+    /// `"hold"`: an empty or non-finite cell holds the column's previous value.
+    pub missing: Option<String>,
 }
 
 /// One pole as written: a real number, or [re, im] for a complex pair.

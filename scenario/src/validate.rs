@@ -329,6 +329,17 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
     }
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let fmu = super::fmu_plant::plant_fmu(&p.fmu, dir, &super::fmu_plant::Sizes { n, p: model.c.nrows(), l: model.b.ncols(), q: model.e.ncols() })?;
+    if p.replay.is_some() {
+        // Recorded data holds its own faults and noise: [[fault]] and [noise] then describe
+        // them (for the design and the scoring), and nothing is applied.
+        if p.process.is_some() || p.fmu.is_some() {
+            return Err(bad("plant.replay", "one true plant: [plant.process], [plant.fmu] or [plant.replay]"));
+        }
+        if raw.controller.is_some() {
+            return Err(bad("controller", "the plant is replayed from recorded data, which cannot react to a controller: a replay is open loop"));
+        }
+    }
+    let replay = super::replay_plant::plant_replay(&p.replay, dir, &super::fmu_plant::Sizes { n, p: model.c.nrows(), l: model.b.ncols(), q: model.e.ncols() }, model.d.ncols(), dt, steps)?;
 
     // Observers.
     let mut seen = BTreeSet::new();
@@ -419,11 +430,12 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
         inputs,
         observers,
         controller,
-        plant_process: match &fmu {
-            Some((_, spec)) => Some(spec.clone()),
-            None => plant_process(&p.process)?,
+        plant_process: match (&fmu, &replay) {
+            (Some((_, spec)), _) | (_, Some((_, spec))) => Some(spec.clone()),
+            _ => plant_process(&p.process)?,
         },
         plant_fmu: fmu.map(|(path, _)| path),
+        plant_replay: replay.map(|(path, _)| path),
         expect,
         source: String::new(),
         seed: raw.seed.unwrap_or(0),

@@ -4,6 +4,7 @@ pub mod budget;
 mod configs;
 mod envelope;
 mod fmu_check;
+mod replay_check;
 pub mod interrupt;
 mod in_process;
 mod processes;
@@ -175,6 +176,8 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
     // An FMU that cannot be the plant (not a zip, model exchange only, a variable that is not
     // there …) is refused before anything runs, by the component that would load it.
     fmu_check::check(s)?;
+    // Recorded data that cannot be the plant is refused the same way, by its reader.
+    let replay = replay_check::check(s)?;
     // A runs directory that is not private (a planted symlink, another user's) is refused
     // before any output exists: bad input, like a scenario's.
     if opts.mode == Mode::Processes {
@@ -240,6 +243,7 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
     let mut summary = Summary::new(s, plan, opts, &metrics, &latency, wall, &stop, rrd.as_deref(), diagnosis);
     summary.realtime = realtime;
     summary.recording_digest = digest;
+    summary.replay = replay;
     if let Some(path) = &summary_path {
         summary.write(path).map_err(LaunchError::Component)?;
     }

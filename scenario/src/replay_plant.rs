@@ -1,0 +1,90 @@
+//! `[plant.replay]`: recorded data as the true plant. A CSV log (its columns mapped by header
+//! name to u, y and optionally w and x) or a run's own `.rrd` is replayed sample by sample by
+//! the `replay_plant` component (crate `replay`), which the launcher also asks to read the file
+//! before a run. Here only what the scenario alone can tell is checked: the map's sizes against
+//! `[plant]`, the options, and that the file exists. The data is open loop: it cannot react
+//! to a controller, so a scenario with one is refused.
+
+use std::path::Path;
+
+use serde_json::json;
+
+use super::fmu_plant::Sizes;
+use super::raw::RawReplay;
+use super::validate::{bad, Bad};
+use super::{quoted, ProcessSpec};
+
+/// The program that replays recorded data as the plant (a kit component built beside the launcher).
+pub const REPLAY_PLANT_PROGRAM: &str = "replay_plant";
+
+/// The replayed plant as the process that runs it, and the data file's absolute path.
+/// `r` is the number of columns of D (the replayed v is zero: D v is in the recorded y).
+pub(crate) fn plant_replay(raw: &Option<RawReplay>, dir: &Path, z: &Sizes, r: usize, dt: f64, steps: u64) -> Result<Option<(std::path::PathBuf, ProcessSpec)>, Bad> {
+    let Some(f) = raw else { return Ok(None) };
+    let path = dir.join(&f.path);
+    if !path.is_file() {
+        return Err(bad("plant.replay.path", format!("{}: no such file", quoted(&path.display().to_string()))));
+    }
+    let path = std::fs::canonicalize(&path).map_err(|e| bad("plant.replay.path", format!("{}: {e}", path.display())))?;
+    let format = match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+        Some("csv") => "csv",
+        Some("rrd") => "rrd",
+        _ => return Err(bad("plant.replay.path", format!("{}: a .csv log or a run's .rrd", quoted(&f.path)))),
+    };
+    let choice = |key: &str, given: &Option<String>, allowed: [&str; 2]| -> Result<String, Bad> {
+        match given.as_deref() {
+            None => Ok(allowed[0].into()),
+            Some(v) if v == allowed[1] => Ok(v.into()),
+            Some(v) => Err(bad(format!("plant.replay.{key}"), format!("{}: the only choice is {}", quoted(v), quoted(allowed[1])))),
+        }
+    };
+    let resample = choice("resample", &f.resample, ["none", "zoh"])?;
+    let missing = choice("missing", &f.missing, ["error", "hold"])?;
+    let columns = [("time", f.time.is_some()), ("inputs", f.inputs.is_some()), ("outputs", f.outputs.is_some()), ("disturbances", f.disturbances.is_some()), ("states", f.states.is_some())];
+    if format == "rrd" {
+        if let Some((key, _)) = columns.iter().find(|c| c.1) {
+            return Err(bad(format!("plant.replay.{key}"), "a run's .rrd names its own signals: no column map"));
+        }
+        if resample != "none" || missing != "error" {
+            return Err(bad("plant.replay", "a run's .rrd is on the run's grid: resample and missing are for CSV logs"));
+        }
+    }
+    // A list of column names: `want` of them, or (when `optional`) none at all.
+    let list = |key: &str, given: &Option<Vec<String>>, want: usize, what: &str, optional: bool| -> Result<Option<Vec<String>>, Bad> {
+        let Some(names) = given else {
+            return if optional || want == 0 || format == "rrd" { Ok(None) } else { Err(bad(format!("plant.replay.{key}"), format!("missing: {want} column name{} ({what})", if want == 1 { "" } else { "s" }))) };
+        };
+        if names.len() != want {
+            return Err(bad(format!("plant.replay.{key}"), format!("{} name{} given; [plant] has {want} {what}", names.len(), if names.len() == 1 { "" } else { "s" })));
+        }
+        if let Some(i) = names.iter().position(|s| s.trim().is_empty()) {
+            return Err(bad(format!("plant.replay.{key}[{}]", i + 1), "a column name, not empty"));
+        }
+        Ok(Some(names.clone()))
+    };
+    let inputs = list("inputs", &f.inputs, z.l, "known inputs (columns of B)", false)?;
+    let outputs = list("outputs", &f.outputs, z.p, "outputs (rows of C)", false)?;
+    let disturbances = list("disturbances", &f.disturbances, z.q, "unknown inputs (columns of E)", true)?;
+    let states = list("states", &f.states, z.n, "states", true)?;
+    let params = json!({
+        "path": path.display().to_string(),
+        "format": format,
+        "time": f.time,
+        "inputs": inputs.unwrap_or_default(),
+        "outputs": outputs.unwrap_or_default(),
+        "disturbances": disturbances,
+        "states": states,
+        "resample": resample,
+        "missing": missing,
+        "dt": dt,
+        "steps": steps,
+        "n": z.n, "p": z.p, "l": z.l, "q": z.q, "r": r,
+    });
+    Ok(Some((path, ProcessSpec { command: vec![REPLAY_PLANT_PROGRAM.into()], params })))
+}
+
+/// Whether the replayed data carries the true state (a CSV with `states`, or an `.rrd`): without
+/// it the plant sample's x is zero and the recorded errors are not errors.
+pub fn replay_has_states(spec: &ProcessSpec) -> bool {
+    spec.params.get("format").and_then(|f| f.as_str()) == Some("rrd") || spec.params.get("states").is_some_and(|s| !s.is_null())
+}
