@@ -128,9 +128,13 @@ impl RunSpace {
             return Err(LockstepError::Io(format!("'{id}' is not a run id")));
         }
         let base = runs_dir();
-        let runs = open_private(RUNS, &base)?;
         let dir = base.join(id);
         let missing = || LockstepError::Io(format!("no run '{id}' in {}", base.display()));
+        // No runs directory yet (no launcher has run on this machine): no run either.
+        if std::fs::symlink_metadata(&base).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound) {
+            return Err(missing());
+        }
+        let runs = open_private(RUNS, &base)?;
         let run = match runs.at(OsStr::new(id)) {
             Ok(run) => run,
             Err(e) if e.raw_os_error() == Some(libc::ENOENT) => return Err(missing()),
