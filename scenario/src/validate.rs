@@ -283,9 +283,11 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
         )?,
     };
 
-    let disturbances = signals("disturbance", &raw.disturbance, e.ncols(), "plant.E")?;
-    let measurement_disturbances = signals("measurement_disturbance", &raw.measurement_disturbance, d.ncols(), "plant.D")?;
-    let inputs = signals("input", &raw.input, b.ncols(), "plant.B")?;
+    // Replayed data holds its own u, w and v: the signals may then be left out (zero).
+    let given = |list: &[Signal], count: usize| if p.replay.is_some() && list.is_empty() { vec![Signal::Constant { value: 0.0 }; count] } else { list.to_vec() };
+    let disturbances = signals("disturbance", &given(&raw.disturbance, e.ncols()), e.ncols(), "plant.E")?;
+    let measurement_disturbances = signals("measurement_disturbance", &given(&raw.measurement_disturbance, d.ncols()), d.ncols(), "plant.D")?;
+    let inputs = signals("input", &given(&raw.input, b.ncols()), b.ncols(), "plant.B")?;
     let ff = match &p.ff {
         Some(rows) => matrix("plant.Ff", rows, (Some(n), None), "n rows, one column per component fault")?,
         None => Mat::zeros(n, 0),
