@@ -25,6 +25,7 @@ fi
 venv="${UIO_VENV:-$PWD/.venv}"
 stamp="$venv/.uio-installed"
 "$venv/bin/python3" -c 'import fmpy' 2>/dev/null || rm -f "$stamp"  # test FMUs (issue 22): fmpy
+"$venv/bin/python3" -c 'import mcap' 2>/dev/null || rm -f "$stamp"  # export --mcap read back (issue 23)
 if [ ! -x "$venv/bin/python3" ] || [ ! -e "$stamp" ] \
    || [ -n "$(find python/pyproject.toml python/uio_component -newer "$stamp" -print -quit)" ]; then
   if ! python3 -c 'import ensurepip, venv' 2>/dev/null; then
@@ -35,7 +36,7 @@ if [ ! -x "$venv/bin/python3" ] || [ ! -e "$stamp" ] \
   fi
   echo "preparing the Python environment $venv"
   [ -x "$venv/bin/python3" ] || python3 -m venv "$venv"
-  "$venv/bin/pip" install -q --disable-pip-version-check ./python pytest scipy fmpy  # fmpy: test FMUs (issue 22)
+  "$venv/bin/pip" install -q --disable-pip-version-check ./python pytest scipy fmpy mcap  # fmpy: test FMUs (issue 22); mcap: export (issue 23)
   touch "$stamp"
 fi
 export PATH="$venv/bin:$PATH"

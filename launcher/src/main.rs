@@ -212,13 +212,23 @@ enum Command {
         #[arg(long, value_name = "T", allow_negative_numbers = true)]
         to: Option<f64>,
     },
-    /// Export a recording's signals as CSV, one file per entity group.
+    /// Export a recording's signals for other tools: CSV, MCAP, NumPy .npz, MATLAB .mat (one or more).
+    #[command(group(clap::ArgGroup::new("format").required(true).multiple(true).args(["csv", "mcap", "npz", "mat"])))]
     Export {
         /// The recording.
         recording: PathBuf,
-        /// Output directory.
-        #[arg(long)]
-        csv: PathBuf,
+        /// Output directory: one CSV per entity group.
+        #[arg(long, value_name = "DIR")]
+        csv: Option<PathBuf>,
+        /// MCAP file (Foxglove, PlotJuggler): one JSON channel per entity group.
+        #[arg(long, value_name = "FILE")]
+        mcap: Option<PathBuf>,
+        /// NumPy .npz file: `t`, `step` and one steps × members array per entity group.
+        #[arg(long, value_name = "FILE")]
+        npz: Option<PathBuf>,
+        /// MATLAB level-5 .mat file: the arrays of --npz.
+        #[arg(long, value_name = "FILE")]
+        mat: Option<PathBuf>,
     },
     /// Write one of a scenario's observers as an FMI co-simulation FMU, DIR/<observer>_fmi<2|3>.fmu.
     ExportFmu {
@@ -529,7 +539,7 @@ fn main() -> ExitCode {
                 Err(e) => fail(&LaunchError::BadInput(format!("{}: {e}", recording.display()))),
             }
         }
-        Command::Export { recording, csv } => {
+        Command::Export { recording, csv, mcap, npz, mat } => {
             let r = match read_recording(&recording) {
                 Ok(r) => r,
                 Err(code) => return code,
@@ -538,11 +548,24 @@ fn main() -> ExitCode {
             if !r.complete {
                 eprintln!("warning: {}: incomplete recording (its writer did not finish); exporting what it holds", recording.display());
             }
-            match recording::export::export(&r, &csv, dt) {
-                Ok(files) => {
-                    println!("{} files in {}", files.len(), csv.display());
-                    ExitCode::SUCCESS
+            use recording::export as ex;
+            let done = (|| -> Result<(), String> {
+                if let Some(d) = &csv {
+                    println!("{} files in {}", ex::export(&r, d, dt)?.len(), d.display());
                 }
+                if let Some(p) = &mcap {
+                    println!("{}: {} channels", p.display(), ex::mcap::export(&r, p, dt)?);
+                }
+                if let Some(p) = &npz {
+                    println!("{}: {} arrays", p.display(), ex::npz::export(&r, p, dt)?);
+                }
+                if let Some(p) = &mat {
+                    println!("{}: {} variables", p.display(), ex::mat::export(&r, p, dt)?);
+                }
+                Ok(())
+            })();
+            match done {
+                Ok(_) => ExitCode::SUCCESS,
                 Err(e) => fail(&LaunchError::BadInput(e)),
             }
         }
