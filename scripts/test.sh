@@ -26,6 +26,7 @@ venv="${UIO_VENV:-$PWD/.venv}"
 stamp="$venv/.uio-installed"
 "$venv/bin/python3" -c 'import fmpy' 2>/dev/null || rm -f "$stamp"  # test FMUs (issue 22): fmpy
 "$venv/bin/python3" -c 'import mcap' 2>/dev/null || rm -f "$stamp"  # export --mcap read back (issue 23)
+"$venv/bin/python3" -c 'import control, maturin' 2>/dev/null || rm -f "$stamp"  # the Python package (issue 23)
 if [ ! -x "$venv/bin/python3" ] || [ ! -e "$stamp" ] \
    || [ -n "$(find python/pyproject.toml python/uio_component -newer "$stamp" -print -quit)" ]; then
   if ! python3 -c 'import ensurepip, venv' 2>/dev/null; then
@@ -36,7 +37,7 @@ if [ ! -x "$venv/bin/python3" ] || [ ! -e "$stamp" ] \
   fi
   echo "preparing the Python environment $venv"
   [ -x "$venv/bin/python3" ] || python3 -m venv "$venv"
-  "$venv/bin/pip" install -q --disable-pip-version-check ./python pytest scipy fmpy mcap  # fmpy: test FMUs (issue 22); mcap: export (issue 23)
+  "$venv/bin/pip" install -q --disable-pip-version-check ./python pytest scipy fmpy mcap maturin control  # fmpy: test FMUs (issue 22); mcap: export, maturin and control: the Python package (issue 23)
   touch "$stamp"
 fi
 export PATH="$venv/bin:$PATH"
@@ -45,6 +46,9 @@ export PATH="$venv/bin:$PATH"
 cargo build --release --workspace --bins
 # The observer FMUs' library (a cdylib, which --bins does not build), for `launcher export-fmu`.
 cargo build --release -p fmu-observer
+# The Python package on the design library (pyuio/, PyO3): maturin builds it with cargo, in
+# this target directory, and installs it in the environment; unchanged sources rebuild nothing.
+"$venv/bin/pip" install -q --disable-pip-version-check --no-build-isolation ./pyuio
 
 log=$(mktemp)
 trap 'rm -f "$log"' EXIT

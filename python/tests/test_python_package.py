@@ -1,0 +1,110 @@
+"""The Python package `uio_observers` (pyuio/, PyO3 + maturin; issue 23 item 4), against the CLI:
+its designs equal `launcher design --json` bit for bit, a design from a python-control
+StateSpace equals the one from its matrices, `run` and `read` give the recording's values as
+the CSV export does, and bad input raises with the launcher's message."""
+
+import csv
+import json
+import subprocess
+
+import control
+import numpy as np
+import pytest
+
+import uio_observers as uo
+from test_diagnosis_scipy import launcher
+
+# Seed 002 (Chen & Patton's example) and the DC motor of scenarios/dc-motor-load-torque.toml.
+SEED002 = dict(A=[[0.0, 1.0, 0.0], [-2.0, -3.0, 0.0], [0.0, 0.0, -2.0]], B=[[0.0, 0.0], [4.0, 0.0], [0.0, 1.0]],
+               C=[[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]], E=[[2.0], [0.0], [0.5]])
+MOTOR = dict(A=[[-2.0, -0.02, 0.0], [1.0, -10.0, 0.0], [0.0, 1.0, 0.0]], B=[[2.0], [0.0], [0.0]],
+             C=[[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], E=[[0.0], [-100.0], [0.0]])
+
+CASES = {
+    "seed002-chen-patton": (SEED002, dict(kind="chen-patton-uio", poles=[-1.0, -2.0, -3.0], placement="matlab", dt=0.001)),
+    "seed002-luenberger-lqe": (SEED002, dict(kind="luenberger", gain="lqe", Q=np.eye(3), R=0.01 * np.eye(2), dt=0.01)),
+    "motor-chen-patton": (MOTOR, dict(kind="chen-patton-uio", poles=[-20.0, -30.0], dt=0.001)),
+    "motor-hui-zak": (MOTOR, dict(kind="hui-zak-uio", decay=1.0, dt=0.001)),
+    "motor-complex-poles": (MOTOR, dict(kind="luenberger", poles=[-20.0, complex(-30.0, 5.0), complex(-30.0, -5.0)], dt=0.002)),
+}
+
+
+def cli_design(tmp_path, text):
+    path = tmp_path / "design.toml"
+    path.write_text(text)
+    done = subprocess.run([launcher(), "design", "--json", str(path)], capture_output=True, text=True, timeout=120)
+    return done
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_a_python_design_equals_the_launchers_bit_for_bit(tmp_path, case):
+    plant, kw = CASES[case]
+    d = uo.design(**plant, **kw)
+    done = cli_design(tmp_path, uo.design_scenario(**plant, **kw))
+    assert done.returncode == 0, done.stderr
+    cli = json.loads(done.stdout)["observers"][0]
+    assert d.json["observers"][0] == cli  # the whole report, every float by value
+    for k in "FGKPQ":
+        want = np.array(cli["sampled"][k], dtype=float).reshape(d.sampled[k].shape)
+        assert np.array_equal(d.sampled[k].view(np.uint64), want.view(np.uint64)), k  # bits, signed zeros too
+    for k, m in cli["matrices"].items():
+        assert np.array_equal(d.continuous[k], np.array(m, dtype=float).reshape(d.continuous[k].shape)), k
+    # The sampled observer's poles are its F's eigenvalues: the discrete poles reported.
+    assert np.allclose(np.sort_complex(np.linalg.eigvals(d.sampled["F"])), np.sort_complex(d.discrete_poles), atol=1e-9)
+
+
+def test_a_design_from_a_python_control_statespace():
+    sys = control.ss(SEED002["A"], SEED002["B"], SEED002["C"], np.zeros((2, 2)))
+    kw = dict(kind="chen-patton-uio", poles=[-1.0, -2.0, -3.0], dt=0.001)
+    from_sys, from_matrices = uo.design(sys=sys, E=SEED002["E"], **kw), uo.design(**SEED002, **kw)
+    for k in "FGKPQ":
+        assert np.array_equal(from_sys.sampled[k], from_matrices.sampled[k]), k
+    # As a python-control system from [u; y] to x̂, its poles are the design's discrete poles.
+    obs = from_sys.statespace()
+    assert obs.dt == 0.001 and obs.ninputs == 4 and obs.noutputs == 3
+    assert np.allclose(np.sort_complex(obs.poles()), np.sort_complex(from_sys.discrete_poles), atol=1e-9)
+    with pytest.raises(ValueError, match="discrete-time StateSpace"):
+        uo.design(sys=control.ss(sys.A, sys.B, sys.C, sys.D, 0.1), E=SEED002["E"], **kw)
+
+
+def test_a_design_that_cannot_exist_raises_the_launchers_reason(tmp_path):
+    # E seen by no output: rank(CE) = 0 < rank(E) = 1, no unknown-input decoupling.
+    plant = dict(SEED002, E=[[0.0], [1.0], [0.0]])
+    kw = dict(kind="chen-patton-uio", poles=[-1.0, -2.0, -3.0], dt=0.001)
+    with pytest.raises(ValueError) as e:
+        uo.design(**plant, **kw)
+    done = cli_design(tmp_path, uo.design_scenario(**plant, **kw))
+    assert done.returncode == 2
+    assert str(e.value) in done.stdout, (str(e.value), done.stdout)
+    with pytest.raises(ValueError, match=r"plant\.C"):  # a scenario error: C of the wrong width
+        uo.design(**dict(SEED002, C=[[1.0, 0.0]]), **kw)
+
+
+def csv_table(path):
+    with open(path) as f:
+        rows = list(csv.reader(f))
+    return np.array([[float(v) if v else np.nan for v in r] for r in rows[1:]])
+
+
+def test_run_and_read_give_the_recordings_values(tmp_path):
+    r = uo.run("seed002-piecewise", tmp_path / "out")
+    assert r.ok and len(r.step) == r.summary["steps"] == 20000 and r.summary["scenario"] == "seed002-piecewise"
+    summary = json.loads((tmp_path / "out" / "seed002-piecewise.summary.json").read_text())
+    assert r.summary["observers"] == summary["observers"]
+    done = subprocess.run([launcher(), "export", "--csv", str(tmp_path / "csv"), r.path], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    compared = 0
+    for group in ("/plant/x", "/plant/y", "/observer/uio/xhat", "/observer/uio/error", "/controller/u"):
+        want = csv_table(tmp_path / "csv" / (group.strip("/").replace("/", "_") + ".csv"))
+        got = r.groups[group][np.isin(r.step, want[:, 0].astype(np.int64))]
+        assert np.array_equal(got, want[:, 2:], equal_nan=True), group
+        assert np.array_equal(r.t[np.isin(r.step, want[:, 0].astype(np.int64))], want[:, 1])
+        compared += got.size
+    assert compared > 200_000
+    again = uo.read(r.path)
+    assert all(np.array_equal(again.groups[g], r.groups[g], equal_nan=True) for g in r.groups)
+    assert r["observer_uio_xhat"] is r.groups["/observer/uio/xhat"]
+    with pytest.raises(ValueError):
+        uo.read(tmp_path / "nothing.rrd")
+    with pytest.raises(ValueError, match="did you mean"):
+        uo.run("seed002-piecewse", tmp_path / "out2")

@@ -1,0 +1,108 @@
+//! `uio_observers._native`: the launcher's own design, run and read paths, reached from Python.
+//! Nothing here designs or simulates: `design` is `launcher design --json`'s report, `run` is
+//! `launcher run --mode in-process`, `read` is the export's table of a recording — so the Python
+//! package gives the CLI's numbers, bit for bit. The Python layer (`uio_observers/__init__.py`)
+//! turns what these return into NumPy arrays.
+
+use std::path::{Path, PathBuf};
+
+use launcher::run::{Mode, Options, Stop};
+use launcher::{design_report, plan, shipped, LaunchError};
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyBytes;
+use scenario::Scenario;
+
+/// Bad input (a scenario, a file) as `ValueError`, what failed while running as `RuntimeError`,
+/// each with the launcher's message.
+fn raise(e: LaunchError) -> PyErr {
+    match e {
+        LaunchError::Scenario(_) | LaunchError::BadInput(_) => PyValueError::new_err(e.to_string()),
+        _ => PyRuntimeError::new_err(e.to_string()),
+    }
+}
+
+/// A scenario file or shipped name, or (with `text`) the scenario written in `text` and
+/// located at `path` (relative paths in it resolve from its folder).
+fn scenario(path: &str, text: Option<&str>) -> Result<Scenario, LaunchError> {
+    Ok(match text {
+        Some(t) => Scenario::parse(Path::new(path), t)?,
+        None => Scenario::load(&shipped::resolve(Path::new(path))?)?,
+    })
+}
+
+/// `launcher design --json`: (every design holds, the JSON report, the text report).
+#[pyfunction]
+#[pyo3(signature = (path, text=None))]
+fn design(path: &str, text: Option<&str>) -> PyResult<(bool, String, String)> {
+    let s = scenario(path, text).map_err(raise)?;
+    let r = design_report::report(&s);
+    Ok((r.ok, serde_json::to_string(&r.json).expect("serialises"), r.text))
+}
+
+/// `launcher run --mode in-process --out OUT`: (the recording, the summary JSON, completed and
+/// every expectation met).
+#[pyfunction]
+#[pyo3(signature = (path, out, force=false))]
+fn run(py: Python<'_>, path: &str, out: &str, force: bool) -> PyResult<(String, String, bool)> {
+    let s = scenario(path, None).map_err(raise)?;
+    let p = plan::plan(&s).map_err(|e| raise(LaunchError::Scenario(e.error)))?;
+    let mut p = p;
+    launcher::calibrate::calibrate(&s, &mut p).map_err(raise)?;
+    let select = recording::write::Selection::new(1, &[]).map_err(|e| raise(LaunchError::BadInput(e)))?;
+    let opts = Options {
+        out: PathBuf::from(out),
+        mode: Mode::InProcess,
+        wait: lockstep::Wait::default_for_machine(),
+        force,
+        allow_unstable: false,
+        record: true,
+        pin: false,
+        select,
+        progress: false,
+        realtime: None,
+    };
+    // The run holds no Python object: other Python threads may go on meanwhile.
+    let o = py.detach(|| launcher::run::run(&s, &p, &opts)).map_err(raise)?;
+    let rrd = o.rrd.as_ref().map(|r| r.display().to_string()).unwrap_or_default();
+    let summary = serde_json::to_string(&o.summary).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+    let ok = matches!(o.stop, Stop::Completed) && o.summary.expectations_met();
+    Ok((rrd, summary, ok))
+}
+
+/// One entity group of a recording: its path, its members' names and labelled names, and its
+/// values row by row (steps × members, NaN where a member has no value at a step).
+type Group<'py> = (String, Vec<String>, Vec<String>, Bound<'py, PyBytes>);
+
+/// A recording as the exports see it: (the steps, dt if known, the groups).
+#[pyfunction]
+fn read<'py>(py: Python<'py>, path: &str) -> PyResult<(Bound<'py, PyBytes>, Option<f64>, Vec<Group<'py>>)> {
+    let r = recording::read(Path::new(path)).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    if let recording::Integrity::Damaged(what) = &r.integrity {
+        return Err(PyValueError::new_err(format!("{path}: damaged: {what}")));
+    }
+    let groups = recording::export::table::labelled(&r);
+    let steps = recording::export::table::all_steps(&groups);
+    let bytes = |v: &[f64]| PyBytes::new(py, &v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>());
+    let mut out = Vec::with_capacity(groups.len());
+    for g in &groups {
+        let cols: Vec<Vec<Option<f64>>> = g.members.iter().map(|m| recording::export::table::aligned(&steps, m.series).collect()).collect();
+        let mut values = Vec::with_capacity(steps.len() * cols.len());
+        for k in 0..steps.len() {
+            values.extend(cols.iter().map(|c| c[k].unwrap_or(f64::NAN)));
+        }
+        let names = g.members.iter().map(|m| m.name.clone()).collect();
+        let labels = g.members.iter().map(|m| m.label.clone()).collect();
+        out.push((g.path.clone(), names, labels, bytes(&values)));
+    }
+    let steps = PyBytes::new(py, &steps.iter().flat_map(|k| k.to_le_bytes()).collect::<Vec<u8>>());
+    Ok((steps, recording::tools::recorded_dt(&r), out))
+}
+
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(design, m)?)?;
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(read, m)?)?;
+    Ok(())
+}

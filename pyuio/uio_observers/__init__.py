@@ -1,0 +1,204 @@
+"""uio-observers from Python: the design library, runs and recordings as NumPy arrays.
+
+    design(A, B, C, E, kind="chen-patton-uio", poles=[...] | gain="lqe", dt=0.001)
+    design(sys, E=E, ...)               # sys: a python-control StateSpace (its A, B, C)
+    run("seed002-sine")                 # a scenario file or a shipped scenario's name
+    read("runs/seed002-sine.rrd")
+
+Every number comes from the Rust library the launcher runs (`launcher design --json`,
+`launcher run --mode in-process`, the export's table of a recording), so it equals the CLI's
+bit for bit. Bad input raises ValueError, a failed run RuntimeError, with the launcher's message.
+"""
+
+import json
+import os
+import tempfile
+
+import numpy as np
+
+from . import _native
+
+__all__ = ["design", "design_scenario", "run", "read", "Design", "Recording", "RunResult"]
+
+
+def _toml_number(v):
+    v = float(v)
+    if not np.isfinite(v):
+        raise ValueError(f"{v} is not a finite number")
+    return repr(v)
+
+
+def _toml_matrix(name, m):
+    m = np.atleast_2d(np.asarray(m, dtype=float))
+    if m.ndim != 2:
+        raise ValueError(f"{name}: a matrix (2-D), not {m.ndim}-D")
+    return "[" + ", ".join("[" + ", ".join(_toml_number(v) for v in row) + "]" for row in m) + "]"
+
+
+def _toml_list(v):
+    return "[" + ", ".join(_toml_number(x) for x in np.ravel(v)) + "]"
+
+
+def _toml_poles(poles):
+    """Poles as a scenario writes them: a complex pair once, as [re, im] (its conjugate implied)."""
+    out, pairs = [], []
+    for p in poles:
+        p = complex(p)
+        if p.imag == 0:
+            out.append(_toml_number(p.real))
+        elif p.conjugate() in pairs:
+            pairs.remove(p.conjugate())
+        else:
+            pairs.append(p)
+            out.append(f"[{_toml_number(p.real)}, {_toml_number(p.imag)}]")
+    return "[" + ", ".join(out) + "]"
+
+
+def _matrices(sys, A, B, C):
+    if sys is not None:
+        if any(m is not None for m in (A, B, C)):
+            raise ValueError("give the plant either as sys (a StateSpace) or as A, B, C, not both")
+        if getattr(sys, "dt", 0) not in (0, None):
+            raise ValueError("sys is a discrete-time StateSpace: design takes the continuous model and dt")
+        A, B, C = sys.A, sys.B, sys.C
+    if A is None or B is None or C is None:
+        raise ValueError("the plant needs A, B and C (or sys)")
+    return [np.atleast_2d(np.asarray(m, dtype=float)) for m in (A, B, C)]
+
+
+def design_scenario(A=None, B=None, C=None, E=None, *, sys=None, D=None, kind="chen-patton-uio", poles=None,
+                    gain=None, Q=None, R=None, placement=None, dt, x0=None, name="design", **keys):
+    """The scenario text `design` designs: the plant and one observer named `observer`; extra
+    keyword arguments become keys of the `[[observer]]` table (e.g. decay=1.0, H=[[...]])."""
+    A, B, C = _matrices(sys, A, B, C)
+    n = A.shape[0]
+    lines = [f'name = "{name}"', f"dt = {_toml_number(dt)}", f"duration = {_toml_number(dt)}", "", "[plant]",
+             f"A = {_toml_matrix('A', A)}", f"B = {_toml_matrix('B', B)}", f"C = {_toml_matrix('C', C)}"]
+    column = lambda m: None if m is None else np.asarray(m, dtype=float).reshape(len(m), -1)  # noqa: E731 (a 1-D E is one column)
+    E, D = column(E), column(D)
+    if E is not None and E.size:
+        lines.append(f"E = {_toml_matrix('E', E)}")
+    if D is not None and D.size:
+        lines.append(f"D = {_toml_matrix('D', D)}")
+    lines.append(f"x0 = {_toml_list(np.zeros(n) if x0 is None else x0)}")
+    # A design needs no signals, but a scenario names one per column of B, E and D.
+    for table, m in (("input", B), ("disturbance", E), ("measurement_disturbance", D)):
+        for _ in range(0 if m is None or not m.size else m.shape[1]):
+            lines += ["", f"[[{table}]]", 'kind = "constant"', "value = 0.0"]
+    lines += ["", "[[observer]]", 'name = "observer"', f'kind = "{kind}"']
+    if poles is not None:
+        lines.append(f"poles = {_toml_poles(poles)}")
+    if gain is not None:
+        lines.append(f'gain = "{gain}"')
+    if Q is not None:
+        lines.append(f"Q = {_toml_matrix('Q', Q)}")
+    if R is not None:
+        lines.append(f"R = {_toml_matrix('R', R)}")
+    if placement is not None:
+        lines.append(f'placement = "{placement}"')
+    for k, v in keys.items():
+        if isinstance(v, str):
+            lines.append(f'{k} = "{v}"')
+        elif np.ndim(v) == 2:
+            lines.append(f"{k} = {_toml_matrix(k, v)}")
+        elif np.ndim(v) == 1:
+            lines.append(f"{k} = {_toml_list(v)}")
+        else:
+            lines.append(f"{k} = {_toml_number(v)}")
+    return "\n".join(lines) + "\n"
+
+
+class Design:
+    """An observer's design: `continuous` (the design's own matrices, e.g. N, L, G, H for a
+    Chen–Patton UIO), `sampled` (F, G, K, P, Q of z⁺ = Fz + Gu + Ky, x̂ = Pz + Qy at `dt`),
+    `poles`, `discrete_poles`, `fixed_modes` (complex arrays), `conditions` [(name, ok, detail)],
+    `report` (the launcher's text) and `json` (its JSON, as `launcher design --json` prints it)."""
+
+    def __init__(self, report, text):
+        self.json = report
+        self.report = text
+        o = report["observers"][0]
+        self.kind = o["kind"]
+        self.conditions = [(c["name"], c["ok"], c["detail"]) for c in o["conditions"]]
+        self.continuous = {k: np.array(v, dtype=float).reshape(len(v), -1) if len(v) else np.zeros((0, 0)) for k, v in o["matrices"].items()}
+        s = o["sampled"]
+        self.dt = s["dt"]
+        self.sampled = {k: np.array(s[k], dtype=float).reshape(len(s[k]), -1) if len(s[k]) else np.zeros((0, 0)) for k in "FGKPQ"}
+        c = lambda pairs: np.array([complex(re, im) for re, im in pairs])  # noqa: E731
+        self.poles, self.discrete_poles, self.fixed_modes = c(o["poles"]), c(o["discrete_poles"]), c(o["fixed_modes"])
+
+    def statespace(self):
+        """The sampled observer as a python-control system from [u; y] to x̂ (dt = self.dt)."""
+        import control
+
+        F, G, K, P, Q = (self.sampled[k] for k in "FGKPQ")
+        return control.ss(F, np.hstack([G, K]), P, np.hstack([np.zeros((P.shape[0], G.shape[1])), Q]), self.dt)
+
+    def __repr__(self):
+        return f"Design({self.kind}, dt={self.dt}, discrete poles {np.round(self.discrete_poles, 6).tolist()})"
+
+
+def design(A=None, B=None, C=None, E=None, **kw):
+    """Designs one observer of `kind` for ẋ = Ax + Bu + Ew, y = Cx (+ Dv) sampled at `dt`; see
+    `design_scenario` for the keywords. Raises ValueError, with the launcher's reason, when the
+    design's conditions do not hold."""
+    text = design_scenario(A, B, C, E, **kw)
+    ok, report, lines = _native.design(os.path.join(os.getcwd(), "design.toml"), text)
+    report = json.loads(report)
+    if not ok:
+        o = report["observers"][0]
+        raise ValueError(o.get("error") or next((ln.strip() for ln in lines.splitlines() if "FAIL" in ln), lines.strip()))
+    return Design(report, lines)
+
+
+class Recording:
+    """A recording's signals: `t` and `step` (one row per recorded step) and, per entity group,
+    a steps × members array (`groups["/observer/uio/xhat"]`, also `recording["observer_uio_xhat"]`),
+    NaN where a member has no value at a step; `names[group]` and `labels[group]` name the
+    columns as the CSV export heads them."""
+
+    def __init__(self, path):
+        steps, dt, groups = _native.read(os.fspath(path))
+        self.path = os.fspath(path)
+        self.step = np.frombuffer(steps, dtype="<i8").copy()
+        self.dt = dt
+        self.t = self.step * dt if dt is not None else None
+        self.groups, self.names, self.labels = {}, {}, {}
+        for group, names, labels, values in groups:
+            self.groups[group] = np.frombuffer(values, dtype="<f8").reshape(len(self.step), len(names)).copy()
+            self.names[group], self.labels[group] = names, labels
+
+    def __getitem__(self, key):
+        g = key if key.startswith("/") else "/" + key.replace("_", "/")
+        if key in self.groups:
+            return self.groups[key]
+        for path, values in self.groups.items():
+            if path.strip("/").replace("/", "_") == key or path == g:
+                return values
+        raise KeyError(key)
+
+    def __repr__(self):
+        return f"Recording({self.path!r}, {len(self.step)} steps, {len(self.groups)} groups)"
+
+
+def read(path):
+    """Reads a `.rrd` recording (ValueError for a missing, damaged or foreign file)."""
+    return Recording(path)
+
+
+class RunResult(Recording):
+    """A finished run: its recording's signals, `summary` (the summary JSON as a dict) and `ok`
+    (completed, every expectation met)."""
+
+    def __init__(self, rrd, summary, ok):
+        super().__init__(rrd)
+        self.summary, self.ok = json.loads(summary), ok
+
+
+def run(scenario, out=None, force=True):
+    """Runs a scenario (a file, or a shipped scenario's name) in this process, recording it to
+    `out` (default: a new temporary folder); returns a RunResult. External components
+    (`kind = "process"`, `[plant.process]`, an FMU plant) need `launcher run` across processes."""
+    out = out or tempfile.mkdtemp(prefix="uio-run-")
+    rrd, summary, ok = _native.run(os.fspath(scenario), os.fspath(out), force)
+    return RunResult(rrd, summary, ok)
