@@ -7,7 +7,10 @@
   the same observer signals bit for bit (closed loop, replayed open loop with the recorded u);
 * a replay with another scenario of the same plant runs; one with another plant's sizes does not;
 * bad data exits 2 before anything runs, naming file, line/column and reason, leaving nothing;
-* `resample = "zoh"` puts a log with missing rows on the grid and counts the held samples.
+* `resample = "zoh"` puts a log with missing rows on the grid and counts the held samples;
+* an MCAP log of the CSV's rows (JSON messages) replays to the CSV replay's recording bit for
+  bit, a run's `launcher export --mcap` replays to its observer signals bit for bit, and a bad
+  MCAP (no such channel, not JSON, a missing or non-finite field, time going back) exits 2.
 """
 
 import json
@@ -333,3 +336,175 @@ def test_replay_throughput(tmp_path):
     wall = time.monotonic() - start
     assert p.returncode == 0, p.stderr
     print(f"\nreplay throughput: {steps + 1} rows in {wall:.2f} s = {(steps + 1) / wall:.0f} rows/s (whole process)")
+
+
+# ---- MCAP logs: the fields of a JSON channel's messages mapped by name as a CSV's columns ----
+
+FIELDS = ["t", "volts1", "volts2", "load1", "load2", *STATES, *OUTPUTS]
+
+
+def write_mcap(path, t, u, w, x, y, topic="/motor", encoding="json", edit=None):
+    """The CSV's rows as JSON messages on `topic`, stamped with t in ns (log and publish time).
+    `edit(k, fields, stamp)` may return other (payload bytes, stamp) for message k."""
+    from mcap.writer import Writer
+
+    with open(path, "wb") as f:
+        out = Writer(f)
+        out.start()
+        schema = out.register_schema(name="motor", encoding="jsonschema", data=json.dumps({"type": "object"}).encode())
+        channel = out.register_channel(topic=topic, message_encoding=encoding, schema_id=schema)
+        out.register_channel(topic="/notes", message_encoding="json", schema_id=schema)
+        for k in range(len(t)):
+            fields = dict(zip(FIELDS, (float(v) for v in (t[k], *u[k], *w[k], *x[k], *y[k]))))
+            stamp = round(t[k] * 1e9)
+            data = json.dumps(fields).encode()
+            if edit is not None:
+                data, stamp = edit(k, fields, stamp) or (data, stamp)
+            out.add_message(channel_id=channel, log_time=stamp, data=data, publish_time=stamp)
+        out.finish()
+
+
+def mcap_scenario(folder, name="motor.mcap", time_field=True, extra=""):
+    """The CSV scenario on an MCAP log: `channel` added, the time a field or the log_time."""
+    scen = motor_scenario(folder, csv=name, extra=f'channel = "/motor"\n{extra}')
+    if not time_field:
+        scen.write_text(re.sub(r'^time = "t"\n', "", scen.read_text(), count=1, flags=re.M))
+    return scen
+
+
+@pytest.mark.parametrize("time_field", [True, False], ids=["time-field", "log-time"])
+def test_mcap_log_replays_as_the_csv_bit_for_bit(motor, tmp_path, time_field):
+    folder, (t, u, w, x, y) = motor
+    csv_out, mcap_out = tmp_path / "csv", tmp_path / "mcap"
+    p = launch(tmp_path, "run", motor_scenario(folder), "--out", csv_out)
+    assert p.returncode == 0, p.stderr
+    write_mcap(tmp_path / "motor.mcap", t, u, w, x, y)
+    p = launch(tmp_path, "run", mcap_scenario(tmp_path, time_field=time_field), "--out", mcap_out)
+    assert p.returncode == 0, p.stderr
+    s = json.loads((mcap_out / "motor-log.summary.json").read_text())
+    assert s["replay"] == {"file": "motor.mcap", "rows": len(t), "samples": len(t), "held_rows": 0, "held_cells": 0, "states": True}
+    values, signals = compared(launch(tmp_path, "compare", csv_out / "motor-log.rrd", mcap_out / "motor-log.rrd"))
+    print(f"\nMCAP replay ({'time field' if time_field else 'log_time'}): {values} values of {signals} signals equal the CSV replay's bit for bit")
+    assert signals > 30 and values > 8000 * 30
+
+
+def test_mcap_of_our_export_replays_open_loop_bit_for_bit(tmp_path):
+    """`launcher export --mcap` of an open-loop run, replayed with the run's scenario on the
+    exported /plant/x, /plant/y and /input channels: every observer signal is the original's."""
+    from mcap.reader import make_reader
+
+    out = tmp_path / "orig"
+    p = launch(tmp_path, "run", os.path.join(SCEN, "seed003-sensor-faults.toml"), "--out", out)
+    assert p.returncode == 0, p.stderr
+    folder = tmp_path / "scen"
+    folder.mkdir()
+    p = launch(tmp_path, "export", out / "seed003-sensor-faults.rrd", "--mcap", folder / "run.mcap")
+    assert p.returncode == 0, p.stderr
+    # Each channel's members, in order: the keys of its first message but step and sim_time.
+    fields = {}
+    with open(folder / "run.mcap", "rb") as f:
+        for _, channel, message in make_reader(f).iter_messages(topics=["/plant/x", "/plant/y", "/input"]):
+            fields.setdefault(channel.topic, [f"{channel.topic}.{k}" for k in json.loads(message.data) if k not in ("step", "sim_time")])
+    assert [len(fields[c]) for c in ("/plant/x", "/plant/y", "/input")] == [4, 3, 1], fields
+    # The path absolute, as `launcher replay` writes it: the recording's copy of the scenario
+    # then parses anywhere, so the exported headers carry the names and units too.
+    text = open(os.path.join(SCEN, "seed003-sensor-faults.toml")).read()
+    text += f"""
+[plant.replay]
+path = "{folder / 'run.mcap'}"
+channel = ["/plant/x", "/plant/y", "/input"]
+states = {names(fields["/plant/x"])}
+outputs = {names(fields["/plant/y"])}
+inputs = {names(fields["/input"])}
+"""
+    (folder / "seed003-sensor-faults.toml").write_text(text)
+    p = launch(tmp_path, "run", folder / "seed003-sensor-faults.toml", "--out", tmp_path / "again")
+    assert p.returncode == 0, p.stderr
+    for d in ("orig", "again"):
+        p = launch(tmp_path, "export", tmp_path / d / "seed003-sensor-faults.rrd", "--csv", tmp_path / f"csv-{d}")
+        assert p.returncode == 0, p.stderr
+    a, b = sorted(os.listdir(tmp_path / "csv-orig")), sorted(os.listdir(tmp_path / "csv-again"))
+    same = [f for f in a if f.startswith(("observer_", "diagnos", "plant_", "input")) and f in b]
+    assert sum(f.startswith("observer_kalman_") for f in same) >= 3 and any(f.startswith("diagnos") for f in same), same
+    cells = 0
+    for f in same:
+        mine, theirs = (tmp_path / "csv-orig" / f).read_bytes(), (tmp_path / "csv-again" / f).read_bytes()
+        assert mine == theirs, f
+        cells += sum(len(line.split(b",")) - 2 for line in mine.splitlines()[1:])
+    a = json.loads((out / "seed003-sensor-faults.summary.json").read_text())
+    b = json.loads((tmp_path / "again" / "seed003-sensor-faults.summary.json").read_text())
+    assert a["diagnosis"] == b["diagnosis"]
+    print(f"\nexported MCAP replayed: {len(same)} groups, {cells} values equal the original's bit for bit")
+
+
+def nan_at(k0, field):
+    def edit(k, fields, stamp):
+        if k == k0:
+            fields[field] = float("nan")
+            return json.dumps(fields).encode(), stamp  # Python writes a bare NaN
+    return edit
+
+
+def drop_at(k0, field):
+    def edit(k, fields, stamp):
+        if k == k0:
+            del fields[field]
+            return json.dumps(fields).encode(), stamp
+    return edit
+
+
+def swap_stamps(k0):
+    def edit(k, fields, stamp):
+        if k in (k0, k0 + 1):
+            return json.dumps(fields).encode(), round((k0 + 1 if k == k0 else k0) * DT * 1e9)
+    return edit
+
+
+BAD_MCAP = {
+    "no such channel": (dict(topic="/motors"), ["bad.mcap: no channel \"/motor\" (plant.replay.channel) (did you mean '/motors'?); the file has \"/motors\" (json), \"/notes\" (json)"]),
+    "not json": (dict(encoding="cdr"), ['bad.mcap: channel "/motor" is encoded as "cdr"', 'only JSON channels']),
+    "not an object": (dict(edit=lambda k, f, s: (b"[1, 2]", s) if k == 50 else None), ['bad.mcap: row 51 of "/motor": a JSON array, not an object']),
+    "field missing": (dict(edit=drop_at(50, "volts1")), ['bad.mcap: row 51, field "volts1": not in the message', 'missing = "hold"']),
+    "no such field": (dict(edit=lambda k, f, s: (json.dumps({("theta2_mea" if n == "theta2_meas" else n): v for n, v in f.items()}).encode(), s)),
+                      ['bad.mcap: no field "theta2_meas" (plant.replay.outputs[6]) in the first message of /motor (did you mean', "it has t, volts1, volts2, load1"]),
+    "non-finite": (dict(edit=nan_at(100, "theta2_meas")), ['bad.mcap: row 101, field "theta2_meas": NaN is not finite']),
+    "null": (dict(edit=lambda k, f, s: (json.dumps({**f, "omega1": None}).encode(), s) if k == 70 else None), ['bad.mcap: row 71, field "omega1": null is not finite']),
+    "time goes back": (dict(edit=swap_stamps(200)), ["bad.mcap: row 202, log_time (s after the first message): t = 0.2 after t = 0.201: time stamps must increase"]),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD_MCAP))
+def test_bad_mcap_exits_2_before_anything_runs(motor, tmp_path, case):
+    _, (t, u, w, x, y) = motor
+    kwargs, want = BAD_MCAP[case]
+    write_mcap(tmp_path / "bad.mcap", t, u, w, x, y, **kwargs)
+    scen = mcap_scenario(tmp_path, name="bad.mcap", time_field=case != "time goes back")
+    out = tmp_path / "out"
+    p = launch(tmp_path, "run", scen, "--out", out)
+    assert p.returncode == 2, p.stderr
+    assert len(p.stderr.strip().splitlines()) == 1, p.stderr
+    for w_ in want:
+        assert w_ in p.stderr, p.stderr
+    nothing_left(tmp_path, out)
+
+
+def test_mcap_missing_hold(motor, tmp_path):
+    """missing = "hold" fills a field left out, null or NaN as it fills a CSV's empty cell."""
+    _, (t, u, w, x, y) = motor
+
+    def edit(k, fields, stamp):
+        if k == 300:
+            fields["theta2_meas"] = None
+        elif k == 301:
+            fields["theta2_meas"] = float("nan")
+        elif k == 302:
+            del fields["theta2_meas"]
+        else:
+            return None
+        return json.dumps(fields).encode(), stamp
+
+    write_mcap(tmp_path / "holes.mcap", t, u, w, x, y, edit=edit)
+    out = tmp_path / "out"
+    p = launch(tmp_path, "run", mcap_scenario(tmp_path, name="holes.mcap", extra='missing = "hold"'), "--out", out)
+    assert p.returncode == 0, p.stderr
+    assert json.loads((out / "motor-log.summary.json").read_text())["replay"]["held_cells"] == 3

@@ -1,4 +1,4 @@
-//! `replay_plant`: recorded data (a CSV log or a run's `.rrd`) as the true plant of a run,
+//! `replay_plant`: recorded data (a CSV or MCAP log or a run's `.rrd`) as the true plant of a run,
 //! written with the component kit like every plant. `[plant.replay]` of a scenario names the
 //! file and its column map; the launcher starts this program with them as `params`.
 //! `replay_plant --check` reads the same parameters from stdin, reads the whole file and prints

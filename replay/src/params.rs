@@ -8,11 +8,15 @@ use serde::Deserialize;
 pub struct Params {
     /// The data file, absolute.
     pub path: String,
-    /// "csv" or "rrd".
+    /// "csv", "mcap" or "rrd".
     pub format: String,
-    /// CSV: the time column (none: rows uniform at dt).
+    /// MCAP: the JSON channels (topics) whose messages are the rows, joined by message index.
+    #[serde(default)]
+    pub channels: Vec<String>,
+    /// CSV: the time column; MCAP: the time field (none: the rows are uniform at dt; MCAP:
+    /// the messages' log_time).
     pub time: Option<String>,
-    /// CSV columns of u (l), y (p), and optionally w (q) and x (n).
+    /// CSV columns (MCAP fields) of u (l), y (p), and optionally w (q) and x (n).
     #[serde(default)]
     pub inputs: Vec<String>,
     #[serde(default)]

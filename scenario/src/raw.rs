@@ -225,13 +225,17 @@ pub struct RawFmu {
     pub substeps: Option<u32>,
 }
 
-/// `[plant.replay]`: recorded samples as the plant, a CSV's columns mapped by header name.
+/// `[plant.replay]`: recorded samples as the plant, a CSV's columns (an MCAP's JSON fields)
+/// mapped by name.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawReplay {
-    /// The `.csv` or `.rrd` file, relative to the scenario's folder.
+    /// The `.csv`, `.mcap` or `.rrd` file, relative to the scenario's folder.
     pub path: String,
-    /// CSV: the time column (absent: the rows are uniform at dt).
+    /// MCAP: the JSON channel whose messages are the rows, or several joined message by message.
+    pub channel: Option<RawChannels>,
+    /// CSV: the time column; MCAP: the time field (absent: CSV rows uniform at dt, MCAP
+    /// messages at their log_time).
     pub time: Option<String>,
     /// CSV columns read as u, one per column of B.
     pub inputs: Option<Vec<String>>,
@@ -245,6 +249,14 @@ pub struct RawReplay {
     pub resample: Option<String>,
     /// `"hold"`: an empty or non-finite cell holds the column's previous value.
     pub missing: Option<String>,
+}
+
+/// `[plant.replay] channel`: one topic or a list of them.
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+pub enum RawChannels {
+    One(String),
+    Many(Vec<String>),
 }
 
 /// One pole as written: a real number, or [re, im] for a complex pair.

@@ -1,5 +1,6 @@
 //! `[plant.replay]`: recorded data as the true plant. A CSV log (its columns mapped by header
-//! name to u, y and optionally w and x) or a run's own `.rrd` is replayed sample by sample by
+//! name to u, y and optionally w and x), an MCAP log (the fields of a JSON channel's messages
+//! mapped the same way) or a run's own `.rrd` is replayed sample by sample by
 //! the `replay_plant` component (crate `replay`), which the launcher also asks to read the file
 //! before a run. Here only what the scenario alone can tell is checked: the map's sizes against
 //! `[plant]`, the options, and that the file exists. The data is open loop: it cannot react
@@ -10,7 +11,7 @@ use std::path::Path;
 use serde_json::json;
 
 use super::fmu_plant::Sizes;
-use super::raw::RawReplay;
+use super::raw::{RawChannels, RawReplay};
 use super::validate::{bad, Bad};
 use super::{quoted, ProcessSpec};
 
@@ -28,9 +29,23 @@ pub(crate) fn plant_replay(raw: &Option<RawReplay>, dir: &Path, z: &Sizes, r: us
     let path = std::fs::canonicalize(&path).map_err(|e| bad("plant.replay.path", format!("{}: {e}", path.display())))?;
     let format = match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
         Some("csv") => "csv",
+        Some("mcap") => "mcap",
         Some("rrd") => "rrd",
-        _ => return Err(bad("plant.replay.path", format!("{}: a .csv log or a run's .rrd", quoted(&f.path)))),
+        _ => return Err(bad("plant.replay.path", format!("{}: a .csv or .mcap log or a run's .rrd", quoted(&f.path)))),
     };
+    let channels = match &f.channel {
+        None if format == "mcap" => return Err(bad("plant.replay.channel", "missing: the topic of the JSON channel whose messages are the samples")),
+        None => Vec::new(),
+        Some(_) if format != "mcap" => return Err(bad("plant.replay.channel", "for an .mcap log only")),
+        Some(RawChannels::One(t)) => vec![t.clone()],
+        Some(RawChannels::Many(ts)) => ts.clone(),
+    };
+    if channels.is_empty() && format == "mcap" {
+        return Err(bad("plant.replay.channel", "an empty list: at least one topic"));
+    }
+    if let Some(i) = channels.iter().position(|t| t.is_empty()) {
+        return Err(bad(format!("plant.replay.channel[{}]", i + 1), "a topic, not empty"));
+    }
     let choice = |key: &str, given: &Option<String>, allowed: [&str; 2]| -> Result<String, Bad> {
         match given.as_deref() {
             None => Ok(allowed[0].into()),
@@ -46,7 +61,7 @@ pub(crate) fn plant_replay(raw: &Option<RawReplay>, dir: &Path, z: &Sizes, r: us
             return Err(bad(format!("plant.replay.{key}"), "a run's .rrd names its own signals: no column map"));
         }
         if resample != "none" || missing != "error" {
-            return Err(bad("plant.replay", "a run's .rrd is on the run's grid: resample and missing are for CSV logs"));
+            return Err(bad("plant.replay", "a run's .rrd is on the run's grid: resample and missing are for CSV and MCAP logs"));
         }
     }
     // A list of column names: `want` of them, or (when `optional`) none at all.
@@ -69,6 +84,7 @@ pub(crate) fn plant_replay(raw: &Option<RawReplay>, dir: &Path, z: &Sizes, r: us
     let params = json!({
         "path": path.display().to_string(),
         "format": format,
+        "channels": channels,
         "time": f.time,
         "inputs": inputs.unwrap_or_default(),
         "outputs": outputs.unwrap_or_default(),
