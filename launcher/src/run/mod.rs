@@ -3,10 +3,9 @@
 pub mod budget;
 mod configs;
 mod envelope;
-mod fmu_check;
-mod replay_check;
 pub mod interrupt;
 mod in_process;
+mod preflight;
 mod processes;
 mod progress;
 mod salvage;
@@ -173,11 +172,10 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
     {
         return Err(LaunchError::BadInput(format!("{}: {what} is an external process: --mode in-process runs only built-in components", s.path.display())));
     }
-    // An FMU that cannot be the plant (not a zip, model exchange only, a variable that is not
-    // there …) is refused before anything runs, by the component that would load it.
-    fmu_check::check(s)?;
-    // Recorded data that cannot be the plant is refused the same way, by its reader.
-    let replay = replay_check::check(s)?;
+    // An FMU or recorded data that cannot be the plant is refused before anything runs, by the
+    // component that would read it.
+    preflight::fmu(s)?;
+    let replay = preflight::replay(s)?;
     // A runs directory that is not private (a planted symlink, another user's) is refused
     // before any output exists: bad input, like a scenario's.
     if opts.mode == Mode::Processes {
