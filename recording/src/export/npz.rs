@@ -51,7 +51,12 @@ fn array<W: Write + Seek, T: npyz::AutoSerialize + npyz::Serialize>(
 ) -> std::io::Result<()> {
     // The size of the entry bounds whether it needs zip64: data plus a header of at most 256 bytes.
     let bytes = shape.iter().product::<u64>() * 8 + 256;
-    let options = SimpleFileOptions::default().compression_method(CompressionMethod::Stored).large_file(bytes >= u32::MAX as u64);
+    // A fixed entry date (zip's epoch, 1980-01-01), not the clock's: the same recording gives
+    // the same file.
+    let options = SimpleFileOptions::default()
+        .compression_method(CompressionMethod::Stored)
+        .last_modified_time(zip::DateTime::default())
+        .large_file(bytes >= u32::MAX as u64);
     zip.start_file(format!("{name}.npy"), options)?;
     let mut npy = npyz::WriteOptions::<T>::new().default_dtype().shape(shape).order(npyz::Order::Fortran).writer(&mut *zip).begin_nd()?;
     for v in values {
