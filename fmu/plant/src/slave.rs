@@ -14,6 +14,7 @@ use crate::log_capture;
 
 /// An instance; the import (the extracted archive) lives as long as it. Fields drop in order:
 /// the instance is freed before its library's folder goes.
+#[allow(clippy::large_enum_variant)] // one instance per process, never moved in the step loop
 pub enum Slave {
     Two { inst: Cs2, _import: Fmi2Import },
     Three { inst: Cs3, _import: Fmi3Import },
