@@ -154,6 +154,17 @@ def nothing_left(tmp_path, out):
     assert os.listdir(tmp_path / "runs") == [], "a run directory was left"
 
 
+def refused(tmp_path, scen, want):
+    """`launcher run scen` exits 2 with one line holding every phrase of `want`, leaving nothing."""
+    out = tmp_path / "out"
+    p = launch(tmp_path, "run", scen, "--out", out)
+    assert p.returncode == 2, p.stderr
+    assert len(p.stderr.strip().splitlines()) == 1, p.stderr
+    for w_ in want:
+        assert w_ in p.stderr, p.stderr
+    nothing_left(tmp_path, out)
+
+
 @pytest.fixture(scope="module")
 def motor(tmp_path_factory):
     folder = tmp_path_factory.mktemp("motor")
@@ -228,13 +239,7 @@ def test_bad_csv_exits_2_before_anything_runs(motor, tmp_path, case):
     scen = motor_scenario(tmp_path, csv="bad.csv")
     if extra is None:
         scen.write_text(scen.read_text() + '\n[controller]\nkind = "lqr"\nobserver = "uio"\n')
-    out = tmp_path / "out"
-    p = launch(tmp_path, "run", scen, "--out", out)
-    assert p.returncode == 2, p.stderr
-    assert len(p.stderr.strip().splitlines()) == 1, p.stderr
-    for w_ in want:
-        assert w_ in p.stderr, p.stderr
-    nothing_left(tmp_path, out)
+    refused(tmp_path, scen, want)
 
 
 def test_missing_hold(motor, tmp_path):
@@ -479,13 +484,7 @@ def test_bad_mcap_exits_2_before_anything_runs(motor, tmp_path, case):
     kwargs, want = BAD_MCAP[case]
     write_mcap(tmp_path / "bad.mcap", t, u, w, x, y, **kwargs)
     scen = mcap_scenario(tmp_path, name="bad.mcap", time_field=case != "time goes back")
-    out = tmp_path / "out"
-    p = launch(tmp_path, "run", scen, "--out", out)
-    assert p.returncode == 2, p.stderr
-    assert len(p.stderr.strip().splitlines()) == 1, p.stderr
-    for w_ in want:
-        assert w_ in p.stderr, p.stderr
-    nothing_left(tmp_path, out)
+    refused(tmp_path, scen, want)
 
 
 def test_mcap_missing_hold(motor, tmp_path):
