@@ -91,7 +91,8 @@ def nothing_left(p, out, runs_dir, recorded=False):
 
 
 def export_csv(rrd, to):
-    done = subprocess.run([launcher(), "export", "--csv", str(to), str(rrd)], capture_output=True, text=True, timeout=120)
+    # From another folder: the recorded scenario's relative FMU path must not cost its names.
+    done = subprocess.run([launcher(), "export", "--csv", str(to), str(rrd)], capture_output=True, text=True, timeout=120, cwd="/")
     assert done.returncode == 0, done.stderr
     return to
 
@@ -176,6 +177,8 @@ B = [[2.0], [0.0], [0.0]]
 C = [[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
 E = [[0.0], [-100.0], [0.0]]
 x0 = [0.0, 0.0, 0.0]
+state_names = ["i", "omega", "theta"]
+state_units = ["A", "rad/s", "rad"]
 
 [plant.fmu]
 path = "{path}"
@@ -211,8 +214,10 @@ poles = [-20.0, -30.0, -40.0]
 def test_the_nonlinear_fmu_plant_runs_under_the_builtin_observers(fmu_dir, tmp_path, v):
     """Friction acts where the load torque does (through E): the UIO rejects it, the
     Luenberger observer does not; both errors are against the FMU's own states."""
+    # The FMU beside the scenario, named relative to it.
+    shutil.copy(os.path.join(fmu_dir, f"dc_motor_fmi{v}.fmu"), tmp_path)
     path = tmp_path / "dc.toml"
-    path.write_text(DC_MOTOR.format(path=os.path.join(fmu_dir, f"dc_motor_fmi{v}.fmu")))
+    path.write_text(DC_MOTOR.format(path=f"dc_motor_fmi{v}.fmu"))
     p, _ = run(path, tmp_path / "out", tmp_path / "runs")
     assert p.returncode == 0, p.stderr_text
     summary = json.loads((tmp_path / "out" / "dc-motor-fmu.summary.json").read_text())
@@ -228,6 +233,7 @@ def test_the_nonlinear_fmu_plant_runs_under_the_builtin_observers(fmu_dir, tmp_p
     got_x, got_y = replay(os.path.join(fmu_dir, f"dc_motor_fmi{v}.fmu"), tmp_path, params, U, W, 0.001)
     assert np.array_equal(got_x, X) and np.array_equal(got_y, Y), (np.abs(got_x - X).max(), np.abs(got_y - Y).max())
     assert np.abs(X[:, 1]).max() > 1.0  # the motor turned (ω in rad/s)
+    assert list(columns(csvs / "plant_x.csv"))[2:] == ["i [A]", "omega [rad/s]", "theta [rad]"]
 
 
 def edit_fmu(src, dst, xml=None, rename=None):

@@ -12,7 +12,7 @@ pub fn recorded_text(r: &Recording) -> Option<&str> {
 /// The scenario stored in a recording, parsed, if it is there and still valid (a scenario whose
 /// matrices are `.npy` files beside it is not: the recording holds its text only).
 pub fn recorded_scenario(r: &Recording) -> Option<Scenario> {
-    Scenario::parse(std::path::Path::new("<recording>"), recorded_text(r)?).ok()
+    Scenario::parse_recorded(recorded_text(r)?).ok()
 }
 
 /// The sample period of a recording: its scenario's `dt`, read alone when the whole scenario

@@ -24,13 +24,19 @@ pub(crate) struct Sizes {
 }
 
 /// The FMU plant as the process that runs it, and the FMU's absolute path.
-pub(crate) fn plant_fmu(raw: &Option<RawFmu>, dir: &Path, z: &Sizes) -> Result<Option<(std::path::PathBuf, ProcessSpec)>, Bad> {
+pub(crate) fn plant_fmu(raw: &Option<RawFmu>, dir: Option<&Path>, z: &Sizes) -> Result<Option<(std::path::PathBuf, ProcessSpec)>, Bad> {
     let Some(f) = raw else { return Ok(None) };
-    let path = dir.join(&f.path);
-    if !path.is_file() {
-        return Err(bad("plant.fmu.path", format!("{}: no such file", quoted(&path.display().to_string()))));
-    }
-    let path = std::fs::canonicalize(&path).map_err(|e| bad("plant.fmu.path", format!("{}: {e}", path.display())))?;
+    // Absolute, from the scenario's folder; as written for a recorded scenario (not read).
+    let path = match dir {
+        Some(dir) => {
+            let path = dir.join(&f.path);
+            if !path.is_file() {
+                return Err(bad("plant.fmu.path", format!("{}: no such file", quoted(&path.display().to_string()))));
+            }
+            std::fs::canonicalize(&path).map_err(|e| bad("plant.fmu.path", format!("{}: {e}", path.display())))?
+        }
+        None => std::path::PathBuf::from(&f.path),
+    };
     let list = |key: &str, given: &Option<Vec<String>>, want: usize, what: &str| -> Result<Vec<String>, Bad> {
         let names = given.clone().unwrap_or_default();
         if names.len() != want {

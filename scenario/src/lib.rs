@@ -245,7 +245,14 @@ impl Scenario {
 
     /// Validates scenario text (`path` is used in messages).
     pub fn parse(path: &Path, text: &str) -> Result<Scenario, ScenarioError> {
-        validate::parse(path, text)
+        validate::parse(path, text, true)
+    }
+
+    /// Validates the scenario text a recording holds, away from its folder: the files of
+    /// `[plant.fmu]` and `[plant.replay]` are named, not read (the run read them), so that a
+    /// recording's names and units survive its scenario's files.
+    pub fn parse_recorded(text: &str) -> Result<Scenario, ScenarioError> {
+        validate::parse(Path::new("<recording>"), text, false)
     }
 
     /// Names of the observers, in order.

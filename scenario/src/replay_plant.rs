@@ -20,13 +20,19 @@ pub const REPLAY_PLANT_PROGRAM: &str = "replay_plant";
 
 /// The replayed plant as the process that runs it, and the data file's absolute path.
 /// `r` is the number of columns of D (the replayed v is zero: D v is in the recorded y).
-pub(crate) fn plant_replay(raw: &Option<RawReplay>, dir: &Path, z: &Sizes, r: usize, dt: f64, steps: u64) -> Result<Option<(std::path::PathBuf, ProcessSpec)>, Bad> {
+pub(crate) fn plant_replay(raw: &Option<RawReplay>, dir: Option<&Path>, z: &Sizes, r: usize, dt: f64, steps: u64) -> Result<Option<(std::path::PathBuf, ProcessSpec)>, Bad> {
     let Some(f) = raw else { return Ok(None) };
-    let path = dir.join(&f.path);
-    if !path.is_file() {
-        return Err(bad("plant.replay.path", format!("{}: no such file", quoted(&path.display().to_string()))));
-    }
-    let path = std::fs::canonicalize(&path).map_err(|e| bad("plant.replay.path", format!("{}: {e}", path.display())))?;
+    // Absolute, from the scenario's folder; as written for a recorded scenario (not read).
+    let path = match dir {
+        Some(dir) => {
+            let path = dir.join(&f.path);
+            if !path.is_file() {
+                return Err(bad("plant.replay.path", format!("{}: no such file", quoted(&path.display().to_string()))));
+            }
+            std::fs::canonicalize(&path).map_err(|e| bad("plant.replay.path", format!("{}: {e}", path.display())))?
+        }
+        None => std::path::PathBuf::from(&f.path),
+    };
     let format = match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
         Some("csv") => "csv",
         Some("mcap") => "mcap",

@@ -27,7 +27,9 @@ pub(crate) fn bad(field: impl Into<String>, reason: impl Into<String>) -> Bad {
     (field.into(), reason.into())
 }
 
-pub(super) fn parse(path: &Path, text: &str) -> Result<Scenario, ScenarioError> {
+/// `files`: whether the files `[plant.fmu]` and `[plant.replay]` name are looked at (not for a
+/// recorded scenario, see [`Scenario::parse_recorded`]).
+pub(super) fn parse(path: &Path, text: &str, files: bool) -> Result<Scenario, ScenarioError> {
     let at = |field: &str| offset(text, &parse_path(field)).map(|o| line_col(text, o));
     let error = |(field, reason): Bad| ScenarioError { file: path.to_path_buf(), at: at(&field), field, reason };
     let de = toml::de::Deserializer::parse(text).map_err(|e| ScenarioError {
@@ -56,7 +58,7 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<Scenario, ScenarioError> 
     let mut raw = raw;
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     super::matrix_file::load_all(&mut raw, dir).map_err(error)?;
-    build(path, raw).map_err(error).map(|mut s| {
+    build(path, raw, files).map_err(error).map(|mut s| {
         s.path = path.to_path_buf();
         s.source = text.to_string();
         s
@@ -197,7 +199,7 @@ pub(crate) fn check_name(field: &str, name: &str, why: &str) -> Result<(), Bad> 
     Ok(())
 }
 
-fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
+fn build(path: &Path, raw: RawScenario, files: bool) -> Result<Scenario, Bad> {
     check_name("name", &raw.name, "it names the recording's files")?;
     let dt = finite("dt", raw.dt)?;
     let duration = finite("duration", raw.duration)?;
@@ -329,7 +331,7 @@ fn build(path: &Path, raw: RawScenario) -> Result<Scenario, Bad> {
             return Err(bad("noise.process", "process noise enters the state, which an FMU plant keeps to itself: an FMU plant takes measurement noise only"));
         }
     }
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = files.then(|| path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new(".")));
     let fmu = super::fmu_plant::plant_fmu(&p.fmu, dir, &super::fmu_plant::Sizes { n, p: model.c.nrows(), l: model.b.ncols(), q: model.e.ncols() })?;
     if p.replay.is_some() {
         // Recorded data holds its own faults and noise: [[fault]] and [noise] then describe
