@@ -14,6 +14,14 @@ use scenario::Scenario;
 /// Where calibration seeds start, above any seed a scenario is likely to name.
 pub const SEED_OFFSET: u64 = 1 << 32;
 
+/// The plan a run of `s` uses: its designs ([`crate::plan::plan`]) with the calibrated
+/// thresholds set.
+pub fn planned(s: &Scenario) -> Result<Plan, LaunchError> {
+    let mut p = crate::plan::plan(s).map_err(|e| LaunchError::Scenario(e.error))?;
+    calibrate(s, &mut p)?;
+    Ok(p)
+}
+
 /// Sets every calibrated bank's thresholds in `plan`.
 pub fn calibrate(s: &Scenario, plan: &mut Plan) -> Result<(), LaunchError> {
     let wanted: Vec<(usize, usize, f64)> = plan

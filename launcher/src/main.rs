@@ -261,18 +261,13 @@ fn fail(e: &LaunchError) -> ExitCode {
 }
 
 /// Loads the scenario a command-line argument names (a path, or a shipped scenario's name).
-fn load(arg: &Path) -> Result<Scenario, LaunchError> {
-    Ok(Scenario::load(&shipped::resolve(arg)?)?)
-}
-
 /// A scenario loaded, with `seed` in place of its own, designed, and its calibrated thresholds set.
 fn prepared(arg: &Path, seed: Option<u64>) -> Result<(Scenario, plan::Plan), LaunchError> {
-    let mut s = load(arg)?;
+    let mut s = shipped::load(arg)?;
     if let Some(seed) = seed {
         s.seed = seed;
     }
-    let mut p = plan::plan(&s).map_err(|e| LaunchError::Scenario(e.error))?;
-    launcher::calibrate::calibrate(&s, &mut p)?;
+    let p = launcher::calibrate::planned(&s)?;
     Ok((s, p))
 }
 
@@ -353,8 +348,7 @@ fn main() -> ExitCode {
             let out = out.unwrap_or_else(|| recording.parent().unwrap_or(Path::new(".")).join("replay"));
             let prepared = launcher::replay::scenario(&recording, scenario.as_deref()).and_then(|s| {
                 launcher::replay::refuse_overwrite(&recording, &out, &s.name)?;
-                let mut p = plan::plan(&s).map_err(|e| LaunchError::Scenario(e.error))?;
-                launcher::calibrate::calibrate(&s, &mut p)?;
+                let p = launcher::calibrate::planned(&s)?;
                 Ok((s, p))
             });
             let (s, p) = match prepared {
@@ -407,7 +401,7 @@ fn main() -> ExitCode {
             }
         }
         Command::Design { scenario, json } => {
-            let s = match load(&scenario) {
+            let s = match shipped::load(&scenario) {
                 Ok(s) => s,
                 Err(e) => return fail(&e),
             };
@@ -571,7 +565,7 @@ fn main() -> ExitCode {
         }
         Command::ExportFmu { scenario, observer, out, fmi } => {
             let fmi = if fmi == "2" { fmu_export::Fmi::V2 } else { fmu_export::Fmi::V3 };
-            match load(&scenario).and_then(|s| export_fmu::export_fmu(&s, &observer, &out, fmi)) {
+            match shipped::load(&scenario).and_then(|s| export_fmu::export_fmu(&s, &observer, &out, fmi)) {
                 Ok(path) => {
                     println!("{}", path.display());
                     ExitCode::SUCCESS

@@ -14,6 +14,11 @@ pub fn dir() -> PathBuf {
     if local.is_dir() { local } else { Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios") }
 }
 
+/// The scenario `arg` names (a file or a shipped scenario's name, [`resolve`]), validated.
+pub fn load(arg: &Path) -> Result<Scenario, LaunchError> {
+    Ok(Scenario::load(&resolve(arg)?)?)
+}
+
 /// The scenario file `arg` names: `arg` itself when it exists or looks like a path (holds a
 /// '/' or ends in `.toml`); otherwise the shipped scenario of that file stem or that name.
 pub fn resolve(arg: &Path) -> Result<PathBuf, LaunchError> {

@@ -48,28 +48,34 @@ impl Sensing {
     }
 
     /// y_k as measured: measurement noise, then the sensor faults active at step k; and each
-    /// fault's (active, value) pair written to `slots` (2 per fault, in order).
+    /// fault's (active, value) pair written to `slots` ([`Sensing::record`]).
     pub fn sense(&mut self, k: u64, y: &mut [f64], slots: &mut [f64]) {
         if let Some(g) = &mut self.measurement_noise {
             g.add_to(y);
         }
         for (i, f) in self.faults.iter().enumerate() {
-            let (phi, _) = f.magnitude(k, self.dt);
-            let active = f.active(k);
-            if let (Target::Sensor(j), true) = (f.fault.target, active) {
+            if let (Target::Sensor(j), true) = (f.fault.target, f.active(k)) {
                 match f.fault.kind {
                     Kind::Stuck => y[j] = f.fault.value,
                     Kind::Noise => y[j] += f.fault.value * self.bursts[i].as_mut().map_or(0.0, Stream::normal),
-                    _ => y[j] += phi,
+                    _ => y[j] += f.magnitude(k, self.dt).0,
                 }
             }
-            let recorded = match f.fault.kind {
-                Kind::Additive | Kind::Bias | Kind::Drift => phi,
+        }
+        self.record(k, slots);
+    }
+
+    /// Each fault's (active, value) pair at step k, written to `slots` (2 per fault, in order):
+    /// the magnitude for additive, bias and drift faults, the value while active for the others.
+    pub fn record(&self, k: u64, slots: &mut [f64]) {
+        for (i, f) in self.faults.iter().enumerate() {
+            let active = f.active(k);
+            slots[2 * i] = if active { 1.0 } else { 0.0 };
+            slots[2 * i + 1] = match f.fault.kind {
+                Kind::Additive | Kind::Bias | Kind::Drift => f.magnitude(k, self.dt).0,
                 _ if active => f.fault.value,
                 _ => 0.0,
             };
-            slots[2 * i] = if active { 1.0 } else { 0.0 };
-            slots[2 * i + 1] = recorded;
         }
     }
 }

@@ -238,7 +238,7 @@ def test_the_nonlinear_fmu_plant_runs_under_the_builtin_observers(fmu_dir, tmp_p
 
 def edit_fmu(src, dst, xml=None, rename=None):
     """A copy of an FMU with its modelDescription.xml changed by `xml` and entries renamed."""
-    with zipfile.ZipFile(src) as zin, zipfile.ZipFile(dst, "w") as zout:
+    with zipfile.ZipFile(src) as zin, zipfile.ZipFile(dst, "w", zipfile.ZIP_DEFLATED) as zout:
         for item in zin.infolist():
             data = zin.read(item.filename)
             name = item.filename
@@ -261,6 +261,8 @@ BAD = {
     ),
     "no-binary": (lambda src, dst: edit_fmu(src, dst, rename=lambda n: n.replace("/x86_64-linux/", "/x86_64-windows/").replace(".so", ".dll")), {}, r"no binary for this platform: binaries/x86_64-linux/lti_plant\.so"),
     "fmi-version": (lambda src, dst: edit_fmu(src, dst, xml=lambda x: x.replace('fmiVersion="3.0"', 'fmiVersion="1.0"')), {}, r"FMI version 1\.0 is not supported"),
+    # Hostile: a description that deflates to 65 MiB is refused by its length, not read whole.
+    "huge-description": (lambda src, dst: edit_fmu(src, dst, xml=lambda x: x + " " * (65 << 20)), {}, r"modelDescription\.xml is longer than 67108864 bytes"),
     "no-such-variable": (None, {"outputs": '["y1", "y9"]'}, r"plant\.fmu\.outputs\[2\]: lti_plant_fmi3\.fmu has no variable named 'y9' \(did you mean"),
     "wrong-causality": (None, {"inputs": '["u1", "y1"]'}, r"plant\.fmu\.inputs\[2\]: 'y1' of lti_plant_fmi3\.fmu is an output, not an input"),
     "wrong-type": (None, {"parameters": "{ Phi_1_1 = true }"}, r"plant\.fmu\.parameters\.Phi_1_1: 'Phi_1_1' of lti_plant_fmi3\.fmu is of type Float64; true is not a value of it"),

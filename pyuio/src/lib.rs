@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 
 use launcher::run::{Mode, Options, Stop};
-use launcher::{design_report, plan, shipped, LaunchError};
+use launcher::{design_report, shipped, LaunchError};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
@@ -27,7 +27,7 @@ fn raise(e: LaunchError) -> PyErr {
 fn scenario(path: &str, text: Option<&str>) -> Result<Scenario, LaunchError> {
     Ok(match text {
         Some(t) => Scenario::parse(Path::new(path), t)?,
-        None => Scenario::load(&shipped::resolve(Path::new(path))?)?,
+        None => shipped::load(Path::new(path))?,
     })
 }
 
@@ -46,9 +46,7 @@ fn design(path: &str, text: Option<&str>) -> PyResult<(bool, String, String)> {
 #[pyo3(signature = (path, out, force=false))]
 fn run(py: Python<'_>, path: &str, out: &str, force: bool) -> PyResult<(String, String, bool)> {
     let s = scenario(path, None).map_err(raise)?;
-    let p = plan::plan(&s).map_err(|e| raise(LaunchError::Scenario(e.error)))?;
-    let mut p = p;
-    launcher::calibrate::calibrate(&s, &mut p).map_err(raise)?;
+    let p = launcher::calibrate::planned(&s).map_err(raise)?;
     let select = recording::write::Selection::new(1, &[]).map_err(|e| raise(LaunchError::BadInput(e)))?;
     let opts = Options {
         out: PathBuf::from(out),

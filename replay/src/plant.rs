@@ -12,29 +12,27 @@ use replay::{Params, Table};
 
 pub struct ReplayPlant {
     table: Table,
-    /// Fault slots only: built without noise, its y is a scratch buffer thrown away.
+    /// Only to write the fault slots ([`Sensing::record`]): nothing acts on the data.
     sensing: Sensing,
-    scratch_y: Vec<f64>,
     lay: PlantLayout,
 }
 
 impl Component for ReplayPlant {
     fn new(cfg: &ComponentConfig) -> Result<Self, String> {
         let p: Params = cfg.params()?;
-        let mut s = PlantConfig::from_protocol(cfg)?;
+        let s = PlantConfig::from_protocol(cfg)?;
         let lay = PlantLayout { n: s.a.rows, p: s.c.rows, q: s.e.cols, r: s.d.cols, l: s.b.cols, f: s.faults.len() };
         if (p.n, p.p, p.q, p.r, p.l) != (lay.n, lay.p, lay.q, lay.r, lay.l) || p.steps != cfg.steps {
             return Err(format!("{}: the parameters are for n = {}, p = {}, l = {}, q = {}, r = {}, {} steps; the run has n = {}, p = {}, l = {}, q = {}, r = {}, {} steps", p.file(), p.n, p.p, p.l, p.q, p.r, p.steps, lay.n, lay.p, lay.l, lay.q, lay.r, cfg.steps));
         }
         let table = replay::load(&p)?;
-        s.noise = None;
-        Ok(ReplayPlant { table, sensing: Sensing::new(&s)?, scratch_y: vec![0.0; lay.p], lay })
+        Ok(ReplayPlant { table, sensing: Sensing::new(&s)?, lay })
     }
 
     fn step(&mut self, k: u64, _inputs: &Inputs, out: &mut [f64]) -> Result<(), StepError> {
         let end = self.lay.faults().start;
         out[..end].copy_from_slice(self.table.row(k));
-        self.sensing.sense(k, &mut self.scratch_y, &mut out[end..]);
+        self.sensing.record(k, &mut out[end..]);
         Ok(())
     }
 }

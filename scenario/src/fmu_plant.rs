@@ -8,35 +8,18 @@ use std::path::Path;
 
 use serde_json::json;
 
+use super::plant_file::{self, Sizes};
 use super::raw::RawFmu;
 use super::validate::{bad, Bad};
-use super::{quoted, ProcessSpec};
+use super::ProcessSpec;
 
 /// The program that runs an FMU plant (a kit component built beside the launcher).
 pub const FMU_PLANT_PROGRAM: &str = "fmu_plant";
 
-/// Sizes of the design model the mapping must match.
-pub(crate) struct Sizes {
-    pub n: usize,
-    pub p: usize,
-    pub l: usize,
-    pub q: usize,
-}
-
 /// The FMU plant as the process that runs it, and the FMU's absolute path.
 pub(crate) fn plant_fmu(raw: &Option<RawFmu>, dir: Option<&Path>, z: &Sizes) -> Result<Option<(std::path::PathBuf, ProcessSpec)>, Bad> {
     let Some(f) = raw else { return Ok(None) };
-    // Absolute, from the scenario's folder; as written for a recorded scenario (not read).
-    let path = match dir {
-        Some(dir) => {
-            let path = dir.join(&f.path);
-            if !path.is_file() {
-                return Err(bad("plant.fmu.path", format!("{}: no such file", quoted(&path.display().to_string()))));
-            }
-            std::fs::canonicalize(&path).map_err(|e| bad("plant.fmu.path", format!("{}: {e}", path.display())))?
-        }
-        None => std::path::PathBuf::from(&f.path),
-    };
+    let path = plant_file::path("plant.fmu.path", dir, &f.path)?;
     let list = |key: &str, given: &Option<Vec<String>>, want: usize, what: &str| -> Result<Vec<String>, Bad> {
         let names = given.clone().unwrap_or_default();
         if names.len() != want {

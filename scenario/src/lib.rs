@@ -5,6 +5,7 @@
 
 mod fault_diagnosis;
 mod fmu_plant;
+mod plant_file;
 mod hosts;
 pub mod limits;
 mod locate;

@@ -10,7 +10,7 @@ use std::path::Path;
 
 use serde_json::json;
 
-use super::fmu_plant::Sizes;
+use super::plant_file::{self, Sizes};
 use super::raw::{RawChannels, RawReplay};
 use super::validate::{bad, Bad};
 use super::{quoted, ProcessSpec};
@@ -22,17 +22,7 @@ pub const REPLAY_PLANT_PROGRAM: &str = "replay_plant";
 /// `r` is the number of columns of D (the replayed v is zero: D v is in the recorded y).
 pub(crate) fn plant_replay(raw: &Option<RawReplay>, dir: Option<&Path>, z: &Sizes, r: usize, dt: f64, steps: u64) -> Result<Option<(std::path::PathBuf, ProcessSpec)>, Bad> {
     let Some(f) = raw else { return Ok(None) };
-    // Absolute, from the scenario's folder; as written for a recorded scenario (not read).
-    let path = match dir {
-        Some(dir) => {
-            let path = dir.join(&f.path);
-            if !path.is_file() {
-                return Err(bad("plant.replay.path", format!("{}: no such file", quoted(&path.display().to_string()))));
-            }
-            std::fs::canonicalize(&path).map_err(|e| bad("plant.replay.path", format!("{}: {e}", path.display())))?
-        }
-        None => std::path::PathBuf::from(&f.path),
-    };
+    let path = plant_file::path("plant.replay.path", dir, &f.path)?;
     let format = match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
         Some("csv") => "csv",
         Some("mcap") => "mcap",

@@ -27,7 +27,7 @@ pub(crate) fn bad(field: impl Into<String>, reason: impl Into<String>) -> Bad {
     (field.into(), reason.into())
 }
 
-/// `files`: whether the files `[plant.fmu]` and `[plant.replay]` name are looked at (not for a
+/// `files`: whether the files `[plant.fmu]` and `[plant.replay]` name are looked for (not for a
 /// recorded scenario, see [`Scenario::parse_recorded`]).
 pub(super) fn parse(path: &Path, text: &str, files: bool) -> Result<Scenario, ScenarioError> {
     let at = |field: &str| offset(text, &parse_path(field)).map(|o| line_col(text, o));
@@ -58,7 +58,7 @@ pub(super) fn parse(path: &Path, text: &str, files: bool) -> Result<Scenario, Sc
     let mut raw = raw;
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     super::matrix_file::load_all(&mut raw, dir).map_err(error)?;
-    build(path, raw, files).map_err(error).map(|mut s| {
+    build(raw, files.then_some(dir)).map_err(error).map(|mut s| {
         s.path = path.to_path_buf();
         s.source = text.to_string();
         s
@@ -199,7 +199,9 @@ pub(crate) fn check_name(field: &str, name: &str, why: &str) -> Result<(), Bad> 
     Ok(())
 }
 
-fn build(path: &Path, raw: RawScenario, files: bool) -> Result<Scenario, Bad> {
+/// `dir`: the scenario's folder, where the files of `[plant.fmu]` and `[plant.replay]` are
+/// looked for (`None`: named, not looked for).
+fn build(raw: RawScenario, dir: Option<&Path>) -> Result<Scenario, Bad> {
     check_name("name", &raw.name, "it names the recording's files")?;
     let dt = finite("dt", raw.dt)?;
     let duration = finite("duration", raw.duration)?;
@@ -331,8 +333,8 @@ fn build(path: &Path, raw: RawScenario, files: bool) -> Result<Scenario, Bad> {
             return Err(bad("noise.process", "process noise enters the state, which an FMU plant keeps to itself: an FMU plant takes measurement noise only"));
         }
     }
-    let dir = files.then(|| path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new(".")));
-    let fmu = super::fmu_plant::plant_fmu(&p.fmu, dir, &super::fmu_plant::Sizes { n, p: model.c.nrows(), l: model.b.ncols(), q: model.e.ncols() })?;
+    let sizes = super::plant_file::Sizes { n, p: model.c.nrows(), l: model.b.ncols(), q: model.e.ncols() };
+    let fmu = super::fmu_plant::plant_fmu(&p.fmu, dir, &sizes)?;
     if p.replay.is_some() {
         // Recorded data holds its own faults and noise: [[fault]] and [noise] then describe
         // them (for the design and the scoring), and nothing is applied.
@@ -343,7 +345,7 @@ fn build(path: &Path, raw: RawScenario, files: bool) -> Result<Scenario, Bad> {
             return Err(bad("controller", "the plant is replayed from recorded data, which cannot react to a controller: a replay is open loop"));
         }
     }
-    let replay = super::replay_plant::plant_replay(&p.replay, dir, &super::fmu_plant::Sizes { n, p: model.c.nrows(), l: model.b.ncols(), q: model.e.ncols() }, model.d.ncols(), dt, steps)?;
+    let replay = super::replay_plant::plant_replay(&p.replay, dir, &sizes, model.d.ncols(), dt, steps)?;
 
     // Observers.
     let mut seen = BTreeSet::new();

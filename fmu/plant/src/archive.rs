@@ -96,16 +96,30 @@ pub fn binary_path(version: Version, model_identifier: &str) -> String {
     format!("binaries/{platform}/{model_identifier}.so")
 }
 
+/// The most an FMU's archive may unpack to (its libraries and resources), bytes.
+pub const MAX_UNPACKED: u64 = 4 << 30;
+/// The longest `modelDescription.xml` read, bytes (a large model's is a few MB).
+pub const MAX_DESCRIPTION: u64 = 64 << 20;
+
 /// Reads and checks the archive at `path`.
 pub fn read(path: &Path) -> Result<Fmu, String> {
     let at = |why: String| format!("{}: {why}", path.display());
     let file = std::fs::File::open(path).map_err(|e| at(format!("cannot open: {e}")))?;
     let mut zip = zip::ZipArchive::new(file).map_err(|e| at(format!("not an FMU: not a zip archive ({e})")))?;
+    // The run extracts the whole archive: what it would unpack to is bounded before anything is.
+    let unpacked: u64 = (0..zip.len()).filter_map(|i| zip.by_index_raw(i).ok().map(|f| f.size())).sum();
+    if unpacked > MAX_UNPACKED {
+        return Err(at(format!("unpacks to {unpacked} bytes, more than the {MAX_UNPACKED} an FMU plant may")));
+    }
     let mut xml = String::new();
     zip.by_name("modelDescription.xml")
         .map_err(|_| at("not an FMU: no modelDescription.xml in the archive".into()))?
+        .take(MAX_DESCRIPTION + 1)
         .read_to_string(&mut xml)
         .map_err(|e| at(format!("modelDescription.xml: {e}")))?;
+    if xml.len() as u64 > MAX_DESCRIPTION {
+        return Err(at(format!("modelDescription.xml is longer than {MAX_DESCRIPTION} bytes")));
+    }
     let min = MinModelDescription::deserialize(&xml).map_err(|e| at(format!("modelDescription.xml: {}", first_line(&e.to_string()))))?;
     let version = match min.fmi_version.split('.').next() {
         Some("2") => Version::Two,
@@ -167,37 +181,25 @@ fn from_fmi3(xml: &str) -> Result<Fmu, String> {
     let Some(cs) = &md.co_simulation else { return Err(no_cs(md.model_exchange.is_some())) };
     let mut vars = BTreeMap::new();
     for v in &md.model_variables.variables {
-        let ty = match v {
-            Variable::Float64(_) => Type::Real,
-            Variable::Int32(_) => Type::Integer,
-            Variable::Boolean(_) => Type::Boolean,
-            Variable::Float32(_) => Type::Other("Float32"),
-            Variable::Int8(_) => Type::Other("Int8"),
-            Variable::UInt8(_) => Type::Other("UInt8"),
-            Variable::Int16(_) => Type::Other("Int16"),
-            Variable::UInt16(_) => Type::Other("UInt16"),
-            Variable::UInt32(_) => Type::Other("UInt32"),
-            Variable::Int64(_) => Type::Other("Int64"),
-            Variable::UInt64(_) => Type::Other("UInt64"),
-            Variable::String(_) => Type::Other("String"),
-            Variable::Binary(_) => Type::Other("Binary"),
-            Variable::Clock(_) => Type::Other("Clock"),
-        };
-        let (a, array): (&dyn AbstractVariableTrait, bool) = match v {
-            Variable::Int8(x) => (x, !x.dimensions().is_empty()),
-            Variable::UInt8(x) => (x, !x.dimensions().is_empty()),
-            Variable::Int16(x) => (x, !x.dimensions().is_empty()),
-            Variable::UInt16(x) => (x, !x.dimensions().is_empty()),
-            Variable::Int32(x) => (x, !x.dimensions().is_empty()),
-            Variable::UInt32(x) => (x, !x.dimensions().is_empty()),
-            Variable::Int64(x) => (x, !x.dimensions().is_empty()),
-            Variable::UInt64(x) => (x, !x.dimensions().is_empty()),
-            Variable::Float32(x) => (x, !x.dimensions().is_empty()),
-            Variable::Float64(x) => (x, !x.dimensions().is_empty()),
-            Variable::Boolean(x) => (x, !x.dimensions().is_empty()),
-            Variable::String(x) => (x, !x.dimensions().is_empty()),
-            Variable::Binary(x) => (x, !x.dimensions().is_empty()),
-            Variable::Clock(x) => (x, false),
+        // Its type, and the variable as the traits every kind shares (a Clock has no dimensions).
+        fn of<T: ArrayableVariableTrait>(ty: Type, x: &T) -> (Type, &dyn AbstractVariableTrait, bool) {
+            (ty, x, !x.dimensions().is_empty())
+        }
+        let (ty, a, array) = match v {
+            Variable::Float64(x) => of(Type::Real, x),
+            Variable::Int32(x) => of(Type::Integer, x),
+            Variable::Boolean(x) => of(Type::Boolean, x),
+            Variable::Float32(x) => of(Type::Other("Float32"), x),
+            Variable::Int8(x) => of(Type::Other("Int8"), x),
+            Variable::UInt8(x) => of(Type::Other("UInt8"), x),
+            Variable::Int16(x) => of(Type::Other("Int16"), x),
+            Variable::UInt16(x) => of(Type::Other("UInt16"), x),
+            Variable::UInt32(x) => of(Type::Other("UInt32"), x),
+            Variable::Int64(x) => of(Type::Other("Int64"), x),
+            Variable::UInt64(x) => of(Type::Other("UInt64"), x),
+            Variable::String(x) => of(Type::Other("String"), x),
+            Variable::Binary(x) => of(Type::Other("Binary"), x),
+            Variable::Clock(x) => (Type::Other("Clock"), x as &dyn AbstractVariableTrait, false),
         };
         let causality = match a.causality() {
             C3::Parameter => Causality::Parameter,

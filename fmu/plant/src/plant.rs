@@ -35,7 +35,9 @@ pub struct FmuPlant {
     controller: Option<usize>,
     u: Vec<f64>,
     u_applied: Vec<f64>,
+    /// w(t_k) and r(t_k) of the last sample: held over the step that follows it.
     w: Vec<f64>,
+    r: Vec<f64>,
     /// The FMU's file name, for messages.
     file: String,
 }
@@ -80,6 +82,7 @@ impl Component for FmuPlant {
             u: vec![0.0; lay.l],
             u_applied: vec![0.0; lay.l],
             w: vec![0.0; lay.q],
+            r: vec![0.0; lay.l],
             s,
             file,
         })
@@ -89,18 +92,11 @@ impl Component for FmuPlant {
         let dt = self.dt;
         if k > 0 {
             let t = (k - 1) as f64 * dt;
-            match self.controller {
-                Some(i) => self.u.copy_from_slice(inputs.get(i)),
-                None => {
-                    for (u, r) in self.u.iter_mut().zip(&self.s.inputs) {
-                        *u = r.sample_step(k - 1, dt);
-                    }
-                }
-            }
+            self.u.copy_from_slice(match self.controller {
+                Some(i) => inputs.get(i),
+                None => &self.r,
+            });
             self.sensing.actuate(k - 1, &self.u, &mut self.u_applied, true);
-            for (w, s) in self.w.iter_mut().zip(&self.s.disturbances) {
-                *w = s.sample_step(k - 1, dt);
-            }
             let r = self.slave.set(&self.map.inputs, &self.u_applied, t).and_then(|_| self.slave.set(&self.map.disturbances, &self.w, t));
             r.map_err(|e| self.fail(e))?;
             let h = dt / self.substeps as f64;
@@ -127,6 +123,8 @@ impl Component for FmuPlant {
             *o = s.sample_step(k, dt);
         }
         out[lay.u_prev()].copy_from_slice(&self.u);
+        self.w.copy_from_slice(&out[lay.w()]);
+        self.r.copy_from_slice(&out[lay.r()]);
         // y = (the FMU's y) + D v, then noise and sensor faults, as the built-in plant measures.
         let (head, tail) = out.split_at_mut(lay.w().start);
         let y = &mut head[lay.y()];
