@@ -98,11 +98,12 @@ pub fn complete(s: &Scenario, banks: Vec<Bank>, own: Vec<Option<Designed>>) -> R
             }
             // A controller that reads the plant's samples (for ŵ, or measured tracked outputs) is
             // one more subscriber to them, beside every observer and the recorder.
-            if fb.reads_plant() && s.observers.len() >= scenario::limits::MAX_OBSERVERS {
+            let processes = s.observer_processes().len();
+            if fb.reads_plant() && processes >= scenario::limits::MAX_OBSERVERS {
                 let field = if c.feedforward { "controller.feedforward" } else { "controller.integral" };
                 let reason = format!(
-                    "this controller reads the plant's samples, as every observer does: with {} observers (bank members included) they would have more than the {} subscribers a service allows (one is the recorder); at most {} observers here",
-                    s.observers.len(),
+                    "this controller reads the plant's samples, as every observer does: with {} observer processes (a bank's members share one) they would have more than the {} subscribers a service allows (one is the recorder); at most {} observers here",
+                    processes,
                     lockstep::settings::MAX_SUBSCRIBERS,
                     scenario::limits::MAX_OBSERVERS - 1
                 );

@@ -1,5 +1,9 @@
-//! Reading a `.rrd` back: every scalar series by entity path, with its steps, decoded with
-//! Rerun's own decoder from frames this module reads and bounds itself ([`frames`]). A file
+//! Reading a `.rrd` back: every scalar series by its signal's path, with its steps, decoded with
+//! Rerun's own decoder from frames this module reads and bounds itself ([`frames`]). Layout 2
+//! (the recording's property `layout`, [`crate::write::LAYOUT`]) stores a component's signals
+//! as the instances of one entity, named by its static [`crate::write::SERIES_COMPONENT`];
+//! layout 1 (no property) stored each signal as an entity of its own. Both read alike; a newer
+//! layout is refused by its number. A file
 //! whose writer was killed (no footer, or a truncated last message) is read as far as it goes
 //! and marked incomplete. A finished file (one that ends with a stream footer) is checked
 //! against the digest its writer stored ([`crate::digest`]): data that does not match, a frame
@@ -73,6 +77,8 @@ pub fn read(path: &Path) -> Result<Recording, ReadError> {
     let mut injector = CachingApplicationIdInjector::default();
     let mut rec = Recording::default();
     let mut stored_digest = None;
+    // Layout 2: entity → the signal behind each instance.
+    let mut instances: BTreeMap<String, Vec<String>> = BTreeMap::new();
     // The digest of what is read, per entity, in file order (the order it was written in).
     let mut read_digests: BTreeMap<String, digest::Running> = BTreeMap::new();
     // Where reading stopped before the end: a cut (a killed writer) or damage.
@@ -98,25 +104,44 @@ pub fn read(path: &Path) -> Result<Recording, ReadError> {
             }
         };
         match item {
-            Some(Item::Static { path, text, legend }) => {
+            Some(Item::Static { path, text, legends, signals }) => {
                 if let Some(s) = text {
                     if path.starts_with("/__properties") && path.ends_with("/digest") {
                         stored_digest = Some(s);
                     } else if path.starts_with("/__properties") && path.ends_with("/steps") {
                         rec.steps_completed = s.trim().parse().ok();
+                    } else if path.starts_with("/__properties") && path.ends_with("/layout") {
+                        match s.trim().parse::<u32>() {
+                            Ok(v) if (1..=crate::write::LAYOUT).contains(&v) => {}
+                            Ok(v) => return Err(err(format!("recording layout {v} is newer than this reader reads (1 to {}): read it with the version of uio-observers that wrote it", crate::write::LAYOUT))),
+                            // Not a number: the bytes were damaged.
+                            Err(_) => {
+                                fault = Some(Fault::Bad(format!("its layout property '{}' is not a layout number", shown(&s))));
+                                break;
+                            }
+                        }
                     } else {
                         rec.scenario = Some(s);
                     }
                 }
-                if let Some(n) = legend {
-                    rec.names.insert(path, n);
+                let names = if signals.is_empty() { vec![path.clone()] } else { signals.clone() };
+                for (signal, legend) in names.iter().zip(legends) {
+                    rec.names.insert(signal.clone(), legend);
+                }
+                if !signals.is_empty() {
+                    instances.insert(path, signals);
                 }
             }
-            Some(Item::Rows { path, steps, times, values }) => {
-                read_digests.entry(path.clone()).or_default().update(&steps, times.as_deref(), &values);
-                let series = rec.series.entry(path).or_default();
-                series.steps.extend_from_slice(&steps);
-                series.values.extend_from_slice(&values);
+            Some(Item::Rows { path, steps, times, values, width }) => {
+                let lone = [path.clone()];
+                let signals = instances.get(&path).map_or(&lone[..], |v| &v[..]);
+                for (i, signal) in signals.iter().enumerate().take(width) {
+                    let column: Vec<f64> = values.iter().skip(i).step_by(width).copied().collect();
+                    read_digests.entry(signal.clone()).or_default().update(&steps, times.as_deref(), &column);
+                    let series = rec.series.entry(signal.clone()).or_default();
+                    series.steps.extend_from_slice(&steps);
+                    series.values.extend(column);
+                }
             }
             None => {}
         }
@@ -168,10 +193,12 @@ fn shown(text: &str) -> String {
 
 /// What one message adds to the recording.
 enum Item {
-    /// A static chunk: a property or the scenario text, and a series' legend.
-    Static { path: String, text: Option<String>, legend: Option<String> },
-    /// Rows of one series: steps, sim_time in ns where recorded, values.
-    Rows { path: String, steps: Vec<i64>, times: Option<Vec<i64>>, values: Vec<f64> },
+    /// A static chunk: a property or the scenario text, and an entity's legends and (layout 2)
+    /// the signal behind each instance.
+    Static { path: String, text: Option<String>, legends: Vec<String>, signals: Vec<String> },
+    /// Rows of one entity: steps, sim_time in ns where recorded, and `width` values a row
+    /// (row-major; a short row is padded with NaN).
+    Rows { path: String, steps: Vec<i64>, times: Option<Vec<i64>>, values: Vec<f64>, width: usize },
 }
 
 /// Decodes one message, its lengths checked first; None for what is not a recording's chunk.
@@ -198,20 +225,52 @@ fn decode(msg: &Message, version: Option<CrateVersion>, injector: &mut CachingAp
     let chunk = Chunk::from_arrow_msg(&arrow).map_err(|e| format!("bad chunk: {e}"))?;
     let path = chunk.entity_path().to_string();
     if chunk.is_static() {
-        let first = |c| chunk.iter_slices::<String>(c).next().and_then(|v| v.into_iter().next()).map(|s| s.to_string());
-        return Ok(Some(Item::Static { path, text: first(TextDocument::descriptor_text().component), legend: first(SeriesLines::descriptor_names().component) }));
+        let all = |c| chunk.iter_slices::<String>(c).next().map(|v| v.into_iter().map(|s| s.to_string()).collect::<Vec<_>>()).unwrap_or_default();
+        let text = all(TextDocument::descriptor_text().component).into_iter().next();
+        return Ok(Some(Item::Static { path, text, legends: all(SeriesLines::descriptor_names().component), signals: all(crate::write::SERIES_COMPONENT.into()) }));
     }
     let timeline = |name: &str| chunk.timelines().iter().find(|(n, _)| n.as_str() == name).map(|(_, c)| c.times_raw().to_vec());
     let Some(mut steps) = timeline("step") else {
         return Ok(None);
     };
-    let values: Vec<f64> = chunk.iter_slices::<f64>(Scalars::descriptor_scalars().component).map(|s| s.first().copied().unwrap_or(f64::NAN)).collect();
-    if values.is_empty() {
+    let rows: Vec<&[f64]> = match chunk.components().get_array(crate::write::VALUES_COMPONENT.into()) {
+        // Layout 2: a list of doubles in each row.
+        Some(outer) => lists(outer)?,
+        // Layout 1: one scalar in each row.
+        None => chunk.iter_slices::<f64>(Scalars::descriptor_scalars().component).collect(),
+    };
+    if rows.is_empty() {
         return Ok(None);
     }
-    let rows = values.len().min(steps.len());
-    steps.truncate(rows);
-    Ok(Some(Item::Rows { path, steps, times: timeline("sim_time"), values: values[..rows].to_vec() }))
+    let n = rows.len().min(steps.len());
+    steps.truncate(n);
+    let width = rows.iter().map(|r| r.len()).max().unwrap_or(0).max(1);
+    let mut values = Vec::with_capacity(n * width);
+    for r in &rows[..n] {
+        values.extend_from_slice(r);
+        values.extend(std::iter::repeat_n(f64::NAN, width - r.len()));
+    }
+    Ok(Some(Item::Rows { path, steps, times: timeline("sim_time"), values, width }))
+}
+
+/// Each row's list of doubles in a column of layout 2 (its first instance; a row without one is
+/// empty).
+fn lists(outer: &rerun::external::arrow::array::ListArray) -> Result<Vec<&[f64]>, String> {
+    use rerun::external::arrow::array::{Array as _, Float64Array, ListArray};
+    let inner = outer.values().as_any().downcast_ref::<ListArray>().ok_or("its values are not lists of lists")?;
+    let doubles = inner.values().as_any().downcast_ref::<Float64Array>().ok_or("its values are not doubles")?.values();
+    let (outer_at, inner_at) = (outer.value_offsets(), inner.value_offsets());
+    let mut rows = Vec::with_capacity(outer.len());
+    for r in 0..outer.len() {
+        let (a, b) = (outer_at[r] as usize, outer_at[r + 1] as usize);
+        if a >= b || a >= inner.len() {
+            rows.push(&doubles[..0]);
+            continue;
+        }
+        let (from, to) = (inner_at[a] as usize, inner_at[a + 1] as usize);
+        rows.push(doubles.get(from..to).ok_or("a row's values lie beyond its column")?);
+    }
+    Ok(rows)
 }
 
 /// Whether the file ends with the stream footer (`RRF2FOOT` and an entry count) that only a

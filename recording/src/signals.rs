@@ -166,3 +166,21 @@ pub fn alarm(diagnoser: &str, i: usize) -> String {
 pub fn isolated(diagnoser: &str) -> String {
     format!("/diagnosis/{diagnoser}/isolated")
 }
+
+/// The entity a signal is stored in (layout 2, [`crate::write::LAYOUT`]): the component that
+/// publishes it, so that one row of an entity holds all of that component's scalars of a step
+/// (`/plant` holds x, y, w, v, r and the faults; `/observer/<name>` x̂, e, r, ŵ and log10 max|e|;
+/// `/controller` u; `/diagnoser/<d>` and `/diagnosis/<d>` a bank's residuals and decisions;
+/// `/latency` the step and hop times). The signal's own path stays its name in every reader.
+pub fn entity_of(path: &str) -> String {
+    let mut parts = path.trim_start_matches('/').split('/');
+    let first = parts.next().unwrap_or("");
+    match first {
+        "observer" | "diagnoser" | "diagnosis" => match parts.next() {
+            Some(name) => format!("/{first}/{name}"),
+            None => format!("/{first}"),
+        },
+        "plant" | "disturbance" | "measurement_disturbance" | "input" | "fault" => "/plant".to_string(),
+        _ => format!("/{first}"),
+    }
+}

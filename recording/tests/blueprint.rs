@@ -33,14 +33,21 @@ fn the_viewer_opens_on_sim_time_paused_with_the_palettes_colours() {
     let dir = std::env::temp_dir().join(format!("uio-blueprint-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("bp.rrd");
-    let mut sink = RrdSink::create(&path, &s.name, blueprint(&s), &s.source).unwrap();
-    let g = sink.group();
+    let scenario = s.clone();
+    let mut sink = RrdSink::create(&path, &s.name, move |layout| blueprint(&scenario, layout), &s.source).unwrap();
+    let g = sink.group("signals");
     let observers: Vec<String> = s.observers.iter().map(|o| o.name.clone()).collect();
+    let mut ids = Vec::new();
     for p in [signals::state(0), signals::estimate("luenberger", 0)] {
         let line = palette::line(&p, &observers);
-        sink.series(g, &p, "legend", line.color, palette::viewer_width(&p, &observers));
+        let id = sink.series(g, &p, "legend", line.color, palette::viewer_width(&p, &observers));
+        ids.push(id);
     }
-    sink.finish(0).unwrap();
+    sink.row(g, 0, 0.0);
+    for id in &ids {
+        sink.push(*id, 1.0);
+    }
+    sink.finish(1).unwrap();
     let all = chunks(&path);
     let _ = std::fs::remove_dir_all(&dir);
     let panel = &all[&(true, "/time_panel".to_string())];
@@ -51,6 +58,7 @@ fn the_viewer_opens_on_sim_time_paused_with_the_palettes_colours() {
     // Colours as 0xRRGGBBAA.
     let colour = |entity: &str| -> Vec<u32> { all[&(false, entity.to_string())].iter().flat_map(|c| c.iter_slices::<u32>("SeriesLines:colors".into()).flat_map(|s| s.to_vec()).collect::<Vec<_>>()).collect() };
     let rgba = |c: palette::Rgb| u32::from_be_bytes([c[0], c[1], c[2], 255]);
-    assert_eq!(colour("/plant/x/1"), [rgba(palette::TRUE_STATE)]);
-    assert_eq!(colour("/observer/luenberger/xhat/1"), [rgba(palette::color(1))]);
+    // Layout 2: each signal is an instance of its component's entity, colour for colour.
+    assert_eq!(colour("/plant"), [rgba(palette::TRUE_STATE)]);
+    assert_eq!(colour("/observer/luenberger"), [rgba(palette::color(1))]);
 }

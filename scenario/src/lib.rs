@@ -8,7 +8,9 @@ mod fmu_plant;
 mod plant_file;
 mod hosts;
 pub mod limits;
+pub use observer_processes::{observer_processes, ObserverProcess};
 mod locate;
+mod observer_processes;
 pub mod matrix_file;
 mod raw;
 mod replay_plant;
@@ -222,6 +224,12 @@ pub fn locate_error(s: &Scenario, field: &str, reason: String) -> ScenarioError 
 }
 
 impl Scenario {
+    /// The observer processes of a run across processes: each the indices of the observers it
+    /// steps ([`observer_processes`]).
+    pub fn observer_processes(&self) -> Vec<ObserverProcess> {
+        observer_processes(&self.observers, &self.remote)
+    }
+
     /// The plant over one step of dt: the exact zero-order-hold sampling of a continuous plant,
     /// or a discrete plant's own Φ, Γ_B, Γ_E.
     pub fn sampled_model(&self) -> lti::Discrete {

@@ -5,10 +5,10 @@
 /// Most steps (duration / dt) a run may have: 11.6 days at 1 kHz.
 pub const MAX_STEPS: u64 = 1_000_000_000;
 
-/// Most observers a run may hold, bank members included. Each subscribes to the plant's
-/// service, which also feeds the launcher's recorder, and a service of this protocol allows
-/// [`lockstep::settings::MAX_SUBSCRIBERS`] subscribers (PROTOCOL.md §4): one for the recorder,
-/// the rest for observers.
+/// Most observer processes a run may hold ([`crate::observer_processes`]: a bank's members
+/// share one). Each subscribes to the plant's service, which also feeds the launcher's
+/// recorder, and a service of this protocol allows [`lockstep::settings::MAX_SUBSCRIBERS`]
+/// subscribers (PROTOCOL.md §4): one for the recorder, the rest for observers.
 pub const MAX_OBSERVERS: usize = lockstep::settings::MAX_SUBSCRIBERS - 1;
 
 /// Most `[[fault]]` entries: each adds two values to every plant sample and two recorded

@@ -400,7 +400,7 @@ fn build(raw: RawScenario, dir: Option<&Path>) -> Result<Scenario, Bad> {
         }
     }
 
-    observer_cap(raw.observer.len(), &observers)?;
+    observer_cap(raw.observer.len(), &observers, &remote)?;
 
     let controller = raw.controller.as_ref().map(|c| controller_entry(c, &model, &seen)).transpose()?;
     let expect = raw.expect.unwrap_or_default();
@@ -454,24 +454,25 @@ fn build(raw: RawScenario, dir: Option<&Path>) -> Result<Scenario, Bad> {
     })
 }
 
-/// At most [`MAX_OBSERVERS`] observers, bank members included: the field named is the
-/// `[[observer]]` or `[[diagnoser]]` that goes past the cap.
-fn observer_cap(own: usize, observers: &[ObserverEntry]) -> Result<(), Bad> {
-    if observers.len() <= MAX_OBSERVERS {
+/// At most [`MAX_OBSERVERS`] observer processes (a bank's members share one,
+/// [`crate::observer_processes`]): each subscribes to the plant's samples. The field named is
+/// the `[[observer]]` or `[[diagnoser]]` that goes past the cap.
+fn observer_cap(own: usize, observers: &[ObserverEntry], remote: &std::collections::BTreeMap<String, super::Remote>) -> Result<(), Bad> {
+    let processes = crate::observer_processes(observers, remote);
+    if processes.len() <= MAX_OBSERVERS {
         return Ok(());
     }
-    let members = observers.len() - own;
-    let field = if own > MAX_OBSERVERS {
-        format!("observer[{}]", MAX_OBSERVERS + 1)
-    } else {
-        let (d, _) = observers[MAX_OBSERVERS].member.expect("past the scenario's own observers come bank members");
-        format!("diagnoser[{}]", d + 1)
+    let first = processes[MAX_OBSERVERS].observers[0];
+    let field = match observers[first].member {
+        None => format!("observer[{}]", first + 1),
+        Some((d, _)) => format!("diagnoser[{}]", d + 1),
     };
+    let banks = processes.len() - own;
     Err(bad(
         field,
         format!(
-            "the run would hold {} observers ({own} [[observer]] + {members} bank members); at most {MAX_OBSERVERS}: each subscribes to the plant's samples, and a service allows {} subscribers, one of them the launcher's recorder",
-            observers.len(),
+            "the run would hold {} observer processes ({own} [[observer]] + {banks} for bank members, one per bank); at most {MAX_OBSERVERS}: each subscribes to the plant's samples, and a service allows {} subscribers, one of them the launcher's recorder",
+            processes.len(),
             lockstep::settings::MAX_SUBSCRIBERS
         ),
     ))

@@ -89,7 +89,7 @@ fn step_functions_do_not_allocate() {
         let Ok(p) = plan(&s) else { panic!("{} does not design", s.name) };
         let cfg = configs(&s, &p);
         let mut plant = Plant::new(&cfg.plant).unwrap();
-        let mut observers: Vec<_> = cfg.observers.iter().map(|(_, o)| o.as_ref().unwrap().observer.instantiate()).collect();
+        let mut observers: Vec<_> = cfg.observers.iter().map(|(_, o)| o.as_ref().unwrap().instantiate()).collect();
         let mut controller = cfg.controller.as_ref().map(|c| Controller::new(c).unwrap());
         let c_obs = cfg.controller.as_ref().and_then(|c| cfg.observers.iter().position(|(n, _)| *n == c.observer)).unwrap_or(0);
         let lay = cfg.layout;

@@ -16,10 +16,13 @@ use super::{Mode, Options};
 use crate::error::LaunchError;
 use crate::plan::Plan;
 
-/// Bytes a recorded scalar takes in the `.rrd`: its value, its step and sim_time stamps and
-/// Rerun's row id (8 + 8 + 8 + 16), and its share of the chunks' headers. Measured: 44.9 bytes
-/// per scalar and step for seed002-sine (33 signals) and seed002-actuator-faults (55).
-pub const BYTES_PER_SCALAR: u64 = 46;
+/// Bytes a recorded value takes in the `.rrd` (layout 2): the f64 itself.
+pub const BYTES_PER_VALUE: u64 = 8;
+
+/// Bytes a row of an entity takes besides its values: Rerun's row id (16), the step and
+/// sim_time stamps (8 + 8) and two list offsets (4 + 4), with its share of the chunks' headers.
+/// Measured: 437 bytes a step in-process for seed002-sine's 29 values in 5 entities.
+pub const BYTES_PER_ROW: u64 = 41;
 
 /// The entity paths a run records, before `--record` filters them: the series
 /// [`super::Session::new`] creates, in no particular order.
@@ -62,11 +65,18 @@ pub fn recorded_paths(s: &Scenario, plan: &Plan, paced: bool) -> Vec<String> {
     p
 }
 
-/// Bytes the run's recording will take, about: recorded steps × recorded scalars × [`BYTES_PER_SCALAR`].
-pub fn recording_bytes(s: &Scenario, plan: &Plan, opts: &Options) -> (u64, u64, u64) {
-    let scalars = recorded_paths(s, plan, opts.realtime.is_some()).iter().filter(|p| opts.select.entity(p)).count() as u64;
+/// Bytes the run's recording will take, about: recorded steps × (values × [`BYTES_PER_VALUE`] +
+/// entity rows × [`BYTES_PER_ROW`]). Returns (steps, values, entity rows, bytes).
+pub fn recording_bytes(s: &Scenario, plan: &Plan, opts: &Options) -> (u64, u64, u64, u64) {
+    let paths: Vec<String> = recorded_paths(s, plan, opts.realtime.is_some()).into_iter().filter(|p| opts.select.entity(p)).collect();
+    let mut entities: Vec<String> = paths.iter().map(|p| sig::entity_of(p)).collect();
+    entities.sort();
+    entities.dedup();
+    // ŵ is a row of its own (one step late), beside its observer's.
+    let late = paths.iter().filter(|p| p.contains("/what/")).map(|p| sig::entity_of(p)).collect::<std::collections::BTreeSet<_>>().len();
+    let (scalars, rows) = (paths.len() as u64, (entities.len() + late) as u64);
     let steps = s.steps.div_ceil(opts.select.every());
-    (steps, scalars, steps.saturating_mul(scalars).saturating_mul(BYTES_PER_SCALAR))
+    (steps, scalars, rows, steps.saturating_mul(scalars * BYTES_PER_VALUE + rows * BYTES_PER_ROW))
 }
 
 /// Memory one run's buffers take that grow with the scenario: each `rms` member's window and
@@ -89,7 +99,8 @@ pub fn memory_bytes(s: &Scenario, plan: &Plan) -> u64 {
 pub fn shared_memory_bytes(s: &Scenario, plant_len: usize) -> u64 {
     use lockstep::settings::{MAX_SUBSCRIBERS, SUBSCRIBER_MAX_BUFFER};
     let n = s.model.n();
-    let lens = std::iter::once(plant_len).chain(s.observers.iter().map(|_| n)).chain(s.controller.as_ref().map(|_| s.model.l()));
+    // An observer process publishes n values per observer it steps (a bank's, all its members').
+    let lens = std::iter::once(plant_len).chain(s.observer_processes().into_iter().map(|p| p.observers.len() * n)).chain(s.controller.as_ref().map(|_| s.model.l()));
     let per_sample = |len: usize| (len as u64 * 8 + std::mem::size_of::<lockstep::WireHeader>() as u64) * (MAX_SUBSCRIBERS * SUBSCRIBER_MAX_BUFFER) as u64;
     lens.map(per_sample).sum()
 }
@@ -97,12 +108,12 @@ pub fn shared_memory_bytes(s: &Scenario, plant_len: usize) -> u64 {
 /// Checks a run's recording, memory and shared memory against the machine; `jobs` runs at once.
 pub fn check(s: &Scenario, plan: &Plan, opts: &Options, plant_len: usize, jobs: u64) -> Result<(), LaunchError> {
     if opts.record {
-        let (steps, scalars, bytes) = recording_bytes(s, plan, opts);
+        let (steps, scalars, rows, bytes) = recording_bytes(s, plan, opts);
         if let Some(free) = free_bytes(&opts.out)
             && bytes > free
         {
             return Err(LaunchError::BadInput(format!(
-                "{}: the recording would take about {} ({steps} recorded steps × {scalars} signals × {BYTES_PER_SCALAR} bytes), the file system has {} free; thin it with --record-every N or --record GLOB",
+                "{}: the recording would take about {} ({steps} recorded steps × ({scalars} signals × {BYTES_PER_VALUE} bytes + {rows} entity rows × {BYTES_PER_ROW} bytes)), the file system has {} free; thin it with --record-every N or --record GLOB",
                 opts.out.display(),
                 size(bytes),
                 size(free)

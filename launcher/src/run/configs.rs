@@ -3,7 +3,7 @@
 
 use controller::{ControllerConfig, FeedforwardConfig, IntegralConfig};
 use lockstep::PlantLayout;
-use observer::shell::ObserverRun;
+use observer::LinearObserver;
 use plant::PlantConfig;
 
 use crate::plan::Plan;
@@ -18,8 +18,11 @@ pub struct Configs {
     pub followers: Vec<bool>,
     /// Whether a controller, built in or external, closes the loop.
     pub closed_loop: bool,
-    /// (name, config) per observer; none for an external observer.
-    pub observers: Vec<(String, Option<ObserverRun>)>,
+    /// (name, sampled observer) per observer; none for an external observer.
+    pub observers: Vec<(String, Option<LinearObserver>)>,
+    /// The observer processes across processes, each the observers it steps
+    /// ([`scenario::observer_processes`]: a bank's members share one).
+    pub processes: Vec<scenario::ObserverProcess>,
     /// The built-in controller's (none without one, or for an external one).
     pub controller: Option<ControllerConfig>,
     /// The plant sample layout.
@@ -77,7 +80,7 @@ pub fn configs(s: &Scenario, plan: &Plan) -> Configs {
     let observers = plan
         .observers
         .iter()
-        .map(|(name, d)| (name.clone(), d.as_ref().map(|d| ObserverRun { observer: d.runtime.clone(), layout })))
+        .map(|(name, d)| (name.clone(), d.as_ref().map(|d| d.runtime.clone())))
         .collect();
     let controller = match (&s.controller, &plan.feedback) {
         (Some(c), Some(fb)) => Some(ControllerConfig {
@@ -100,5 +103,5 @@ pub fn configs(s: &Scenario, plan: &Plan) -> Configs {
         }),
         _ => None,
     };
-    Configs { plant, followers, closed_loop: s.controller.is_some(), observers, controller, layout, pace_s: None }
+    Configs { plant, followers, closed_loop: s.controller.is_some(), observers, processes: s.observer_processes(), controller, layout, pace_s: None }
 }

@@ -9,6 +9,8 @@ use lockstep::{PlantLayout, RunSpace, Wait, FOLLOWER_LAG, PROTOCOL_VERSION};
 use scenario::{Named, ProcessSpec, Scenario};
 use serde_json::{json, Value};
 
+use observer::shell::ObserverRun;
+
 use super::configs::{is_follower, Configs};
 
 /// Who runs a component.
@@ -64,7 +66,64 @@ fn fields(l: PlantLayout) -> BTreeMap<String, [usize; 2]> {
         .collect()
 }
 
-/// Every component of the run, in start order: plant, observers, controller.
+/// One observer process: a scenario's observer, or a bank's members together.
+struct ObserverProcess {
+    name: String,
+    label: String,
+    program: Program,
+    params: Value,
+    publishes: PublishSpec,
+    follower: bool,
+}
+
+/// The observer processes ([`Configs::processes`]). An observer publishes its x̂ on
+/// `observer/<name>`; a bank's process publishes its members' x̂ side by side on
+/// `observer/<bank>`, member i's at values i·n … (i+1)·n.
+fn observer_processes(s: &Scenario, cfg: &Configs) -> Vec<ObserverProcess> {
+    let lay = cfg.layout;
+    let run = |members: &[usize]| {
+        let observers: Vec<_> = members.iter().map(|&i| cfg.observers[i].1.clone().expect("a designed observer has a runtime")).collect();
+        serde_json::to_value(ObserverRun { observers, layout: lay }).expect("serialises")
+    };
+    cfg.processes
+        .iter()
+        .map(|process| {
+            let members = &process.observers[..];
+            let first = &s.observers[members[0]];
+            let follower = members.iter().all(|&i| is_follower(s, &s.observers[i].name));
+            match process.bank {
+                Some(d) => {
+                    let bank = &s.diagnosers[d].name;
+                    let names = members.iter().flat_map(|&i| s.names.state.iter().map(move |x| format!("{} ({})", x.name, s.observers[i].name))).collect();
+                    ObserverProcess {
+                        name: bank.clone(),
+                        label: format!("bank '{bank}' ({} member{})", members.len(), if members.len() == 1 { "" } else { "s" }),
+                        program: Program::Builtin("observer"),
+                        params: run(members),
+                        publishes: PublishSpec { service: format!("observer/{bank}"), len: lay.n * members.len(), names },
+                        follower,
+                    }
+                }
+                None => {
+                    let (program, params) = match &first.process {
+                        Some(p) => (Program::External(p.clone()), p.params.clone()),
+                        None => (Program::Builtin("observer"), run(members)),
+                    };
+                    ObserverProcess {
+                        name: first.name.clone(),
+                        label: format!("observer '{}'", first.name),
+                        program,
+                        params,
+                        publishes: PublishSpec { service: format!("observer/{}", first.name), len: lay.n, names: names(&s.names.state) },
+                        follower,
+                    }
+                }
+            }
+        })
+        .collect()
+}
+
+/// Every component of the run, in start order: plant, observer processes, controller.
 pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> Vec<Launchable> {
     let lay = cfg.layout;
     let m = &s.model;
@@ -93,14 +152,13 @@ pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> V
         inlet_timeout_s: None,
     };
     let plant_read = |sleep_us| ReadSpec { service: "plant".into(), len: lay.len(), lag: 0, sleep_us, fields: fields(lay) };
-    let estimate = |name: &str| PublishSpec { service: format!("observer/{name}"), len: lay.n, names: names(&s.names.state) };
+    let processes = observer_processes(s, cfg);
     let mut out = Vec::new();
 
-    // The plant reads every observer (a follower may trail) and the controller.
-    let mut reads: Vec<ReadSpec> = s
-        .observers
+    // The plant reads every observer process (a follower may trail) and the controller.
+    let mut reads: Vec<ReadSpec> = processes
         .iter()
-        .map(|o| ReadSpec { service: format!("observer/{}", o.name), len: lay.n, lag: if is_follower(s, &o.name) { FOLLOWER_LAG } else { 0 }, sleep_us: None, fields: BTreeMap::new() })
+        .map(|p| ReadSpec { service: format!("observer/{}", p.name), len: p.publishes.len, lag: if p.follower { FOLLOWER_LAG } else { 0 }, sleep_us: None, fields: BTreeMap::new() })
         .collect();
     if s.controller.is_some() {
         reads.push(ReadSpec { service: "controller".into(), len: lay.l, lag: 0, sleep_us: None, fields: BTreeMap::new() });
@@ -133,15 +191,10 @@ pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> V
     };
     out.push(Launchable { label, program, config: plant });
 
-    for (o, (name, run)) in s.observers.iter().zip(&cfg.observers) {
-        let sleep = is_follower(s, name).then_some(super::configs::FOLLOWER_SLEEP_US);
-        let (program, params) = match (&o.process, run) {
-            (Some(p), _) => (Program::External(p.clone()), p.params.clone()),
-            (None, Some(r)) => (Program::Builtin("observer"), serde_json::to_value(r).expect("serialises")),
-            (None, None) => unreachable!("a designed observer has a runtime"),
-        };
-        let config = base(name, Role::Observer, estimate(name), vec![plant_read(sleep)], params);
-        out.push(Launchable { label: format!("observer '{name}'"), program, config });
+    for p in processes {
+        let sleep = p.follower.then_some(super::configs::FOLLOWER_SLEEP_US);
+        let config = base(&p.name, Role::Observer, p.publishes, vec![plant_read(sleep)], p.params);
+        out.push(Launchable { label: p.label, program: p.program, config });
     }
 
     if let Some(c) = &s.controller {

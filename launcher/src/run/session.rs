@@ -27,14 +27,14 @@ struct ObserverChannels {
     what: Vec<SeriesId>,
 }
 
-/// The recording's series, in three groups by time stamp: the signals of step k, the hops
-/// measured at step k, and what completes one step late (the step time, controller→plant).
+/// The recording's series, in groups by time stamp: the signals of step k, and the latencies of
+/// step k − 1, which complete with row k (the step time and the controller→plant hop; the
+/// other hops of step k − 1 wait for them, so that all latencies of a step are one row).
 struct Channels {
     signals: usize,
     /// ŵ_{k−1}, completed by row k (a group only when some observer estimates w).
     estimates_late: Option<usize>,
-    hops_now: usize,
-    hops_late: usize,
+    latency: usize,
     x: Vec<SeriesId>,
     y: Vec<SeriesId>,
     w: Vec<SeriesId>,
@@ -73,6 +73,11 @@ pub struct Session {
     pub progress: Option<Progress>,
     /// The hops a row completes, reused from step to step (no allocation per step).
     hop_values: Vec<(usize, u64)>,
+    /// The hops of the previous step measured with its own row (plant→observers,
+    /// observer→controller), recorded with the row that completes that step's latencies.
+    pending_hops: Vec<(usize, u64)>,
+    /// The hops of a step whose latencies a row completes (reused).
+    done_hops: Vec<(usize, u64)>,
     /// One per diagnoser bank: its decisions step by step.
     monitors: Vec<Monitor>,
     /// The diagnosis figures (with any bank).
@@ -186,11 +191,12 @@ impl Session {
         let hops = hop_names(s);
         let sink = match rrd {
             Some(path) => {
-                let mut sink = RrdSink::create(path, &s.name, blueprint(s), &s.source).map_err(LaunchError::BadInput)?;
+                let scenario = s.clone();
+                let mut sink = RrdSink::create(path, &s.name, move |layout| blueprint(&scenario, layout), &s.source).map_err(LaunchError::BadInput)?;
                 sink.select(select.clone());
-                let (signals, hops_now, hops_late) = (sink.group(), sink.group(), sink.group());
-                let estimates_late = estimates.iter().any(Option::is_some).then(|| sink.group());
-                let overrun_group = pace.is_some().then(|| sink.group());
+                let (signals, latency) = (sink.group("signals"), sink.group("latency"));
+                let estimates_late = estimates.iter().any(Option::is_some).then(|| sink.group("what"));
+                let overrun_group = pace.is_some().then(|| sink.group("overrun"));
                 let names = &s.names;
                 let observer_names: Vec<String> = s.observers.iter().map(|o| o.name.clone()).collect();
                 let mut paths: Vec<String> = Vec::new();
@@ -260,20 +266,15 @@ impl Session {
                     .iter()
                     .map(|f| [series(signals, sig::fault_active(&f.name), format!("{} active", f.name)), series(signals, sig::fault_value(&f.name), format!("{} value", f.name))])
                     .collect();
-                let step_latency = series(hops_late, "/latency/step".into(), "step".into());
+                let step_latency = series(latency, "/latency/step".into(), "step".into());
                 if let Some(g) = overrun_group {
                     overrun = Some((g, series(g, "/latency/overrun".into(), "overrun".into())));
                 }
-                let late = s.controller.is_some();
-                let hop_ids = hops
-                    .iter()
-                    .enumerate()
-                    .map(|(i, h)| series(if late && i == hops.len() - 1 { hops_late } else { hops_now }, hop_entity(h), h.clone()))
-                    .collect();
+                let hop_ids = hops.iter().map(|h| series(latency, hop_entity(h), h.clone())).collect();
                 for p in select.unmatched(paths.iter().map(String::as_str)) {
                     eprintln!("warning: --record {}: matches no signal of this run, so records nothing", scenario::quoted(&p));
                 }
-                Some((sink, Channels { signals, estimates_late, hops_now, hops_late, x, y, w, v, r, u, observers, members, decisions, faults, step_latency, hops: hop_ids }))
+                Some((sink, Channels { signals, estimates_late, latency, x, y, w, v, r, u, observers, members, decisions, faults, step_latency, hops: hop_ids }))
             }
             None => None,
         };
@@ -297,6 +298,8 @@ impl Session {
             dt: s.dt,
             progress: None,
             hop_values: Vec::with_capacity(s.observers.len() + 2),
+            pending_hops: Vec::with_capacity(s.observers.len() + 2),
+            done_hops: Vec::with_capacity(s.observers.len() + 2),
             monitors,
             judge,
             pace,
@@ -339,8 +342,16 @@ impl Session {
         if let Some(ns) = step_ns {
             self.latency.step(ns);
         }
-        let pushed = self.push(row, step_ns.map(|ns| (row.k - 1, ns)), &hop_values);
+        // Step k − 1's latencies complete now: its hops from the last row, and controller→plant.
+        let mut done = std::mem::take(&mut self.done_hops);
+        done.clear();
+        done.extend_from_slice(&self.pending_hops);
+        done.extend(hop_values.iter().filter(|&&(i, _)| i > nobs));
+        self.pending_hops.clear();
+        self.pending_hops.extend(hop_values.iter().filter(|&&(i, _)| i <= nobs));
+        let pushed = self.push(row, step_ns.map(|ns| (row.k - 1, ns)), &done);
         self.hop_values = hop_values;
+        self.done_hops = done;
         pushed
     }
 
@@ -357,9 +368,9 @@ impl Session {
         }
         let Some((sink, ch)) = &mut self.sink else { return Ok(()) };
         let k = end.step.saturating_sub(1);
-        sink.row(ch.hops_late, k, k as f64 * self.dt);
+        sink.row(ch.latency, k, k as f64 * self.dt);
         sink.push(ch.step_latency, step_ns as f64);
-        if let Some((i, ns)) = late {
+        for &(i, ns) in self.pending_hops.iter().chain(late.as_ref()) {
             sink.push(ch.hops[i], ns as f64);
         }
         sink.flush_full().map_err(LaunchError::Component)
@@ -460,17 +471,14 @@ impl Session {
             sink.push(*active, f[0]);
             sink.push(*value, f[1]);
         }
-        // Latencies are recorded at the step they belong to: the step time and the
-        // controller→plant hop of step k−1 complete with row k (in-process: step k itself).
+        // Latencies are recorded at the step they belong to: those of step k−1 complete with
+        // row k (in-process: step k itself, which has no hops).
         if let Some((ks, ns)) = step_ns {
-            sink.row(ch.hops_late, ks, ks as f64 * self.dt);
+            sink.row(ch.latency, ks, ks as f64 * self.dt);
             sink.push(ch.step_latency, ns as f64);
-        }
-        if !hops.is_empty() {
-            sink.row(ch.hops_now, k, t);
-        }
-        for &(i, ns) in hops {
-            sink.push(ch.hops[i], ns as f64);
+            for &(i, ns) in hops {
+                sink.push(ch.hops[i], ns as f64);
+            }
         }
         sink.flush_full().map_err(LaunchError::Component)
     }

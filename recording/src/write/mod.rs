@@ -5,6 +5,7 @@
 mod blueprint;
 mod file_sink;
 mod latency;
+mod layout;
 mod metrics;
 mod rrd;
 mod select;
@@ -15,7 +16,8 @@ pub use blueprint::blueprint;
 pub use file_sink::UncompressedFileSink;
 pub use latency::{histogram, Latency, Percentiles};
 pub use metrics::{nan_max, FaultFree, Metrics, ObserverFigures};
-pub use rrd::{RrdSink, SeriesId};
+pub use layout::{Layout, Line, LAYOUT, SERIES_COMPONENT, VALUES_COMPONENT};
+pub use rrd::{RrdSink, SeriesId, FLUSH_STEPS};
 pub use select::Selection;
 pub use what::InputEstimate;
 

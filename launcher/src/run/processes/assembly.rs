@@ -134,6 +134,7 @@ impl Queue {
 /// Per-component queues of received samples, assembled into rows in step order.
 pub(super) struct Assembly {
     pub(super) plant: Queue,
+    /// One per observer process.
     pub(super) observers: Vec<Queue>,
     pub(super) controller: Option<Queue>,
     pub(super) next: u64,
@@ -143,9 +144,40 @@ pub(super) struct Assembly {
     pub(super) dt: f64,
     /// Index of the observer the controller reads.
     pub(super) controller_observer: Option<usize>,
+    /// Per observer process, the observers whose x̂ its sample holds, side by side.
+    members: Vec<Vec<usize>>,
+    /// Per observer process of several, its sample of the step being assembled.
+    scratch: Vec<Vec<f64>>,
+    /// The observer process of each observer.
+    process_of: Vec<usize>,
 }
 
 impl Assembly {
+    /// The queues of `components` (plant, observer processes, controller), as the launcher
+    /// spawns them.
+    pub(super) fn new(components: &[Launchable], cfg: &super::super::configs::Configs, steps: u64, dt: f64, controller_observer: Option<usize>) -> Self {
+        let nproc = cfg.processes.len();
+        let members: Vec<Vec<usize>> = cfg.processes.iter().map(|p| p.observers.clone()).collect();
+        let mut process_of = vec![0; cfg.observers.len()];
+        for (p, m) in members.iter().enumerate() {
+            for &i in m {
+                process_of[i] = p;
+            }
+        }
+        Assembly {
+            plant: Queue::new(&components[0]),
+            observers: components[1..1 + nproc].iter().map(Queue::new).collect(),
+            controller: components.get(1 + nproc).map(Queue::new),
+            next: 0,
+            steps,
+            dt,
+            controller_observer,
+            scratch: members.iter().map(|m| if m.len() > 1 { vec![0.0; m.len() * cfg.layout.n] } else { Vec::new() }).collect(),
+            members,
+            process_of,
+        }
+    }
+
     /// The component whose sample for the next step is missing, first in the order samples flow
     /// within a step (plant, observers, controller): the others wait on it. Indices as the
     /// launcher spawns them.
@@ -164,7 +196,7 @@ impl Assembly {
     pub(super) fn queued_violation(&self, row: &StepRow) -> Option<LaunchError> {
         self.plant
             .violation(row.plant.len())
-            .or_else(|| self.observers.iter().zip(&row.xhat).find_map(|(q, x)| q.violation(x.len())))
+            .or_else(|| self.observers.iter().zip(&self.members).find_map(|(q, m)| q.violation(m.len() * row.xhat.first().map_or(0, Vec::len))))
             .or_else(|| self.controller.as_ref().and_then(|q| q.violation(row.u.len())))
     }
 
@@ -183,14 +215,24 @@ impl Assembly {
             row.plant_hdr = self.plant.take(k, &mut row.plant)?;
             row.k = k;
             row.t = k as f64 * self.dt;
-            for (i, q) in self.observers.iter_mut().enumerate() {
-                row.xhat_hdr[i] = q.take(k, &mut row.xhat[i])?;
-                q.made_after(k, &row.xhat_hdr[i], &row.plant_hdr, "the plant", &self.plant.host)?;
+            for ((q, members), buf) in self.observers.iter_mut().zip(&self.members).zip(&mut self.scratch) {
+                if let [i] = members[..] {
+                    row.xhat_hdr[i] = q.take(k, &mut row.xhat[i])?;
+                    q.made_after(k, &row.xhat_hdr[i], &row.plant_hdr, "the plant", &self.plant.host)?;
+                    continue;
+                }
+                // A bank's process: its members' x̂ side by side.
+                let h = q.take(k, buf)?;
+                q.made_after(k, &h, &row.plant_hdr, "the plant", &self.plant.host)?;
+                for (&i, x) in members.iter().zip(buf.chunks_exact(row.xhat[members[0]].len())) {
+                    row.xhat[i].copy_from_slice(x);
+                    row.xhat_hdr[i] = h;
+                }
             }
             if let Some(q) = &mut self.controller {
                 row.u_hdr = q.take(k, &mut row.u)?;
                 if let Some(c) = self.controller_observer {
-                    let o = &self.observers[c];
+                    let o = &self.observers[self.process_of[c]];
                     q.made_after(k, &row.u_hdr, &row.xhat_hdr[c], &o.label, &o.host)?;
                 }
             }

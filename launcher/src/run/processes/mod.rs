@@ -19,7 +19,7 @@ use std::time::{Duration, Instant};
 use lockstep::{cleanup_dead_runs, Bus, Reader, RunSpace, Wait};
 use scenario::Scenario;
 
-use self::assembly::{Assembly, Queue, Readers};
+use self::assembly::{Assembly, Readers};
 use self::placement::placement;
 use self::proc::{spawn, stop_all, Proc};
 use super::configs::Configs;
@@ -63,7 +63,8 @@ fn run_in(s: &Scenario, space: &RunSpace, cfg: &Configs, session: &mut Session, 
     let bus = Bus::join(space, "launcher", Wait::Yield).map_err(ipc)?;
     space.restrict_shm().map_err(ipc)?;
     let readers: Vec<Reader> = components.iter().map(|c| bus.reader(&c.config.publishes.service)).collect::<Result<_, _>>().map_err(ipc)?;
-    let nobs = s.observers.len();
+    // Observer processes: one per observer, one per bank (its members together).
+    let nobs = cfg.processes.len();
 
     let (tx, rx) = mpsc::channel();
     let mut procs: Vec<Proc> = Vec::new();
@@ -78,15 +79,7 @@ fn run_in(s: &Scenario, space: &RunSpace, cfg: &Configs, session: &mut Session, 
         let stall = Duration::from_secs_f64(s.stall_timeout);
         handshake(&mut procs, &rx, stall)?;
         let r = Readers { plant: &readers[0], observers: &readers[1..1 + nobs], controller: readers.get(1 + nobs) };
-        let mut asm = Assembly {
-            plant: Queue::new(&components[0]),
-            observers: components[1..1 + nobs].iter().map(Queue::new).collect(),
-            controller: components.get(1 + nobs).map(Queue::new),
-            next: 0,
-            steps: s.steps,
-            dt: s.dt,
-            controller_observer: s.controller.as_ref().and_then(|c| s.observers.iter().position(|o| o.name == c.observer)),
-        };
+        let mut asm = Assembly::new(&components, cfg, s.steps, s.dt, s.controller.as_ref().and_then(|c| s.observers.iter().position(|o| o.name == c.observer)));
         supervise(cfg, session, &mut procs, &r, &mut asm, stall)
     })();
     stop_all(&mut procs);
@@ -175,7 +168,7 @@ fn closed_before_ready(p: &mut Proc) -> LaunchError {
 
 fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: &Readers, asm: &mut Assembly, stall: Duration) -> Result<Stop, LaunchError> {
     let steps = cfg.plant.steps;
-    let mut row = StepRow::new(cfg.layout, readers.observers.len(), readers.controller.is_some());
+    let mut row = StepRow::new(cfg.layout, cfg.observers.len(), readers.controller.is_some());
     let mut last_progress = Instant::now();
     let pgids: Vec<u32> = procs.iter().map(|p| p.child.id()).collect();
     let mut watch: Option<liveness::Watch> = None;

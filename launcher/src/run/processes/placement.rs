@@ -35,7 +35,8 @@ pub(crate) fn pin_self(cpu: usize) {
 /// between processes costs ~2.5 µs on the 2-vCPU machines this was measured on). In between,
 /// the plant keeps the first CPU and the rest of the ring takes the others in turn.
 pub(super) fn placement(cfg: &Configs, pin: bool) -> (Option<usize>, Vec<Option<usize>>, Option<usize>) {
-    let ring_observers: Vec<bool> = cfg.followers.iter().map(|f| !f).collect();
+    // Per observer process: in the ring unless every observer it steps is a follower.
+    let ring_observers: Vec<bool> = cfg.processes.iter().map(|p| p.observers.iter().any(|&i| !cfg.followers[i])).collect();
     let ring = 1 + ring_observers.iter().filter(|&&r| r).count() + usize::from(cfg.closed_loop);
     let mut cpus = ring_cpus(ring, pin).into_iter();
     let plant = cpus.next().flatten();
