@@ -47,16 +47,30 @@ impl Default for Running {
 impl Running {
     /// Adds rows, in the order written: steps, sim_time in ns (None: no such timeline), values.
     pub fn update(&mut self, steps: &[i64], times_ns: Option<&[i64]>, values: &[f64]) {
-        // One row at a time through a stack buffer: XXH64's streaming state gives the same hash
-        // as one write of all rows, and nothing is allocated.
-        let mut row = [0u8; 24];
+        self.update_iter(steps, times_ns, values.iter().copied());
+    }
+
+    /// [`Self::update`] with the values from an iterator (a column of row-major rows).
+    pub fn update_iter(&mut self, steps: &[i64], times_ns: Option<&[i64]>, values: impl Iterator<Item = f64>) {
+        // Rows gathered into a stack buffer and hashed 170 at a time: XXH64's streaming state
+        // gives the same hash however the bytes are cut, and a 4 KB write runs at the hash's
+        // own speed where one 24-byte write per row went through its internal buffer.
+        const ROWS: usize = 170;
+        let mut buf = [0u8; 24 * ROWS];
+        let mut filled = 0;
         for (i, (k, v)) in steps.iter().zip(values).enumerate() {
             let t = times_ns.and_then(|t| t.get(i)).copied().unwrap_or(0);
+            let row = &mut buf[filled..filled + 24];
             row[..8].copy_from_slice(&k.to_le_bytes());
             row[8..16].copy_from_slice(&t.to_le_bytes());
             row[16..].copy_from_slice(&v.to_bits().to_le_bytes());
-            self.0.write(&row);
+            filled += 24;
+            if filled == buf.len() {
+                self.0.write(&buf);
+                filled = 0;
+            }
         }
+        self.0.write(&buf[..filled]);
     }
 
     /// 16 hex digits.
@@ -122,6 +136,9 @@ mod tests {
             parts.update(s, Some(s), v);
         }
         assert_eq!(whole.hex(), parts.hex());
+        // The definition: XXH64 (seed 0) of the rows' little-endian words, in one piece.
+        let bytes: Vec<u8> = steps.iter().zip(&values).flat_map(|(k, v)| [k.to_le_bytes(), k.to_le_bytes(), v.to_bits().to_le_bytes()].concat()).collect();
+        assert_eq!(whole.hex(), format!("{:016x}", XxHash64::oneshot(0, &bytes)));
         // One bit of one value.
         let mut flipped = values.clone();
         flipped[500] = f64::from_bits(flipped[500].to_bits() ^ 1);

@@ -191,7 +191,7 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
     let partial = rrd.as_ref().map(|p| p.with_extension("rrd.partial"));
     interrupt::install();
     cfg.pace_s = opts.realtime.map(|x| s.dt / x);
-    let mut session = Session::new(s, cfg.layout, plan, partial.as_deref(), &opts.select, cfg.pace_s).inspect_err(|_| {
+    let mut session = Session::new(s, cfg.layout, plan, partial.as_deref(), &opts.select, cfg.pace_s, opts.mode == Mode::Processes).inspect_err(|_| {
         // A recording that could not even be started is of no use to anyone.
         if let Some(p) = &partial {
             let _ = fs::remove_file(p);

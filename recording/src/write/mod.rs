@@ -3,6 +3,7 @@
 //! recording ([`RrdSink`]), written in batched columns off the lockstep's critical path.
 
 mod blueprint;
+mod columns;
 mod file_sink;
 mod latency;
 mod layout;

@@ -12,7 +12,8 @@
 //! legend, colour and width (`SeriesLines`); readers split the rows back into the signals.
 //!
 //! Entities whose signals share time stamps form a group with one time column; rows are
-//! buffered and sent with `send_columns` every [`FLUSH_STEPS`] steps. Timelines: `step`
+//! buffered row-major and handed every [`FLUSH_STEPS`] steps to the recorder's own thread
+//! ([`super::columns`]), which digests them and sends them with `send_columns`. Timelines: `step`
 //! (sequence) and `sim_time` (seconds). What is sent is thinned and filtered by a
 //! [`Selection`] and digested per signal ([`crate::digest`]); the digest is written when the
 //! recording is closed.
@@ -22,16 +23,14 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
 use rerun::blueprint::{Blueprint, BlueprintActivation};
-use rerun::external::arrow::array::{ArrayRef, Float64Array, ListArray, StringArray};
-use rerun::external::arrow::buffer::{OffsetBuffer, ScalarBuffer};
-use rerun::external::arrow::datatypes::{DataType, Field, FieldRef};
-use rerun::time::Timeline;
-use rerun::{AsComponents as _, Color, ComponentDescriptor, RecordingStream, RecordingStreamBuilder, SerializedComponentBatch, SerializedComponentColumn, SeriesLines, TextDocument, TimeColumn};
+use rerun::external::arrow::array::{ArrayRef, StringArray};
+use rerun::{AsComponents as _, Color, ComponentDescriptor, RecordingStream, RecordingStreamBuilder, SerializedComponentBatch, SeriesLines, TextDocument};
 
+use super::columns::{self, Batch, Columns};
 use super::file_sink::UncompressedFileSink;
-use super::layout::{Layout, Line, LAYOUT, SERIES_COMPONENT, VALUES_COMPONENT};
+use super::layout::{Layout, Line, LAYOUT, SERIES_COMPONENT};
 use super::select::Selection;
-use crate::digest::{self, Running};
+use crate::digest;
 use crate::palette::Rgb;
 use crate::signals;
 
@@ -55,10 +54,13 @@ struct Group {
 struct Entity {
     path: String,
     group: usize,
-    /// Every live signal registered here, in order.
+    /// Its signals, in element order.
     series: Vec<usize>,
-    /// Its instances, once decided ([`RrdSink::freeze`]).
-    instances: Option<Vec<usize>>,
+    /// The rows since the last send, row-major: row r holds signal j at r·K + j (K signals).
+    /// A row starts as NaN, so a signal not set in a row reads as NaN.
+    values: Vec<f64>,
+    /// Its statics have been logged.
+    announced: bool,
 }
 
 struct Signal {
@@ -67,9 +69,11 @@ struct Signal {
     color: Rgb,
     width: f32,
     group: usize,
-    /// Selected, and not found unfilled when its entity was frozen.
+    /// Selected: recorded.
     live: bool,
-    values: Vec<f64>,
+    /// Its entity and its element there.
+    entity: usize,
+    slot: usize,
 }
 
 /// Identifies a signal.
@@ -82,17 +86,15 @@ pub struct RrdSink {
     groups: Vec<Group>,
     entities: Vec<Entity>,
     signals: Vec<Signal>,
-    /// The fields of a row's list of doubles, and of the column's list of those lists.
-    inner: FieldRef,
-    outer: FieldRef,
     /// The file, for messages.
     path: PathBuf,
     /// The first write error of the file sink (which writes on Rerun's thread).
     error: Arc<Mutex<Option<String>>>,
     select: Selection,
     blueprint: Option<MakeBlueprint>,
-    /// Per signal sent, and the scenario text.
-    digests: BTreeMap<String, Running>,
+    /// The thread that digests and sends the batches (from the first send).
+    columns: Option<Columns>,
+    /// The scenario text's digest.
     scenario_digest: String,
 }
 
@@ -111,20 +113,16 @@ impl RrdSink {
         let scenario_text = format!("```toml\n{scenario_toml}\n```");
         let scenario_digest = digest::of_text(&scenario_text);
         rec.log_static("scenario", &TextDocument::from_markdown(scenario_text)).map_err(|e| e.to_string())?;
-        let inner = Arc::new(Field::new("item", DataType::Float64, true));
-        let outer = Arc::new(Field::new("item", DataType::List(inner.clone()), true));
         Ok(RrdSink {
             rec,
             groups: Vec::new(),
             entities: Vec::new(),
             signals: Vec::new(),
-            inner,
-            outer,
             path: path.to_path_buf(),
             error,
             select: Selection::default(),
             blueprint: Some(Box::new(blueprint)),
-            digests: BTreeMap::new(),
+            columns: None,
             scenario_digest,
         })
     }
@@ -143,24 +141,27 @@ impl RrdSink {
     }
 
     /// Registers signal `path` in `group` with its legend name, colour and line width (points).
+    /// Every signal is registered before the first row: an entity's rows hold them all.
     pub fn series(&mut self, group: usize, path: &str, legend: &str, color: Rgb, width: f32) -> SeriesId {
         let live = self.select.entity(path);
         let id = self.signals.len();
-        self.signals.push(Signal { path: path.to_string(), legend: legend.to_string(), color, width, group, live, values: Vec::new() });
+        let (mut entity, mut slot) = (usize::MAX, 0);
         if live {
             let owner = signals::entity_of(path);
-            let e = match self.entities.iter().position(|e| e.group == group && (e.path == owner || e.path == format!("{owner}/{}", self.groups[group].label))) {
+            let labelled = format!("{owner}/{}", self.groups[group].label);
+            entity = match self.entities.iter().position(|e| e.group == group && (e.path == owner || e.path == labelled)) {
                 Some(e) => e,
                 None => {
                     let taken = self.entities.iter().any(|e| e.path == owner);
-                    let path = if taken { format!("{owner}/{}", self.groups[group].label) } else { owner };
-                    self.entities.push(Entity { path, group, series: Vec::new(), instances: None });
+                    self.entities.push(Entity { path: if taken { labelled } else { owner }, group, series: Vec::new(), values: Vec::new(), announced: false });
                     self.groups[group].entities.push(self.entities.len() - 1);
                     self.entities.len() - 1
                 }
             };
-            self.entities[e].series.push(id);
+            slot = self.entities[entity].series.len();
+            self.entities[entity].series.push(id);
         }
+        self.signals.push(Signal { path: path.to_string(), legend: legend.to_string(), color, width, group, live, entity, slot });
         SeriesId(id)
     }
 
@@ -173,27 +174,36 @@ impl RrdSink {
         if selected {
             g.steps.push(k as i64);
             g.times_ns.push((t * 1e9).round() as i64);
+            for &e in &g.entities {
+                let e = &mut self.entities[e];
+                e.values.resize(e.values.len() + e.series.len(), f64::NAN);
+            }
         }
     }
 
     /// Sets a signal's value in its group's current row.
     #[inline]
     pub fn push(&mut self, id: SeriesId, v: f64) {
-        let s = &mut self.signals[id.0];
+        let s = &self.signals[id.0];
         if s.live && !self.groups[s.group].skip {
-            s.values.push(v);
+            let e = &mut self.entities[s.entity];
+            let at = e.values.len() - e.series.len() + s.slot;
+            e.values[at] = v;
         }
     }
 
     /// Sends every group holding at least [`FLUSH_STEPS`] rows; fails once the file could not
     /// be written (a full disk), naming it.
     pub fn flush_full(&mut self) -> Result<(), String> {
+        let mut sent = false;
         for i in 0..self.groups.len() {
             if self.groups[i].steps.len() >= FLUSH_STEPS {
                 self.send(i)?;
+                sent = true;
             }
         }
-        self.write_error()
+        // The sink's error is looked at when something was written (a lock per step is not free).
+        if sent { self.write_error() } else { Ok(()) }
     }
 
     /// The file sink's first write error, if any.
@@ -204,21 +214,12 @@ impl RrdSink {
         }
     }
 
-    /// Decides the instances of every entity whose group has rows (a signal never filled in
-    /// this mode — a hop in-process — is left out), logs their statics, and sends the blueprint.
-    /// An entity whose group has no rows yet keeps every signal, decided at its first send.
-    fn freeze(&mut self) -> Result<(), String> {
-        for e in 0..self.entities.len() {
-            if self.entities[e].instances.is_none() && !self.groups[self.entities[e].group].steps.is_empty() {
-                let filled: Vec<usize> = self.entities[e].series.iter().copied().filter(|&s| !self.signals[s].values.is_empty()).collect();
-                self.fix(e, filled)?;
-            }
-        }
+    /// The layout (every entity and its signals), sent once as the blueprint.
+    fn send_blueprint(&mut self) -> Result<(), String> {
         let Some(make) = self.blueprint.take() else { return Ok(()) };
         let mut layout = Layout::default();
         for e in &self.entities {
-            let instances = e.instances.as_ref().unwrap_or(&e.series);
-            layout.entity(&e.path, instances.iter().map(|&s| {
+            layout.entity(&e.path, e.series.iter().map(|&s| {
                 let sig = &self.signals[s];
                 (sig.path.clone(), Line { legend: sig.legend.clone(), color: sig.color, width: sig.width })
             }));
@@ -226,29 +227,19 @@ impl RrdSink {
         make(&layout).send(&self.rec, BlueprintActivation { make_active: true, make_default: true }).map_err(|e| e.to_string())
     }
 
-    /// Fixes entity `e`'s instances and logs its statics.
-    fn fix(&mut self, e: usize, instances: Vec<usize>) -> Result<(), String> {
-        for &s in &self.entities[e].series {
-            if !instances.contains(&s) {
-                self.signals[s].live = false;
-                self.signals[s].values = Vec::new();
-            }
-        }
-        if !instances.is_empty() {
-            let sig = |s: &usize| &self.signals[*s];
-            let lines = SeriesLines::new()
-                .with_names(instances.iter().map(|s| sig(s).legend.clone()))
-                .with_colors(instances.iter().map(|s| Color::from_rgb(sig(s).color[0], sig(s).color[1], sig(s).color[2])))
-                .with_widths(instances.iter().map(|s| sig(s).width));
-            let names: ArrayRef = Arc::new(StringArray::from_iter_values(instances.iter().map(|s| sig(s).path.as_str())));
-            let mut batches = lines.as_serialized_batches();
-            batches.push(SerializedComponentBatch::new(names, ComponentDescriptor { archetype: None, component: SERIES_COMPONENT.into(), component_type: None }));
-            self.rec.log_serialized_batches(self.entities[e].path.as_str(), true, batches).map_err(|e| e.to_string())?;
-            // Logged rows wait in Rerun's batcher while sent columns go straight through: the
-            // readers need these statics before the entity's first rows.
-            self.rec.flush_blocking().map_err(|e| format!("{}: cannot write: {e}", self.path.display()))?;
-        }
-        self.entities[e].instances = Some(instances);
+    /// Logs entity `e`'s statics: the signal behind each element, and its line.
+    fn announce(&mut self, e: usize) -> Result<(), String> {
+        let entity = &self.entities[e];
+        let sig = |s: &usize| &self.signals[*s];
+        let lines = SeriesLines::new()
+            .with_names(entity.series.iter().map(|s| sig(s).legend.clone()))
+            .with_colors(entity.series.iter().map(|s| Color::from_rgb(sig(s).color[0], sig(s).color[1], sig(s).color[2])))
+            .with_widths(entity.series.iter().map(|s| sig(s).width));
+        let names: ArrayRef = Arc::new(StringArray::from_iter_values(entity.series.iter().map(|s| sig(s).path.as_str())));
+        let mut batches = lines.as_serialized_batches();
+        batches.push(SerializedComponentBatch::new(names, ComponentDescriptor { archetype: None, component: SERIES_COMPONENT.into(), component_type: None }));
+        self.rec.log_serialized_batches(entity.path.as_str(), true, batches).map_err(|e| e.to_string())?;
+        self.entities[e].announced = true;
         Ok(())
     }
 
@@ -256,48 +247,35 @@ impl RrdSink {
         if self.groups[i].steps.is_empty() {
             return Ok(());
         }
-        if self.blueprint.is_some() {
-            self.freeze()?;
+        self.send_blueprint()?;
+        let fresh: Vec<usize> = self.groups[i].entities.iter().copied().filter(|&e| !self.entities[e].announced).collect();
+        for &e in &fresh {
+            self.announce(e)?;
         }
-        let rows = self.groups[i].steps.len();
+        if !fresh.is_empty() {
+            // Logged rows wait in Rerun's batcher while sent columns go straight through: the
+            // readers need these statics before the entity's first rows.
+            self.rec.flush_blocking().map_err(|e| format!("{}: cannot write: {e}", self.path.display()))?;
+        }
+        if self.columns.is_none() {
+            let entities = self.entities.iter().map(|e| columns::Entity { path: e.path.clone(), signals: e.series.iter().map(|&s| self.signals[s].path.clone()).collect() }).collect();
+            self.columns = Some(Columns::start(self.rec.clone(), entities)?);
+        }
         let g = &mut self.groups[i];
         // Fresh buffers of a whole batch: the per-step pushes never grow them again.
-        let step_values = std::mem::replace(&mut g.steps, Vec::with_capacity(FLUSH_STEPS));
-        let time_values = std::mem::replace(&mut g.times_ns, Vec::with_capacity(FLUSH_STEPS));
-        let (step_values, time_values) = (ScalarBuffer::from(step_values), ScalarBuffer::from(time_values));
-        let steps = TimeColumn::new(Some(true), Timeline::new_sequence("step"), step_values.clone());
-        let times = TimeColumn::new(Some(true), Timeline::new_duration("sim_time"), time_values.clone());
-        for e in self.groups[i].entities.clone() {
-            if self.entities[e].instances.is_none() {
-                // A group whose first row came after the first send: all its signals.
-                let all = self.entities[e].series.clone();
-                self.fix(e, all)?;
-            }
-            let Some(instances) = self.entities[e].instances.clone() else { continue };
-            if instances.is_empty() {
-                continue;
-            }
-            // Row-major: row r holds instance j at r·K + j.
-            let mut values = Vec::with_capacity(rows * instances.len());
-            for &s in &instances {
-                let sig = &self.signals[s];
-                if sig.values.len() != rows {
-                    return Err(format!("{}: {} values for {rows} rows", sig.path, sig.values.len()));
-                }
-                self.digests.entry(sig.path.clone()).or_default().update(&step_values, Some(&time_values), &sig.values);
-            }
-            for r in 0..rows {
-                values.extend(instances.iter().map(|&s| self.signals[s].values[r]));
-            }
-            for &s in &instances {
-                self.signals[s].values.clear();
-            }
-            let lists = ListArray::new(self.inner.clone(), OffsetBuffer::<i32>::from_lengths(std::iter::repeat_n(instances.len(), rows)), Arc::new(Float64Array::from(values)), None);
-            let column = ListArray::new(self.outer.clone(), OffsetBuffer::<i32>::from_lengths(std::iter::repeat_n(1, rows)), Arc::new(lists), None);
-            let column = SerializedComponentColumn::new(column, ComponentDescriptor::partial(VALUES_COMPONENT));
-            self.rec.send_columns(self.entities[e].path.as_str(), [steps.clone(), times.clone()], [column]).map_err(|e| e.to_string())?;
-        }
-        Ok(())
+        let batch = Batch {
+            steps: std::mem::replace(&mut g.steps, Vec::with_capacity(FLUSH_STEPS)),
+            times_ns: std::mem::replace(&mut g.times_ns, Vec::with_capacity(FLUSH_STEPS)),
+            values: g
+                .entities
+                .iter()
+                .map(|&e| {
+                    let e_ = &mut self.entities[e];
+                    (e, std::mem::replace(&mut e_.values, Vec::with_capacity(FLUSH_STEPS * e_.series.len())))
+                })
+                .collect(),
+        };
+        self.columns.as_mut().expect("started above").send(batch)
     }
 
     /// Sends what is left, the number of steps the run completed (a thinned or filtered
@@ -307,11 +285,13 @@ impl RrdSink {
         for i in 0..self.groups.len() {
             self.send(i)?;
         }
-        if self.blueprint.is_some() {
-            self.freeze()?;
-        }
+        self.send_blueprint()?;
+        let written = match self.columns.take() {
+            Some(mut c) => c.finish()?,
+            None => BTreeMap::new(),
+        };
         self.rec.send_property("steps", &TextDocument::new(steps_completed.to_string())).map_err(|e| e.to_string())?;
-        let mut digests: BTreeMap<String, String> = self.digests.iter().map(|(k, d)| (k.clone(), d.hex())).collect();
+        let mut digests: BTreeMap<String, String> = written.iter().map(|(k, d)| (k.clone(), d.hex())).collect();
         digests.insert(digest::SCENARIO_KEY.into(), self.scenario_digest.clone());
         self.rec.send_property("digest", &TextDocument::new(digest::to_json(&digests))).map_err(|e| e.to_string())?;
         let flushed = self.rec.flush_blocking();
