@@ -27,6 +27,7 @@ stamp="$venv/.uio-installed"
 "$venv/bin/python3" -c 'import fmpy' 2>/dev/null || rm -f "$stamp"  # test FMUs (issue 22): fmpy
 "$venv/bin/python3" -c 'import mcap' 2>/dev/null || rm -f "$stamp"  # export --mcap read back (issue 23)
 "$venv/bin/python3" -c 'import control, maturin' 2>/dev/null || rm -f "$stamp"  # the Python package (issue 23)
+"$venv/bin/python3" -c 'import rerun' 2>/dev/null || rm -f "$stamp"  # `rerun rrd verify` on our recordings (issue 24)
 if [ ! -x "$venv/bin/python3" ] || [ ! -e "$stamp" ] \
    || [ -n "$(find python/pyproject.toml python/uio_component -newer "$stamp" -print -quit)" ]; then
   if ! python3 -c 'import ensurepip, venv' 2>/dev/null; then
@@ -37,7 +38,7 @@ if [ ! -x "$venv/bin/python3" ] || [ ! -e "$stamp" ] \
   fi
   echo "preparing the Python environment $venv"
   [ -x "$venv/bin/python3" ] || python3 -m venv "$venv"
-  "$venv/bin/pip" install -q --disable-pip-version-check ./python pytest scipy fmpy mcap maturin control  # fmpy: test FMUs (issue 22); mcap: export, maturin and control: the Python package (issue 23)
+  "$venv/bin/pip" install -q --disable-pip-version-check ./python pytest scipy fmpy mcap maturin control rerun-sdk==0.36.3  # fmpy: test FMUs (issue 22); mcap: export, maturin and control: the Python package (issue 23); rerun-sdk: Rerun's own CLI checks our recordings (issue 24)
   touch "$stamp"
 fi
 export PATH="$venv/bin:$PATH"

@@ -54,6 +54,10 @@ enum Command {
         /// path segment, `**` across segments); repeat for several.
         #[arg(long = "record", value_name = "GLOB")]
         record: Vec<String>,
+        /// Write the recording with Rerun's LZ4 chunk compression: about 0.64 × the bytes, for
+        /// the recorder's CPU time.
+        #[arg(long)]
+        compress: bool,
         /// The noise generator's seed (default: the scenario's `seed`).
         #[arg(long)]
         seed: Option<u64>,
@@ -283,13 +287,14 @@ fn main() -> ExitCode {
         pin: "auto".into(),
         record_every: 1,
         record: Vec::new(),
+        compress: false,
         seed: None,
         realtime: false,
         speed: None,
         stall_timeout: None,
     });
     match command {
-        Command::Run { scenario, out, mode, wait, force, allow_unstable, pin, record_every, record, seed, realtime, speed, stall_timeout } => {
+        Command::Run { scenario, out, mode, wait, force, allow_unstable, pin, record_every, record, compress, seed, realtime, speed, stall_timeout } => {
             let speed = speed.unwrap_or(1.0);
             if let Err(e) = limits::speed(speed) {
                 return fail(&e);
@@ -298,7 +303,7 @@ fn main() -> ExitCode {
             // A paced run sleeps while it waits, unless told otherwise.
             let wait = wait.or(realtime.map(|_| Wait::Block));
             let select = match recording::write::Selection::new(record_every, &record) {
-                Ok(x) => x,
+                Ok(x) => x.compressed(compress),
                 Err(e) => return fail(&LaunchError::BadInput(e)),
             };
             let (mut s, p) = match prepared(&scenario, seed) {

@@ -34,7 +34,7 @@ fn the_viewer_opens_on_sim_time_paused_with_the_palettes_colours() {
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("bp.rrd");
     let scenario = s.clone();
-    let mut sink = RrdSink::create(&path, &s.name, move |layout| blueprint(&scenario, layout), &s.source).unwrap();
+    let mut sink = RrdSink::create(&path, &s.name, move |layout| blueprint(&scenario, layout), &s.source, Default::default()).unwrap();
     let g = sink.group("signals");
     let observers: Vec<String> = s.observers.iter().map(|o| o.name.clone()).collect();
     let mut ids = Vec::new();

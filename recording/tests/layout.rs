@@ -1,5 +1,5 @@
-//! Issue 24: the recording layout. Layout 2 stores a component's signals as the instances of
-//! one entity and reads back signal by signal, bit for bit; a layout-1 recording (a signal per
+//! Issue 24: the recording layout. Layout 2 stores a component's signals as the elements of
+//! one entity's rows and reads back signal by signal, bit for bit (LZ4-compressed too); a layout-1 recording (a signal per
 //! entity, no `layout` property) still reads; a layout this reader does not know is refused by
 //! its number; a recording costs at most twice the bytes of the values it holds.
 
@@ -18,9 +18,9 @@ fn scratch(tag: &str) -> PathBuf {
 
 /// 30 signals of a closed loop's shape in five entities (a plant, two observers, a controller,
 /// an input estimate one step late), `steps` rows of values no two alike.
-fn write_layout_2(path: &std::path::Path, steps: u64, every: u64) -> (BTreeMap<String, Series>, usize) {
-    let mut sink = RrdSink::create(path, "layout", |_| rerun::blueprint::Blueprint::new(rerun::blueprint::Vertical::new(Vec::<rerun::blueprint::ContainerLike>::new())), "name = \"layout\"").unwrap();
-    sink.select(recording::write::Selection::new(every, &[]).unwrap());
+fn write_layout_2(path: &std::path::Path, steps: u64, every: u64, compress: bool) -> (BTreeMap<String, Series>, usize) {
+    let select = recording::write::Selection::new(every, &[]).unwrap().compressed(compress);
+    let mut sink = RrdSink::create(path, "layout", |_| rerun::blueprint::Blueprint::new(rerun::blueprint::Vertical::new(Vec::<rerun::blueprint::ContainerLike>::new())), "name = \"layout\"", select).unwrap();
     let (now, late) = (sink.group("signals"), sink.group("what"));
     let mut paths: Vec<String> = (1..=3).map(|i| format!("/plant/x/{i}")).chain((1..=2).map(|j| format!("/plant/y/{j}"))).chain(["/disturbance/1".into(), "/input/1".into(), "/input/2".into()]).collect();
     for o in ["uio", "luenberger"] {
@@ -65,13 +65,13 @@ fn write_layout_2(path: &std::path::Path, steps: u64, every: u64) -> (BTreeMap<S
 fn layout_2_reads_back_signal_by_signal_bit_for_bit() {
     let dir = scratch("roundtrip");
     let path = dir.join("r.rrd");
-    for every in [1, 7] {
-        let (expected, signals) = write_layout_2(&path, 10_000, every);
+    for (every, compress) in [(1, false), (7, false), (1, true)] {
+        let (expected, signals) = write_layout_2(&path, 10_000, every, compress);
         let r = read(&path).unwrap();
         assert_eq!(r.integrity, Integrity::Verified);
         assert!(r.complete);
         assert_eq!(r.series.len(), signals);
-        assert_eq!(r.series, expected, "every {every}");
+        assert_eq!(r.series, expected, "every {every}, compressed {compress}");
         assert_eq!(r.names["/plant/x/2"], "/plant/x/2");
         assert_eq!(r.names["/observer/uio/what/1"], "w estimate");
     }
@@ -83,7 +83,7 @@ fn a_recording_costs_at_most_twice_its_values() {
     let dir = scratch("size");
     let path = dir.join("r.rrd");
     let steps = 50_000;
-    let (_, signals) = write_layout_2(&path, steps, 1);
+    let (_, signals) = write_layout_2(&path, steps, 1, false);
     let bytes = std::fs::metadata(&path).unwrap().len() as f64;
     let raw = (steps as usize * signals * 8) as f64;
     let _ = std::fs::remove_dir_all(&dir);

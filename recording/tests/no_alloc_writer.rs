@@ -40,7 +40,7 @@ static GLOBAL: Counting = Counting;
 fn rows_between_sends_allocate_nothing() {
     let dir = std::env::temp_dir().join(format!("uio-noalloc-writer-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let mut sink = RrdSink::create(&dir.join("r.rrd"), "r", |_| rerun::blueprint::Blueprint::new(rerun::blueprint::Vertical::new(Vec::<rerun::blueprint::ContainerLike>::new())), "").unwrap();
+    let mut sink = RrdSink::create(&dir.join("r.rrd"), "r", |_| rerun::blueprint::Blueprint::new(rerun::blueprint::Vertical::new(Vec::<rerun::blueprint::ContainerLike>::new())), "", Default::default()).unwrap();
     let (g, late) = (sink.group("signals"), sink.group("late"));
     let ids: Vec<_> = ["/plant/x/1", "/plant/y/1", "/observer/a/xhat/1", "/observer/a/error/1", "/controller/u/1"].iter().map(|p| sink.series(g, p, p, [0, 0, 0], 1.0)).collect();
     let step = sink.series(late, "/latency/step", "step", [0, 0, 0], 1.0);

@@ -194,8 +194,7 @@ impl Session {
         let sink = match rrd {
             Some(path) => {
                 let scenario = s.clone();
-                let mut sink = RrdSink::create(path, &s.name, move |layout| blueprint(&scenario, layout), &s.source).map_err(LaunchError::BadInput)?;
-                sink.select(select.clone());
+                let mut sink = RrdSink::create(path, &s.name, move |layout| blueprint(&scenario, layout), &s.source, select.clone()).map_err(LaunchError::BadInput)?;
                 let (signals, latency) = (sink.group("signals"), sink.group("latency"));
                 let estimates_late = estimates.iter().any(Option::is_some).then(|| sink.group("what"));
                 let overrun_group = pace.is_some().then(|| sink.group("overrun"));

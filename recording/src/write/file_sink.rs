@@ -1,4 +1,4 @@
-//! An `.rrd` file sink that writes Rerun's format uncompressed.
+//! An `.rrd` file sink that writes Rerun's format uncompressed (or, asked, LZ4-compressed).
 //!
 //! Rerun's own `FileSink` always LZ4-compresses, which on this project's numeric series gains
 //! little (about 1.7×) and costs a whole core at the rates a lockstep run produces samples. This
@@ -28,8 +28,14 @@ pub struct UncompressedFileSink {
 impl UncompressedFileSink {
     /// Creates (truncates) the file and writes the stream header.
     pub fn create(path: &Path) -> Result<Self, String> {
+        Self::create_with(path, false)
+    }
+
+    /// The same, its chunks LZ4-compressed as Rerun's own sink writes them when `lz4`.
+    pub fn create_with(path: &Path, lz4: bool) -> Result<Self, String> {
         let file = File::create(path).map_err(|e| format!("{}: cannot create: {e}", path.display()))?;
-        let encoder = Encoder::new_eager(re_build_info::CrateVersion::LOCAL, EncodingOptions::PROTOBUF_UNCOMPRESSED, BufWriter::with_capacity(1 << 20, file))
+        let options = if lz4 { EncodingOptions::PROTOBUF_COMPRESSED } else { EncodingOptions::PROTOBUF_UNCOMPRESSED };
+        let encoder = Encoder::new_eager(re_build_info::CrateVersion::LOCAL, options, BufWriter::with_capacity(1 << 20, file))
             .map_err(|e| format!("{}: {e}", path.display()))?;
         Ok(Self { encoder: Mutex::new(Some(encoder)), error: Arc::new(Mutex::new(None)) })
     }

@@ -101,8 +101,9 @@ pub struct RrdSink {
 impl RrdSink {
     /// Opens `path` for writing, with the scenario text as a document and the layout version
     /// as a property; `blueprint` is made and sent when the layout is known (the first send).
-    pub fn create(path: &Path, name: &str, blueprint: impl FnOnce(&Layout) -> Blueprint + Send + 'static, scenario_toml: &str) -> Result<Self, String> {
-        let sink = UncompressedFileSink::create(path)?;
+    /// `select` says what is written, and whether compressed.
+    pub fn create(path: &Path, name: &str, blueprint: impl FnOnce(&Layout) -> Blueprint + Send + 'static, scenario_toml: &str, select: Selection) -> Result<Self, String> {
+        let sink = UncompressedFileSink::create_with(path, select.compress())?;
         let error = sink.error_slot();
         let rec = RecordingStreamBuilder::new("uio-observers")
             .recording_name(name)
@@ -120,16 +121,11 @@ impl RrdSink {
             signals: Vec::new(),
             path: path.to_path_buf(),
             error,
-            select: Selection::default(),
+            select,
             blueprint: Some(Box::new(blueprint)),
             columns: None,
             scenario_digest,
         })
-    }
-
-    /// Records only what `select` selects (set before the first signal).
-    pub fn select(&mut self, select: Selection) {
-        self.select = select;
     }
 
     /// A new group of signals sharing time stamps; returns its index. `label` names its

@@ -5,16 +5,17 @@
 
 use crate::globs::Globs;
 
-/// The steps and entities to record.
+/// The steps and entities to record, and whether the file is compressed.
 #[derive(Debug, Clone)]
 pub struct Selection {
     every: u64,
     globs: Option<Globs>,
+    compress: bool,
 }
 
 impl Default for Selection {
     fn default() -> Self {
-        Selection { every: 1, globs: None }
+        Selection { every: 1, globs: None, compress: false }
     }
 }
 
@@ -28,10 +29,21 @@ impl Selection {
             return Err("--record-every must be at least 1".into());
         }
         if patterns.is_empty() {
-            return Ok(Selection { every, globs: None });
+            return Ok(Selection { every, globs: None, compress: false });
         }
         let globs = Globs::new(patterns).map_err(|e| format!("--record {e}"))?;
-        Ok(Selection { every, globs: Some(globs) })
+        Ok(Selection { every, globs: Some(globs), compress: false })
+    }
+
+    /// The same, written with Rerun's LZ4 chunk compression (`--compress`): about 0.64 × the
+    /// bytes for seed002, for the encoding thread's time.
+    pub fn compressed(self, compress: bool) -> Self {
+        Selection { compress, ..self }
+    }
+
+    /// Whether the file is LZ4-compressed.
+    pub fn compress(&self) -> bool {
+        self.compress
     }
 
     /// N of `--record-every N`: steps 0, N, 2N, … are recorded.
