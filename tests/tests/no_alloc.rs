@@ -169,3 +169,35 @@ fn process_loop(s: &Scenario) {
         assert_eq!(n, 0, "{}: {n} allocations in {} steps of the process loops", s.name, end - 100);
     }
 }
+
+/// Issue 24: the recording writer allocates nothing per step. Between two sends of a group, a
+/// row and its values go into buffers sized for a whole batch (`FLUSH_STEPS` rows).
+#[test]
+fn the_recording_writer_allocates_nothing_between_sends() {
+    use recording::write::{blueprint, RrdSink, FLUSH_STEPS};
+    let s = Scenario::load(&scenario("seed002-sine")).unwrap();
+    let dir = Scratch::new("noalloc-writer");
+    let shown = s.clone();
+    let mut sink = RrdSink::create(&dir.join("r.rrd"), "r", move |l| blueprint(&shown, l), &s.source, Default::default()).unwrap();
+    let (g, late) = (sink.group("signals"), sink.group("late"));
+    let ids: Vec<_> = ["/plant/x/1", "/plant/y/1", "/observer/a/xhat/1", "/observer/a/error/1", "/controller/u/1"].iter().map(|p| sink.series(g, p, p, [0, 0, 0], 1.0)).collect();
+    let step = sink.series(late, "/latency/step", "step", [0, 0, 0], 1.0);
+    let mut k = 0u64;
+    let mut one = |sink: &mut RrdSink| {
+        sink.row(g, k, k as f64 * 1e-3);
+        for (i, id) in ids.iter().enumerate() {
+            sink.push(*id, (k + i as u64) as f64);
+        }
+        sink.row(late, k, k as f64 * 1e-3);
+        sink.push(step, 1.0);
+        sink.flush_full().unwrap();
+        k += 1;
+    };
+    // Two batches sent: every buffer has been made for a whole batch.
+    for _ in 0..2 * FLUSH_STEPS {
+        one(&mut sink);
+    }
+    let n = allocations(|| (0..FLUSH_STEPS - 1).for_each(|_| one(&mut sink)));
+    sink.finish(k).unwrap();
+    assert_eq!(n, 0, "{n} allocations in {} rows", FLUSH_STEPS - 1);
+}
