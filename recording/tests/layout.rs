@@ -120,3 +120,33 @@ fn a_newer_layout_is_refused_by_its_number() {
     assert!(e.contains(&format!("recording layout {} is newer than this reader reads (1 to {LAYOUT})", LAYOUT + 1)), "{e}");
     assert!(e.starts_with(&path.display().to_string()) && !e.contains('\n'), "{e}");
 }
+
+#[test]
+fn a_wide_entity_goes_in_smaller_batches_and_reads_back() {
+    use recording::write::{FLUSH_STEPS, FLUSH_VALUES};
+    let dir = scratch("wide");
+    let path = dir.join("w.rrd");
+    // 3000 signals a row: a batch holds FLUSH_VALUES / 3000 rows, so 2000 rows make several.
+    let width = 3000;
+    assert!(FLUSH_VALUES / width < FLUSH_STEPS);
+    let mut sink = RrdSink::create(&path, "wide", |_| rerun::blueprint::Blueprint::new(rerun::blueprint::Vertical::new(Vec::<rerun::blueprint::ContainerLike>::new())), "", Default::default()).unwrap();
+    let g = sink.group("signals");
+    let ids: Vec<_> = (1..=width).map(|i| sink.series(g, &format!("/plant/x/{i}"), "x", [0, 0, 0], 1.0)).collect();
+    for k in 0..2000u64 {
+        sink.row(g, k, k as f64 * 0.01);
+        for (i, id) in ids.iter().enumerate() {
+            sink.push(*id, (k * 7919 + i as u64) as f64 / 3.0);
+        }
+        sink.flush_full().unwrap();
+    }
+    sink.finish(2000).unwrap();
+    let r = read(&path).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(r.integrity, Integrity::Verified);
+    assert_eq!(r.series.len(), width);
+    for (i, id) in [1usize, 1500, 3000].iter().enumerate() {
+        let s = &r.series[&format!("/plant/x/{id}")];
+        assert_eq!(s.steps, (0..2000).collect::<Vec<i64>>(), "{i}");
+        assert!(s.values.iter().enumerate().all(|(k, &v)| v == (k as u64 * 7919 + *id as u64 - 1) as f64 / 3.0));
+    }
+}

@@ -18,7 +18,7 @@ pub use file_sink::UncompressedFileSink;
 pub use latency::{histogram, Latency, Percentiles};
 pub use metrics::{nan_max, FaultFree, Metrics, ObserverFigures};
 pub use layout::{Layout, Line, LAYOUT, SERIES_COMPONENT, VALUES_COMPONENT};
-pub use rrd::{RrdSink, SeriesId, FLUSH_STEPS};
+pub use rrd::{RrdSink, SeriesId, FLUSH_STEPS, FLUSH_VALUES};
 pub use select::Selection;
 pub use what::InputEstimate;
 

@@ -12,7 +12,8 @@
 //! legend, colour and width (`SeriesLines`); readers split the rows back into the signals.
 //!
 //! Entities whose signals share time stamps form a group with one time column; rows are
-//! buffered row-major and handed every [`FLUSH_STEPS`] steps to the recorder's own thread
+//! buffered row-major and handed every [`FLUSH_STEPS`] steps (fewer for a group of more than
+//! [`FLUSH_VALUES`] / [`FLUSH_STEPS`] values a row) to the recorder's own thread
 //! ([`super::columns`]), which digests them and sends them with `send_columns`. Timelines: `step`
 //! (sequence) and `sim_time` (seconds). What is sent is thinned and filtered by a
 //! [`Selection`] and digested per signal ([`crate::digest`]); the digest is written when the
@@ -37,6 +38,11 @@ use crate::signals;
 /// Steps buffered before a group is sent.
 pub const FLUSH_STEPS: usize = 4096;
 
+/// Values buffered before a group is sent, whatever its steps (8 MB): a wide model's batch
+/// (n = 1000 holds ≈ 10⁴ values a step) stays small, with the few that wait for the recorder's
+/// thread.
+pub const FLUSH_VALUES: usize = 1 << 20;
+
 /// Makes the blueprint once the layout is known.
 type MakeBlueprint = Box<dyn FnOnce(&Layout) -> Blueprint + Send>;
 
@@ -47,8 +53,17 @@ struct Group {
     /// sim_time in nanoseconds (Rerun's duration unit).
     times_ns: Vec<i64>,
     entities: Vec<usize>,
+    /// Values a row of the group holds (all its entities').
+    width: usize,
     /// The current row is not recorded (thinned out): its values are dropped.
     skip: bool,
+}
+
+impl Group {
+    /// Rows buffered before the group is sent: [`FLUSH_STEPS`], fewer for a wide group.
+    fn batch(&self) -> usize {
+        FLUSH_STEPS.min(FLUSH_VALUES / self.width.max(1)).max(1)
+    }
 }
 
 struct Entity {
@@ -132,7 +147,7 @@ impl RrdSink {
     /// entities where their component already has one in an earlier group
     /// (`/observer/uio/what` beside `/observer/uio`).
     pub fn group(&mut self, label: &str) -> usize {
-        self.groups.push(Group { label: label.to_string(), steps: Vec::new(), times_ns: Vec::new(), entities: Vec::new(), skip: false });
+        self.groups.push(Group { label: label.to_string(), steps: Vec::new(), times_ns: Vec::new(), entities: Vec::new(), width: 0, skip: false });
         self.groups.len() - 1
     }
 
@@ -156,6 +171,7 @@ impl RrdSink {
             };
             slot = self.entities[entity].series.len();
             self.entities[entity].series.push(id);
+            self.groups[group].width += 1;
         }
         self.signals.push(Signal { path: path.to_string(), legend: legend.to_string(), color, width, group, live, entity, slot });
         SeriesId(id)
@@ -188,12 +204,12 @@ impl RrdSink {
         }
     }
 
-    /// Sends every group holding at least [`FLUSH_STEPS`] rows; fails once the file could not
-    /// be written (a full disk), naming it.
+    /// Sends every group holding a batch ([`FLUSH_STEPS`] rows, or [`FLUSH_VALUES`] values);
+    /// fails once the file could not be written (a full disk), naming it.
     pub fn flush_full(&mut self) -> Result<(), String> {
         let mut sent = false;
         for i in 0..self.groups.len() {
-            if self.groups[i].steps.len() >= FLUSH_STEPS {
+            if self.groups[i].steps.len() >= self.groups[i].batch() {
                 self.send(i)?;
                 sent = true;
             }
@@ -258,16 +274,17 @@ impl RrdSink {
             self.columns = Some(Columns::start(self.rec.clone(), entities)?);
         }
         let g = &mut self.groups[i];
+        let rows = g.batch();
         // Fresh buffers of a whole batch: the per-step pushes never grow them again.
         let batch = Batch {
-            steps: std::mem::replace(&mut g.steps, Vec::with_capacity(FLUSH_STEPS)),
-            times_ns: std::mem::replace(&mut g.times_ns, Vec::with_capacity(FLUSH_STEPS)),
+            steps: std::mem::replace(&mut g.steps, Vec::with_capacity(rows)),
+            times_ns: std::mem::replace(&mut g.times_ns, Vec::with_capacity(rows)),
             values: g
                 .entities
                 .iter()
                 .map(|&e| {
                     let e_ = &mut self.entities[e];
-                    (e, std::mem::replace(&mut e_.values, Vec::with_capacity(FLUSH_STEPS * e_.series.len())))
+                    (e, std::mem::replace(&mut e_.values, Vec::with_capacity(rows * e_.series.len())))
                 })
                 .collect(),
         };
