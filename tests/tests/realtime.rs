@@ -79,14 +79,20 @@ fn speed_scales_the_pace_and_an_impossible_pace_is_reported() {
 #[test]
 fn a_python_plant_is_paced_too() {
     let s = Scratch::new("realtime-python");
+    // The same run unpaced first: how long this machine, now, takes for it (~1.3 s usually;
+    // 2.6 s seen in a slow phase of the machine).
+    let out = run(&s, &scenario("cartpole-python-plant"), &[]);
+    assert!(out.status.success(), "{:?}", text(&out));
+    let unpaced = summary(&s, "cartpole-python-plant")["wall_s"].as_f64().unwrap();
     // 10 s of simulated time at five times real time.
-    let out = run(&s, &scenario("cartpole-python-plant"), &["--realtime", "--speed", "5"]);
+    let out = run(&s, &scenario("cartpole-python-plant"), &["--realtime", "--speed", "5", "--force"]);
     assert!(out.status.success(), "{:?}", text(&out));
     let rt = &summary(&s, "cartpole-python-plant")["realtime"];
     let (paced, scheduled) = (rt["paced_wall_s"].as_f64().unwrap(), rt["scheduled_s"].as_f64().unwrap());
-    // Paced means never ahead of the schedule (unpaced, this plant takes ~1.3 s for the 2 s); a
-    // late finish is the machine's, not the pacing's: at 0.2 ms a step the Python plant needs
-    // long to catch up after one stall (the page cache's writeback stalled it 50–120 ms in CI
-    // after the tests before it wrote their recordings), so the upper bound is loose.
-    assert!((scheduled - 2.0).abs() < 1e-9 && paced >= scheduled * 0.999 && paced <= scheduled * 1.25, "{rt}");
+    // Paced means never ahead of the schedule; a late finish is the machine's, not the
+    // pacing's: at 0.2 ms a step the Python plant needs long to catch up after one stall (the
+    // page cache's writeback stalled it 50–120 ms in CI after the tests before it wrote their
+    // recordings), so the upper bound is loose, and relative to the unpaced run where the
+    // machine is slower than the schedule.
+    assert!((scheduled - 2.0).abs() < 1e-9 && paced >= scheduled * 0.999 && paced <= scheduled.max(unpaced) * 1.25, "{rt}, unpaced {unpaced} s");
 }
