@@ -10,6 +10,11 @@ use recording::read::{read, write as write_layout_1, Recording, Series};
 use recording::write::{RrdSink, UncompressedFileSink, LAYOUT};
 use recording::Integrity;
 
+/// A recording's layout for tests that do not look at it: no view.
+fn empty_blueprint(_: &recording::write::Layout) -> rerun::blueprint::Blueprint {
+    rerun::blueprint::Blueprint::new(rerun::blueprint::Vertical::new(Vec::<rerun::blueprint::ContainerLike>::new()))
+}
+
 fn scratch(tag: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("uio-layout-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -20,7 +25,7 @@ fn scratch(tag: &str) -> PathBuf {
 /// an input estimate one step late), `steps` rows of values no two alike.
 fn write_layout_2(path: &std::path::Path, steps: u64, every: u64, compress: bool) -> (BTreeMap<String, Series>, usize) {
     let select = recording::write::Selection::new(every, &[]).unwrap().compressed(compress);
-    let mut sink = RrdSink::create(path, "layout", |_| rerun::blueprint::Blueprint::new(rerun::blueprint::Vertical::new(Vec::<rerun::blueprint::ContainerLike>::new())), "name = \"layout\"", select).unwrap();
+    let mut sink = RrdSink::create(path, "layout", empty_blueprint, "name = \"layout\"", select).unwrap();
     let (now, late) = (sink.group("signals"), sink.group("what"));
     let mut paths: Vec<String> = (1..=3).map(|i| format!("/plant/x/{i}")).chain((1..=2).map(|j| format!("/plant/y/{j}"))).chain(["/disturbance/1".into(), "/input/1".into(), "/input/2".into()]).collect();
     for o in ["uio", "luenberger"] {
@@ -129,7 +134,7 @@ fn a_wide_entity_goes_in_smaller_batches_and_reads_back() {
     // 3000 signals a row: a batch holds FLUSH_VALUES / 3000 rows, so 2000 rows make several.
     let width = 3000;
     assert!(FLUSH_VALUES / width < FLUSH_STEPS);
-    let mut sink = RrdSink::create(&path, "wide", |_| rerun::blueprint::Blueprint::new(rerun::blueprint::Vertical::new(Vec::<rerun::blueprint::ContainerLike>::new())), "", Default::default()).unwrap();
+    let mut sink = RrdSink::create(&path, "wide", empty_blueprint, "", Default::default()).unwrap();
     let g = sink.group("signals");
     let ids: Vec<_> = (1..=width).map(|i| sink.series(g, &format!("/plant/x/{i}"), "x", [0, 0, 0], 1.0)).collect();
     for k in 0..2000u64 {

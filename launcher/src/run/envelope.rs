@@ -66,8 +66,9 @@ fn fields(l: PlantLayout) -> BTreeMap<String, [usize; 2]> {
         .collect()
 }
 
-/// One observer process: a scenario's observer, or a bank's members together.
-struct ObserverProcess {
+/// How one observer process ([`scenario::ObserverProcess`]) is started: a scenario's observer,
+/// or a bank's members together.
+struct ObserverLaunch {
     name: String,
     label: String,
     program: Program,
@@ -79,7 +80,7 @@ struct ObserverProcess {
 /// The observer processes ([`Configs::processes`]). An observer publishes its x̂ on
 /// `observer/<name>`; a bank's process publishes its members' x̂ side by side on
 /// `observer/<bank>`, member i's at values i·n … (i+1)·n.
-fn observer_processes(s: &Scenario, cfg: &Configs) -> Vec<ObserverProcess> {
+fn observer_launches(s: &Scenario, cfg: &Configs) -> Vec<ObserverLaunch> {
     let lay = cfg.layout;
     let run = |members: &[usize]| {
         let observers: Vec<_> = members.iter().map(|&i| cfg.observers[i].1.clone().expect("a designed observer has a runtime")).collect();
@@ -95,7 +96,7 @@ fn observer_processes(s: &Scenario, cfg: &Configs) -> Vec<ObserverProcess> {
                 Some(d) => {
                     let bank = &s.diagnosers[d].name;
                     let names = members.iter().flat_map(|&i| s.names.state.iter().map(move |x| format!("{} ({})", x.name, s.observers[i].name))).collect();
-                    ObserverProcess {
+                    ObserverLaunch {
                         name: bank.clone(),
                         label: format!("bank '{bank}' ({} member{})", members.len(), if members.len() == 1 { "" } else { "s" }),
                         program: Program::Builtin("observer"),
@@ -109,7 +110,7 @@ fn observer_processes(s: &Scenario, cfg: &Configs) -> Vec<ObserverProcess> {
                         Some(p) => (Program::External(p.clone()), p.params.clone()),
                         None => (Program::Builtin("observer"), run(members)),
                     };
-                    ObserverProcess {
+                    ObserverLaunch {
                         name: first.name.clone(),
                         label: format!("observer '{}'", first.name),
                         program,
@@ -152,7 +153,7 @@ pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> V
         inlet_timeout_s: None,
     };
     let plant_read = |sleep_us| ReadSpec { service: "plant".into(), len: lay.len(), lag: 0, sleep_us, fields: fields(lay) };
-    let processes = observer_processes(s, cfg);
+    let processes = observer_launches(s, cfg);
     let mut out = Vec::new();
 
     // The plant reads every observer process (a follower may trail) and the controller.

@@ -167,9 +167,9 @@ pub fn hop_entity(hop: &str) -> String {
 impl Session {
     /// Starts a session; with `rrd`, opens the recording there.
     /// `select` thins and filters what is written; the figures see every step.
-    /// `hops`: the run measures hop latencies (across processes; in one process there are none).
-    pub fn new(s: &Scenario, layout: PlantLayout, plan: &Plan, rrd: Option<&Path>, select: &Selection, pace_s: Option<f64>, hops: bool) -> Result<Self, LaunchError> {
-        let measured_hops = hops;
+    /// `measures_hops`: the run measures hop latencies (across processes; in one process there
+    /// are none).
+    pub fn new(s: &Scenario, layout: PlantLayout, plan: &Plan, rrd: Option<&Path>, select: &Selection, pace_s: Option<f64>, measures_hops: bool) -> Result<Self, LaunchError> {
         let banks = &plan.banks[..];
         // ŵ of the scenario's own observers (a bank member's model widens E with its blind
         // channels: its estimator is not of the plant's w).
@@ -271,7 +271,7 @@ impl Session {
                 if let Some(g) = overrun_group {
                     overrun = Some((g, series(g, "/latency/overrun".into(), "overrun".into())));
                 }
-                let hop_ids = if measured_hops { hops.iter().map(|h| series(latency, hop_entity(h), h.clone())).collect() } else { Vec::new() };
+                let hop_ids = if measures_hops { hops.iter().map(|h| series(latency, hop_entity(h), h.clone())).collect() } else { Vec::new() };
                 for p in select.unmatched(paths.iter().map(String::as_str)) {
                     eprintln!("warning: --record {}: matches no signal of this run, so records nothing", scenario::quoted(&p));
                 }

@@ -55,8 +55,13 @@ impl Columns {
     /// Hands a batch over (waits while [`DEPTH`] are in flight); fails with the thread's error
     /// once it has stopped.
     pub fn send(&mut self, batch: Batch) -> Result<(), String> {
-        let sent = self.tx.as_ref().is_some_and(|tx| tx.send(batch).is_ok());
-        if sent { Ok(()) } else { self.finish().map(|_| ()).and(Err("the recorder's thread has stopped".into())) }
+        if let Some(tx) = &self.tx
+            && tx.send(batch).is_ok()
+        {
+            return Ok(());
+        }
+        // The thread has gone: its own error says why.
+        self.finish().and(Err("the recorder's thread has stopped".into()))
     }
 
     /// Waits for every batch to be written; returns each signal's digest.

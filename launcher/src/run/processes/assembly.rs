@@ -142,14 +142,12 @@ pub(super) struct Assembly {
     pub(super) steps: u64,
     /// Sample period: the recording's time is k·dt, whatever a plant's header says.
     pub(super) dt: f64,
-    /// Index of the observer the controller reads.
-    pub(super) controller_observer: Option<usize>,
+    /// The observer the controller reads, and the observer process that publishes it.
+    pub(super) controller_observer: Option<(usize, usize)>,
     /// Per observer process, the observers whose x̂ its sample holds, side by side.
     members: Vec<Vec<usize>>,
     /// Per observer process of several, its sample of the step being assembled.
     scratch: Vec<Vec<f64>>,
-    /// The observer process of each observer.
-    process_of: Vec<usize>,
 }
 
 impl Assembly {
@@ -158,12 +156,7 @@ impl Assembly {
     pub(super) fn new(components: &[Launchable], cfg: &super::super::configs::Configs, steps: u64, dt: f64, controller_observer: Option<usize>) -> Self {
         let nproc = cfg.processes.len();
         let members: Vec<Vec<usize>> = cfg.processes.iter().map(|p| p.observers.clone()).collect();
-        let mut process_of = vec![0; cfg.observers.len()];
-        for (p, m) in members.iter().enumerate() {
-            for &i in m {
-                process_of[i] = p;
-            }
-        }
+        let controller_observer = controller_observer.map(|c| (c, members.iter().position(|m| m.contains(&c)).expect("every observer has a process")));
         Assembly {
             plant: Queue::new(&components[0]),
             observers: components[1..1 + nproc].iter().map(Queue::new).collect(),
@@ -174,7 +167,6 @@ impl Assembly {
             controller_observer,
             scratch: members.iter().map(|m| if m.len() > 1 { vec![0.0; m.len() * cfg.layout.n] } else { Vec::new() }).collect(),
             members,
-            process_of,
         }
     }
 
@@ -231,8 +223,8 @@ impl Assembly {
             }
             if let Some(q) = &mut self.controller {
                 row.u_hdr = q.take(k, &mut row.u)?;
-                if let Some(c) = self.controller_observer {
-                    let o = &self.observers[self.process_of[c]];
+                if let Some((c, p)) = self.controller_observer {
+                    let o = &self.observers[p];
                     q.made_after(k, &row.u_hdr, &row.xhat_hdr[c], &o.label, &o.host)?;
                 }
             }
