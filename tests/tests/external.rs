@@ -1,7 +1,8 @@
 //! Issue 11: components we did not write join a run through PROTOCOL.md — and one that breaks
 //! it is named, stops the run quickly, and leaves nothing behind.
 
-use std::time::Duration;
+use std::process::Stdio;
+use std::time::{Duration, Instant};
 
 use tests::*;
 
@@ -58,6 +59,44 @@ fn a_component_that_never_says_ready_is_named() {
     assert_eq!(code, Some(3), "{err}");
     assert!(err.contains("observer 'bad' (pid") && err.contains("did not report ready within 20 s and is asleep, using no CPU"), "{err}");
     assert!(took < Duration::from_secs(25), "took {took:?}");
+}
+
+/// The pid of the child of `parent` whose command line holds `program`, once it runs.
+fn child_running(parent: u32, program: &str) -> i32 {
+    let deadline = Instant::now() + Duration::from_secs(20);
+    loop {
+        for e in std::fs::read_dir("/proc").unwrap().flatten() {
+            let Ok(pid) = e.file_name().to_string_lossy().parse::<i32>() else { continue };
+            let stat = std::fs::read_to_string(e.path().join("stat")).unwrap_or_default();
+            // The parent pid is the second field after the parenthesised command name.
+            let ppid = stat.rsplit_once(')').and_then(|(_, r)| r.split_whitespace().nth(1)).and_then(|p| p.parse::<u32>().ok());
+            let cmd = std::fs::read(e.path().join("cmdline")).unwrap_or_default();
+            if ppid == Some(parent) && String::from_utf8_lossy(&cmd).contains(program) {
+                return pid;
+            }
+        }
+        assert!(Instant::now() < deadline, "{program} did not start");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+/// A component the kernel has stopped before it said ready cannot say it: it is named after the
+/// run's blocked limit (5 s), not the 20 s start-up allowance.
+#[test]
+fn a_component_stopped_before_ready_is_named_at_the_blocked_limit() {
+    let s = Scratch::new("bad-stopped-early");
+    let path = with_bad_observer(&s, 10, r#"["faulty_observer"]"#, r#"{ fault = "never_ready" }"#);
+    let child = launcher(&s).arg("run").arg(&path).arg("--out").arg(s.join("out")).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    let lpid = child.id();
+    signal(child_running(lpid, "faulty_observer"), libc::SIGSTOP);
+    let stopped = Instant::now();
+    let out = child.wait_with_output().unwrap();
+    let took = stopped.elapsed();
+    let (_, err) = text(&out);
+    assert_eq!(out.status.code(), Some(3), "{err}");
+    assert!(err.contains("observer 'bad' (pid") && err.contains("did not report ready within") && err.contains("and is stopped"), "{err}");
+    assert!(took < Duration::from_secs(10), "took {took:?}");
+    assert_clean(&s, lpid);
 }
 
 #[test]

@@ -94,7 +94,8 @@ const EXIT_GRACE: Duration = Duration::from_millis(100);
 /// Waits for every component's `ready`, then tells them all `go`. A component whose stdout ends
 /// before `ready` cannot report it: it failed to start, and is named at once. One still starting
 /// after [`READY_TIMEOUT`] is waited for up to the stall limit while it runs or waits for a core
-/// (an interpreter importing its libraries on a loaded machine), and named once stopped or blocked.
+/// (an interpreter importing its libraries on a loaded machine), and named once blocked; one the
+/// kernel has stopped (SIGSTOP, a debugger) is named after [`STALL_BLOCKED`].
 fn handshake(procs: &mut [Proc], rx: &mpsc::Receiver<(usize, Option<String>)>, stall: Duration) -> Result<(), LaunchError> {
     let start = Instant::now();
     let pgids: Vec<u32> = procs.iter().map(|p| p.child.id()).collect();
@@ -123,16 +124,21 @@ fn handshake(procs: &mut [Proc], rx: &mpsc::Receiver<(usize, Option<String>)>, s
         }
         let slow: Vec<usize> = (0..procs.len()).filter(|&i| !ready[i]).collect();
         // (All may have become ready in this pass: the loop then ends.)
-        if start.elapsed() > READY_TIMEOUT && !slow.is_empty() {
+        // A stopped component cannot become ready until someone continues it: it is named after
+        // the run's own blocked limit, not the start-up allowance.
+        if start.elapsed() > STALL_BLOCKED && !slow.is_empty() {
             let w = watch.get_or_insert_with(|| liveness::Watch::new(&pgids));
             // One slow component judged per look, in turn.
             let mut named = None;
             let i = slow[looks % slow.len()];
             if let Some(v) = w.judge(&pgids, i) {
                 looks += 1;
-                if v != liveness::Verdict::Busy {
-                    named = Some(format!("{} did not report ready within {} s and is {}", procs[i].describe_stall(), READY_TIMEOUT.as_secs(), if v == liveness::Verdict::Stopped { "stopped" } else { "asleep, using no CPU" }));
-                }
+                let waited = start.elapsed();
+                named = match v {
+                    liveness::Verdict::Stopped => Some(format!("{} did not report ready within {} s and is stopped", procs[i].describe_stall(), waited.as_secs())),
+                    liveness::Verdict::Blocked if waited > READY_TIMEOUT => Some(format!("{} did not report ready within {} s and is asleep, using no CPU", procs[i].describe_stall(), READY_TIMEOUT.as_secs())),
+                    _ => None,
+                };
             }
             if named.is_none() && start.elapsed() > stall.max(READY_TIMEOUT) {
                 let labels: Vec<&str> = slow.iter().map(|&i| procs[i].label.as_str()).collect();
