@@ -13,6 +13,7 @@ pub mod shell;
 
 use lti::input_estimate::InputEstimateStep;
 use lti::kernel::{mul_acc, mul_into};
+use lti::sampled::SampledSignal;
 use lti::signal::Signal;
 use lti::MatData;
 use nalgebra::{DMatrix, DVector};
@@ -83,7 +84,7 @@ pub struct Controller {
     g: DMatrix<f64>,
     n: DMatrix<f64>,
     r: DVector<f64>,
-    references: Vec<Signal>,
+    references: Vec<SampledSignal>,
     dt: f64,
     gx: DVector<f64>,
     u: DVector<f64>,
@@ -146,7 +147,7 @@ impl Controller {
                 Ok(Feedforward { m_what: InputEstimateStep::new(mw, &a, &b), y, u_prev })
             })
             .transpose()?;
-        Ok(Self { gx: DVector::zeros(l), u: DVector::zeros(l), r: DVector::zeros(l), g, n, references: cfg.references.clone(), dt: cfg.dt, integral, feedforward, reads_plant: cfg.reads_plant() })
+        Ok(Self { gx: DVector::zeros(l), u: DVector::zeros(l), r: DVector::zeros(l), g, n, references: SampledSignal::all(&cfg.references, cfg.dt), dt: cfg.dt, integral, feedforward, reads_plant: cfg.reads_plant() })
     }
 
     /// Whether it reads the plant's sample (for ŵ, or measured tracked outputs).
@@ -157,33 +158,35 @@ impl Controller {
     /// u_k = N r(t_k) − G x̂_k (− G_ξ ξ_k − M ŵ_{k−1}); `plant` is the plant's sample k, read only
     /// when [`Self::reads_plant`] (may be empty otherwise).
     pub fn step(&mut self, k: u64, xhat: &[f64], plant: &[f64]) -> &[f64] {
-        for (r, s) in self.r.iter_mut().zip(&self.references) {
-            *r = s.sample_step(k, self.dt);
+        // (Slices, not nalgebra's iterators: this runs every step.)
+        let (r, gx, u) = (self.r.as_mut_slice(), self.gx.as_mut_slice(), self.u.as_mut_slice());
+        for (r, s) in r.iter_mut().zip(&self.references) {
+            *r = s.sample_step(k);
         }
-        mul_into(self.u.as_mut_slice(), &self.n, self.r.as_slice());
-        mul_into(self.gx.as_mut_slice(), &self.g, xhat);
+        mul_into(u, &self.n, r);
+        mul_into(gx, &self.g, xhat);
         if let Some(i) = &mut self.integral {
-            mul_acc(self.gx.as_mut_slice(), &i.gi, i.xi.as_slice());
+            mul_acc(gx, &i.gi, i.xi.as_slice());
             // ξ_{k+1} = ξ_k + dt (r_k − z_k), after u_k used ξ_k.
             match &i.y {
                 Some(y) => mul_into(i.z.as_mut_slice(), &i.ct, &plant[y.clone()]),
                 None => mul_into(i.z.as_mut_slice(), &i.ct, xhat),
             }
-            for ((xi, r), z) in i.xi.iter_mut().zip(self.r.iter()).zip(i.z.iter()) {
+            for ((xi, r), z) in i.xi.as_mut_slice().iter_mut().zip(r.iter()).zip(i.z.as_slice()) {
                 *xi += self.dt * (r - z);
             }
         }
         if let Some(f) = &mut self.feedforward {
             // M ŵ_{k−1} once there is an x̂_{k−1}; nothing is cancelled at k = 0.
             if f.m_what.push(&plant[f.y.clone()], &plant[f.u_prev.clone()], xhat) {
-                for (gx, m) in self.gx.iter_mut().zip(&f.m_what.value) {
+                for (gx, m) in gx.iter_mut().zip(&f.m_what.value) {
                     *gx += m;
                 }
             }
         }
-        for (u, gx) in self.u.iter_mut().zip(self.gx.iter()) {
+        for (u, gx) in u.iter_mut().zip(gx.iter()) {
             *u -= gx;
         }
-        self.u.as_slice()
+        u
     }
 }

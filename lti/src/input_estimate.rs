@@ -9,17 +9,20 @@
 //! matrices (MW, MWCΦ, MWCΓ_B) to get Mŵ directly — the controller's cancellation of w. One pass
 //! of products and sums, in a fixed order, so the recorder and the controller form the same bits.
 
-use crate::kernel::{mul_acc, mul_into};
+use crate::kernel::mul_into;
 use crate::Mat;
 
 /// ŵ_{k−1} from sample k, step by step.
 #[derive(Debug, Clone)]
 pub struct InputEstimateStep {
-    w: Mat,
-    /// −WCΦ and −WCΓ_B, so that one pass of products and sums forms ŵ.
-    neg_w_c_phi: Mat,
-    neg_w_c_gamma_b: Mat,
-    prev_xhat: Vec<f64>,
+    /// [W  −WCΦ  −WCΓ_B], so that one pass over each row forms ŵ, summed in the order of the
+    /// three products one after another.
+    m: Mat,
+    /// [y_k; x̂_{k−1}; u_{k−1}] as `m` reads it (x̂'s part holds x̂_k between samples).
+    stacked: Vec<f64>,
+    /// p and n: where x̂'s and u's parts start.
+    p: usize,
+    n: usize,
     started: bool,
     /// ŵ_{k−1}, completed by the last sample (valid once [`Self::push`] returned true).
     pub value: Vec<f64>,
@@ -28,8 +31,12 @@ pub struct InputEstimateStep {
 impl InputEstimateStep {
     /// From W (q×p), WCΦ (q×n) and WCΓ_B (q×l).
     pub fn new(w: Mat, w_c_phi: &Mat, w_c_gamma_b: &Mat) -> Self {
-        let (q, n) = (w.nrows(), w_c_phi.ncols());
-        InputEstimateStep { w, neg_w_c_phi: -w_c_phi, neg_w_c_gamma_b: -w_c_gamma_b, prev_xhat: vec![0.0; n], started: false, value: vec![0.0; q] }
+        let (q, p, n, l) = (w.nrows(), w.ncols(), w_c_phi.ncols(), w_c_gamma_b.ncols());
+        let mut m = Mat::zeros(q, p + n + l);
+        m.columns_mut(0, p).copy_from(&w);
+        m.columns_mut(p, n).copy_from(&-w_c_phi);
+        m.columns_mut(p + n, l).copy_from(&-w_c_gamma_b);
+        InputEstimateStep { m, stacked: vec![0.0; p + n + l], p, n, started: false, value: vec![0.0; q] }
     }
 
     /// Sample k: y_k, the u_{k−1} the plant held over step k − 1, and x̂_k. Returns whether
@@ -37,11 +44,12 @@ impl InputEstimateStep {
     pub fn push(&mut self, y: &[f64], u_prev: &[f64], xhat: &[f64]) -> bool {
         let ready = self.started;
         if ready {
-            mul_into(&mut self.value, &self.w, y);
-            mul_acc(&mut self.value, &self.neg_w_c_phi, &self.prev_xhat);
-            mul_acc(&mut self.value, &self.neg_w_c_gamma_b, u_prev);
+            let (yy, rest) = self.stacked.split_at_mut(self.p);
+            yy.copy_from_slice(y);
+            rest[self.n..].copy_from_slice(u_prev);
+            mul_into(&mut self.value, &self.m, &self.stacked);
         }
-        self.prev_xhat.copy_from_slice(xhat);
+        self.stacked[self.p..self.p + self.n].copy_from_slice(xhat);
         self.started = true;
         ready
     }

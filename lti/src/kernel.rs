@@ -9,34 +9,53 @@ use nalgebra::DMatrix;
 /// out = M v (each row summed from 0.0 over the columns in order, as `gemv` with β = 0).
 #[inline]
 pub fn mul_into(out: &mut [f64], m: &DMatrix<f64>, v: &[f64]) {
-    let rows = m.nrows();
-    let data = m.as_slice();
-    assert!(out.len() == rows && data.len() == rows * v.len(), "mul_into: shapes do not conform");
-    for (i, o) in out.iter_mut().enumerate() {
-        let mut acc = 0.0;
-        for (j, &vj) in v.iter().enumerate() {
-            // SAFETY: as in `mul_acc`.
-            acc += unsafe { *data.get_unchecked(i + j * rows) } * vj;
-        }
-        *o = acc;
-    }
+    product(out, m, v, false);
 }
 
 /// out += M v, summing each row over the columns in order (the same order as `gemv`).
 #[inline]
 pub fn mul_acc(out: &mut [f64], m: &DMatrix<f64>, v: &[f64]) {
+    product(out, m, v, true);
+}
+
+/// out = M v, or out += M v when `add`. The rows are taken four at a time, each block's sums in
+/// registers while the columns are walked in order, j = 0, 1, …: every row still sums its own
+/// terms in column order, so the bits are those of one row at a time, and the column-major
+/// storage is read contiguously.
+#[inline]
+fn product(out: &mut [f64], m: &DMatrix<f64>, v: &[f64], add: bool) {
     let rows = m.nrows();
     let data = m.as_slice();
-    assert!(out.len() == rows && data.len() == rows * v.len(), "mul_acc: shapes do not conform");
-    for (i, o) in out.iter_mut().enumerate() {
-        let mut acc = *o;
-        for (j, &vj) in v.iter().enumerate() {
-            // SAFETY: i < rows and j < v.len(), so i + j·rows < rows·v.len() = data.len()
-            // (asserted above).
-            acc += unsafe { *data.get_unchecked(i + j * rows) } * vj;
-        }
-        *o = acc;
+    assert!(out.len() == rows && data.len() == rows * v.len(), "matrix–vector product: shapes do not conform");
+    let mut i0 = 0;
+    while rows - i0 >= 4 {
+        block::<4>(out, data, rows, i0, v, add);
+        i0 += 4;
     }
+    match rows - i0 {
+        3 => block::<3>(out, data, rows, i0, v, add),
+        2 => block::<2>(out, data, rows, i0, v, add),
+        1 => block::<1>(out, data, rows, i0, v, add),
+        _ => {}
+    }
+}
+
+/// Rows i0 … i0 + B − 1 of [`product`].
+#[inline(always)]
+fn block<const B: usize>(out: &mut [f64], data: &[f64], rows: usize, i0: usize, v: &[f64], add: bool) {
+    let out = &mut out[i0..i0 + B];
+    let mut acc = [0.0; B];
+    if add {
+        acc.copy_from_slice(out);
+    }
+    for (j, &vj) in v.iter().enumerate() {
+        for (i, a) in acc.iter_mut().enumerate() {
+            // SAFETY: i0 + B ≤ rows and j < v.len(), so i0 + i + j·rows < rows·v.len() =
+            // data.len() (asserted by `product`).
+            *a += unsafe { *data.get_unchecked(i0 + i + j * rows) } * vj;
+        }
+    }
+    out.copy_from_slice(&acc);
 }
 
 #[cfg(test)]
@@ -54,5 +73,30 @@ mod tests {
         assert_eq!(out, [1.0, 4.0]);
         let mut empty: [f64; 0] = [];
         mul_into(&mut empty, &DMatrix::zeros(0, 3), &v);
+    }
+
+    /// Every block size and remainder gives the bits of one row at a time, summed in column
+    /// order from 0.0 (or from out), on values whose sums depend on that order.
+    #[test]
+    fn blocks_sum_each_row_in_column_order() {
+        for rows in 0..11 {
+            for cols in 0..7 {
+                let m = DMatrix::from_fn(rows, cols, |i, j| ((i * 7 + j * 3) as f64 * 0.37).sin() * 10f64.powi((i + j) as i32 % 5 - 2));
+                let v: Vec<f64> = (0..cols).map(|j| (j as f64 * 1.3).cos() * 1e3).collect();
+                let start: Vec<f64> = (0..rows).map(|i| i as f64 * 1e-3 - 0.1).collect();
+                let mut into = vec![f64::NAN; rows];
+                let mut acc = start.clone();
+                mul_into(&mut into, &m, &v);
+                mul_acc(&mut acc, &m, &v);
+                for i in 0..rows {
+                    let (mut a, mut b) = (0.0, start[i]);
+                    for j in 0..cols {
+                        a += m[(i, j)] * v[j];
+                        b += m[(i, j)] * v[j];
+                    }
+                    assert_eq!((into[i].to_bits(), acc[i].to_bits()), (a.to_bits(), b.to_bits()), "{rows}×{cols} row {i}");
+                }
+            }
+        }
     }
 }

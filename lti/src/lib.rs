@@ -27,6 +27,7 @@ pub mod lyapunov;
 pub mod model;
 pub mod pinv;
 pub mod place;
+pub mod sampled;
 pub mod poles;
 pub mod signal;
 pub mod staircase;

@@ -82,18 +82,24 @@ impl LinearObserver {
         let r = self.order();
         let p: DMatrix<f64> = (&self.p).into();
         let zero = |m: &MatData| m.data.iter().all(|&x| x == 0.0);
+        let g_zero = zero(&self.g);
+        let l = if g_zero { 0 } else { self.inputs() };
+        // [F G K] (or [F K] when G = 0), acting on the stacked [z; u; y].
+        let mut fgk = DMatrix::zeros(r, r + l + self.outputs());
+        fgk.columns_mut(0, r).copy_from(&DMatrix::from(&self.f));
+        if !g_zero {
+            fgk.columns_mut(r, l).copy_from(&DMatrix::from(&self.g));
+        }
+        fgk.columns_mut(r + l, self.outputs()).copy_from(&DMatrix::from(&self.k));
         ObserverState {
             p_identity: p.is_square() && p == DMatrix::identity(p.nrows(), p.ncols()),
-            g_zero: zero(&self.g),
             q_zero: zero(&self.q),
-            f: (&self.f).into(),
-            g: (&self.g).into(),
-            k: (&self.k).into(),
+            stacked: vec![0.0; fgk.ncols()],
+            fgk,
+            l,
             p: (&self.p).into(),
             q: (&self.q).into(),
-            z: vec![0.0; r],
             z_next: vec![0.0; r],
-            y_prev: vec![0.0; self.outputs()],
             xhat: vec![0.0; self.states()],
             started: false,
             start: self.xhat0.as_ref().map(|x0| (x0.clone(), lti::pinv::pinv(&p))),
@@ -104,22 +110,22 @@ impl LinearObserver {
 /// A running observer: matrices and preallocated state.
 #[derive(Debug, Clone)]
 pub struct ObserverState {
-    f: DMatrix<f64>,
-    g: DMatrix<f64>,
-    k: DMatrix<f64>,
+    /// [F G K], or [F K] when G = 0: z⁺ = F z + G u + K y is one pass over each row, summed
+    /// in the same order as the three products one after another (the same bits).
+    fgk: DMatrix<f64>,
+    /// The columns of G in `fgk`: l, or 0 when G = 0.
+    l: usize,
     p: DMatrix<f64>,
     q: DMatrix<f64>,
-    z: Vec<f64>,
+    /// [z_k; u_{k−1}; y_k] (u's part empty when G = 0): z_k, then what the next update reads.
+    stacked: Vec<f64>,
     z_next: Vec<f64>,
-    y_prev: Vec<f64>,
     xhat: Vec<f64>,
     started: bool,
     /// (x̂₀, P⁺) when the scenario gives an initial estimate.
     start: Option<(Vec<f64>, DMatrix<f64>)>,
     /// P = I (full-order observers): x̂ = z + Qy needs no product with P.
     p_identity: bool,
-    /// G = 0 (no known input acts): skip G u.
-    g_zero: bool,
     /// Q = 0 (predictor-form Luenberger): skip Q y.
     q_zero: bool,
 }
@@ -127,33 +133,35 @@ pub struct ObserverState {
 impl ObserverState {
     /// One step: takes y_k and u_{k−1}, returns x̂_k.
     pub fn step(&mut self, y: &[f64], u_prev: &[f64]) -> &[f64] {
+        let r = self.z_next.len();
         if self.started {
-            mul_into(&mut self.z_next, &self.f, &self.z);
-            if !self.g_zero {
-                mul_acc(&mut self.z_next, &self.g, u_prev);
+            // z_k = F z_{k−1} + G u_{k−1} + K y_{k−1}: `stacked` holds z_{k−1} and y_{k−1}.
+            if self.l > 0 {
+                self.stacked[r..r + self.l].copy_from_slice(u_prev);
             }
-            mul_acc(&mut self.z_next, &self.k, &self.y_prev);
-            std::mem::swap(&mut self.z, &mut self.z_next);
+            mul_into(&mut self.z_next, &self.fgk, &self.stacked);
+            self.stacked[..r].copy_from_slice(&self.z_next);
         } else if let Some((x0, p_pinv)) = &self.start {
             // z_0 = P⁺(x̂₀ − Q y_0), with x̂ as the scratch vector.
             mul_into(&mut self.xhat, &self.q, y);
             for (v, x) in self.xhat.iter_mut().zip(x0) {
                 *v = x - *v;
             }
-            mul_into(&mut self.z, p_pinv, &self.xhat);
+            mul_into(&mut self.stacked[..r], p_pinv, &self.xhat);
         }
         self.started = true;
+        let (z, rest) = self.stacked.split_at_mut(r);
+        rest[self.l..].copy_from_slice(y);
         // Exact identities and zeros are skipped: for finite values the result differs from the
         // full product only in the sign of a zero, and both run modes execute this same code.
         if self.p_identity {
-            self.xhat.copy_from_slice(&self.z);
+            self.xhat.copy_from_slice(z);
         } else {
-            mul_into(&mut self.xhat, &self.p, &self.z);
+            mul_into(&mut self.xhat, &self.p, z);
         }
         if !self.q_zero {
             mul_acc(&mut self.xhat, &self.q, y);
         }
-        self.y_prev.copy_from_slice(y);
         &self.xhat
     }
 }

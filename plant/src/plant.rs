@@ -26,7 +26,8 @@
 use lockstep::PlantLayout;
 use lti::discretize::exp_upper;
 use lti::kernel::{mul_acc, mul_into};
-use lti::signal::{locate, Signal, Switch};
+use lti::sampled::SampledSignal;
+use lti::signal::{locate, Switch};
 use nalgebra::{DMatrix, DVector};
 
 use crate::config::PlantConfig;
@@ -75,9 +76,9 @@ impl std::fmt::Display for Divergence {
 pub struct Plant {
     dt: f64,
     bound: f64,
-    disturbances: Vec<Signal>,
-    measurement: Vec<Signal>,
-    inputs: Vec<Signal>,
+    disturbances: Vec<SampledSignal>,
+    measurement: Vec<SampledSignal>,
+    inputs: Vec<SampledSignal>,
     /// (disturbance index, ω, φ) of each sinusoidal part.
     sines: Vec<(usize, f64, f64)>,
     /// (sin, cos) of each generator at the last sampled t_k, shared by the sample and the step.
@@ -206,9 +207,9 @@ impl Plant {
         Ok(Self {
             dt: cfg.dt,
             bound: cfg.state_bound,
-            disturbances: cfg.disturbances.clone(),
-            measurement: cfg.measurement_disturbances.clone(),
-            inputs: cfg.inputs.clone(),
+            disturbances: SampledSignal::all(&cfg.disturbances, cfg.dt),
+            measurement: SampledSignal::all(&cfg.measurement_disturbances, cfg.dt),
+            inputs: SampledSignal::all(&cfg.inputs, cfg.dt),
             generators: vec![(0.0, 1.0); sines.len()],
             sines,
             c,
@@ -241,7 +242,7 @@ impl Plant {
     /// The sample of step k: [x_k | y_k | w(t_k) | v(t_k) | r(t_k) | u_{k−1}].
     pub fn sample(&mut self, k: u64) -> &[f64] {
         let t = self.time(k);
-        let (dt, lay) = (self.dt, self.layout);
+        let lay = self.layout;
         for (g, &(_, omega, phase)) in self.generators.iter_mut().zip(&self.sines) {
             *g = (omega * t + phase).sin_cos();
         }
@@ -253,16 +254,16 @@ impl Plant {
                 Some(&(d, _, _)) if d == i => {
                     let amplitude = s.sine().map_or(0.0, |a| a.0);
                     next_sine += 1;
-                    amplitude * self.generators[next_sine - 1].0 + s.held_at_step(k, dt)
+                    amplitude * self.generators[next_sine - 1].0 + s.held_at_step(k)
                 }
-                _ => s.sample_step(k, dt),
+                _ => s.sample_step(k),
             };
         }
         for (o, s) in out[lay.v()].iter_mut().zip(&self.measurement) {
-            *o = s.sample_step(k, dt);
+            *o = s.sample_step(k);
         }
         for (o, s) in out[lay.r()].iter_mut().zip(&self.inputs) {
-            *o = s.sample_step(k, dt);
+            *o = s.sample_step(k);
         }
         // y = C x + D v, written in place.
         let (head, tail) = out.split_at_mut(lay.w().start);
@@ -302,7 +303,7 @@ impl Plant {
             let held = &mut self.xi.as_mut_slice()[l..l + q];
             if piece.held.is_empty() {
                 for (c, s) in held.iter_mut().zip(&self.disturbances) {
-                    *c = s.held_at_step(k, self.dt);
+                    *c = s.held_at_step(k);
                 }
             } else {
                 held.copy_from_slice(&piece.held);
@@ -321,7 +322,7 @@ impl Plant {
         if let Some(g) = &mut self.process_noise {
             g.add_to(self.x.as_mut_slice());
         }
-        for (i, &v) in self.x.iter().enumerate() {
+        for (i, &v) in self.x.as_slice().iter().enumerate() {
             if !v.is_finite() || v.abs() > self.bound {
                 return Err(Divergence { step: k, state: i, value: v, bound: self.bound });
             }

@@ -46,7 +46,8 @@ pub struct FaultFree {
 /// as a perfect one.
 #[inline]
 pub fn nan_max(a: f64, b: f64) -> f64 {
-    if a.is_nan() || b.is_nan() { f64::NAN } else { a.max(b) }
+    // a when it is NaN or larger; else b, NaN when b is.
+    if a > b || a.is_nan() { a } else { b }
 }
 
 /// Accumulates [`ObserverFigures`] and pairwise differences.
@@ -142,41 +143,44 @@ impl Metrics {
 
     /// Adds one step.
     pub fn push(&mut self, row: &StepRow) {
-        let x = &row.plant[self.layout.x()];
-        let y = &row.plant[self.layout.y()];
-        for (o, xhat) in row.xhat.iter().enumerate() {
+        let k = row.k;
+        let lay = self.layout;
+        let (x, y) = (&row.plant[lay.x()], &row.plant[lay.y()]);
+        let in_tail = k >= self.planned_tail;
+        // The fault-free stretch [0, F) and its last quarter, when step k is in them.
+        let fault_free = match &mut self.fault_free {
+            Some((first, _, ff)) if k < *first => Some((k >= *first - *first / 4, ff)),
+            _ => None,
+        };
+        let per_observer = row.xhat.iter().zip(&mut self.error).zip(&mut self.residual).zip(&mut self.what).zip(&mut self.observers).zip(&mut self.blocks).zip(&mut self.exact);
+        let mut fault_free = fault_free.map(|(last_quarter, ff)| (last_quarter, ff.iter_mut()));
+        for ((((((xhat, error), res), what), f), [be, br]), exact) in per_observer {
             let mut emax: f64 = 0.0;
-            for i in 0..self.layout.n {
-                let e = x[i] - xhat[i];
-                self.error[o][i] = e;
+            for ((e, &xi), &xh) in error.iter_mut().zip(x).zip(xhat) {
+                *e = xi - xh;
                 emax = nan_max(emax, e.abs());
             }
             let mut rmax: f64 = 0.0;
-            let res = &mut self.residual[o];
             mul_into(res, &self.c, xhat);
             for (r, &yj) in res.iter_mut().zip(y) {
                 *r = yj - *r;
                 rmax = nan_max(rmax, r.abs());
             }
-            if let Some(what) = &mut self.what[o] {
-                what.push(row.k, y, &row.plant[self.layout.u_prev()], &row.plant[self.layout.w()], xhat);
+            if let Some(what) = what {
+                what.push(k, y, &row.plant[lay.u_prev()], &row.plant[lay.w()], xhat);
             }
-            let f = &mut self.observers[o];
             f.max_abs_error = nan_max(f.max_abs_error, emax);
             f.final_abs_error = emax;
-            let [be, br] = &mut self.blocks[o];
-            be.push(row.k, emax);
-            br.push(row.k, rmax);
-            if row.k >= self.planned_tail {
-                let x = &mut self.exact[o];
-                x[0] = nan_max(x[0], emax);
-                x[1] = nan_max(x[1], rmax);
+            be.push(k, emax);
+            br.push(k, rmax);
+            if in_tail {
+                exact[0] = nan_max(exact[0], emax);
+                exact[1] = nan_max(exact[1], rmax);
             }
-            if let Some((first, _, ff)) = &mut self.fault_free
-                && row.k < *first
+            if let Some((last_quarter, ff)) = &mut fault_free
+                && let Some(m) = ff.next()
             {
-                let m = &mut ff[o];
-                if row.k >= *first - *first / 4 {
+                if *last_quarter {
                     m[0] = nan_max(m[0], emax);
                     m[1] = nan_max(m[1], rmax);
                 }
@@ -184,8 +188,8 @@ impl Metrics {
             }
         }
         for ((a, b), d) in self.differences.iter_mut() {
-            for i in 0..self.layout.n {
-                *d = nan_max(*d, (row.xhat[*a][i] - row.xhat[*b][i]).abs());
+            for (xa, xb) in row.xhat[*a].iter().zip(&row.xhat[*b]) {
+                *d = nan_max(*d, (xa - xb).abs());
             }
         }
         self.steps += 1;

@@ -33,7 +33,8 @@ pub fn tail_start(completed: u64, planned: u64) -> Option<u64> {
 /// Maxima of one figure per block of steps, allocated once for the whole run.
 #[derive(Debug, Clone)]
 pub struct BlockMax {
-    len: u64,
+    /// log₂ of the block length (a power of two): k's block is k >> shift.
+    shift: u32,
     blocks: Vec<f64>,
 }
 
@@ -41,20 +42,20 @@ impl BlockMax {
     /// For a run of `planned` steps.
     pub fn new(planned: u64) -> Self {
         let len = block_len(planned);
-        BlockMax { len, blocks: vec![0.0; planned.div_ceil(len).max(1) as usize] }
+        BlockMax { shift: len.trailing_zeros(), blocks: vec![0.0; planned.div_ceil(len).max(1) as usize] }
     }
 
     /// Takes the value of step `k` into its block (steps beyond the plan are ignored).
     #[inline]
     pub fn push(&mut self, k: u64, v: f64) {
-        if let Some(b) = self.blocks.get_mut((k / self.len) as usize) {
+        if let Some(b) = self.blocks.get_mut((k >> self.shift) as usize) {
             *b = nan_max(*b, v);
         }
     }
 
     /// The largest value from step `start` (a block boundary) on.
     pub fn max_from(&self, start: u64) -> f64 {
-        self.blocks.iter().skip((start / self.len) as usize).fold(0.0, |m, &v| nan_max(m, v))
+        self.blocks.iter().skip((start >> self.shift) as usize).fold(0.0, |m, &v| nan_max(m, v))
     }
 }
 
