@@ -22,7 +22,7 @@ pub fn mul_acc(out: &mut [f64], m: &DMatrix<f64>, v: &[f64]) {
 /// registers while the columns are walked in order, j = 0, 1, …: every row still sums its own
 /// terms in column order, so the bits are those of one row at a time, and the column-major
 /// storage is read contiguously.
-#[inline]
+#[inline(always)]
 fn product(out: &mut [f64], m: &DMatrix<f64>, v: &[f64], add: bool) {
     let rows = m.nrows();
     let data = m.as_slice();
