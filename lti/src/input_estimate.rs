@@ -9,7 +9,7 @@
 //! matrices (MW, MWCΦ, MWCΓ_B) to get Mŵ directly — the controller's cancellation of w. One pass
 //! of products and sums, in a fixed order, so the recorder and the controller form the same bits.
 
-use crate::kernel::mul_into;
+use crate::kernel::{copy, mul_into};
 use crate::Mat;
 
 /// ŵ_{k−1} from sample k, step by step.
@@ -45,11 +45,11 @@ impl InputEstimateStep {
         let ready = self.started;
         if ready {
             let (yy, rest) = self.stacked.split_at_mut(self.p);
-            yy.copy_from_slice(y);
-            rest[self.n..].copy_from_slice(u_prev);
+            copy(yy, y);
+            copy(&mut rest[self.n..], u_prev);
             mul_into(&mut self.value, &self.m, &self.stacked);
         }
-        self.stacked[self.p..self.p + self.n].copy_from_slice(xhat);
+        copy(&mut self.stacked[self.p..self.p + self.n], xhat);
         self.started = true;
         ready
     }

@@ -58,6 +58,32 @@ fn block<const B: usize>(out: &mut [f64], data: &[f64], rows: usize, i0: usize, 
     out.copy_from_slice(&acc);
 }
 
+/// dst = src, for the short vectors of a step: up to 8 values as register moves (a call to
+/// `memcpy`, which `copy_from_slice` makes for a length known only at run time, costs more
+/// than such a copy); longer ones with `copy_from_slice`.
+#[inline(always)]
+pub fn copy(dst: &mut [f64], src: &[f64]) {
+    assert!(dst.len() == src.len(), "copy: lengths differ");
+    match src.len() {
+        0 => {}
+        1 => dst[0] = src[0],
+        2 => fixed::<2>(dst, src),
+        3 => fixed::<3>(dst, src),
+        4 => fixed::<4>(dst, src),
+        5 => fixed::<5>(dst, src),
+        6 => fixed::<6>(dst, src),
+        7 => fixed::<7>(dst, src),
+        8 => fixed::<8>(dst, src),
+        _ => dst.copy_from_slice(src),
+    }
+}
+
+#[inline(always)]
+fn fixed<const N: usize>(dst: &mut [f64], src: &[f64]) {
+    let (d, s): (&mut [f64; N], &[f64; N]) = (dst.try_into().expect("length N"), src.try_into().expect("length N"));
+    *d = *s;
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -96,6 +122,9 @@ mod tests {
                     }
                     assert_eq!((into[i].to_bits(), acc[i].to_bits()), (a.to_bits(), b.to_bits()), "{rows}×{cols} row {i}");
                 }
+                let mut copied = vec![0.0; rows];
+                copy(&mut copied, &acc);
+                assert_eq!(copied.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), acc.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
             }
         }
     }

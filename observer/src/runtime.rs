@@ -14,7 +14,7 @@
 //! step): it first advances z_{k−1} → z_k with the stored y_{k−1}, then forms x̂_k. All buffers are
 //! allocated at construction; `step` does not allocate.
 
-use lti::kernel::{mul_acc, mul_into};
+use lti::kernel::{copy, mul_acc, mul_into};
 use lti::MatData;
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
@@ -137,10 +137,10 @@ impl ObserverState {
         if self.started {
             // z_k = F z_{k−1} + G u_{k−1} + K y_{k−1}: `stacked` holds z_{k−1} and y_{k−1}.
             if self.l > 0 {
-                self.stacked[r..r + self.l].copy_from_slice(u_prev);
+                copy(&mut self.stacked[r..r + self.l], u_prev);
             }
             mul_into(&mut self.z_next, &self.fgk, &self.stacked);
-            self.stacked[..r].copy_from_slice(&self.z_next);
+            copy(&mut self.stacked[..r], &self.z_next);
         } else if let Some((x0, p_pinv)) = &self.start {
             // z_0 = P⁺(x̂₀ − Q y_0), with x̂ as the scratch vector.
             mul_into(&mut self.xhat, &self.q, y);
@@ -151,11 +151,11 @@ impl ObserverState {
         }
         self.started = true;
         let (z, rest) = self.stacked.split_at_mut(r);
-        rest[self.l..].copy_from_slice(y);
+        copy(&mut rest[self.l..], y);
         // Exact identities and zeros are skipped: for finite values the result differs from the
         // full product only in the sign of a zero, and both run modes execute this same code.
         if self.p_identity {
-            self.xhat.copy_from_slice(z);
+            copy(&mut self.xhat, z);
         } else {
             mul_into(&mut self.xhat, &self.p, z);
         }

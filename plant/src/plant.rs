@@ -25,7 +25,7 @@
 
 use lockstep::PlantLayout;
 use lti::discretize::exp_upper;
-use lti::kernel::{mul_acc, mul_into};
+use lti::kernel::{copy, mul_acc, mul_into};
 use lti::sampled::SampledSignal;
 use lti::signal::{locate, Switch};
 use nalgebra::{DMatrix, DVector};
@@ -247,7 +247,7 @@ impl Plant {
             *g = (omega * t + phase).sin_cos();
         }
         let out = &mut self.out;
-        out[lay.x()].copy_from_slice(self.x.as_slice());
+        copy(&mut out[lay.x()], self.x.as_slice());
         let mut next_sine = 0;
         for (i, (o, s)) in out[lay.w()].iter_mut().zip(&self.disturbances).enumerate() {
             *o = match self.sines.get(next_sine) {
@@ -285,7 +285,7 @@ impl Plant {
     pub fn advance(&mut self, k: u64, u: &[f64]) -> Result<(), Divergence> {
         let t = self.time(k);
         let lay = self.layout;
-        self.out[lay.u_prev()].copy_from_slice(u);
+        copy(&mut self.out[lay.u_prev()], u);
         // Additive actuator faults act through the state equation below, integrated exactly.
         self.sensing.actuate(k, u, &mut self.u_applied, false);
         let u = self.u_applied.as_slice();
@@ -306,7 +306,7 @@ impl Plant {
                     *c = s.held_at_step(k);
                 }
             } else {
-                held.copy_from_slice(&piece.held);
+                copy(held, &piece.held);
             }
             integrate(piece, t, u, &self.sines, at_tk, &mut self.xi, &mut self.x, &mut self.x_next);
         }
@@ -347,7 +347,7 @@ fn integrate(
     let t0 = tk + piece.offset;
     let l = u.len();
     let q = xi.len() - l - 2 * sines.len();
-    xi.as_mut_slice()[..l].copy_from_slice(u);
+    copy(&mut xi.as_mut_slice()[..l], u);
     for (j, &(_, omega, phase)) in sines.iter().enumerate() {
         let (sin, cos) = match generators_at_tk {
             Some(g) => g[j],

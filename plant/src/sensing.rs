@@ -36,7 +36,7 @@ impl Sensing {
     /// The input acting over step k: the commanded `u` with stuck actuators held and lost gain
     /// taken off; with `additive`, an additive actuator fault's φ(t_k) added too.
     pub fn actuate(&self, k: u64, u: &[f64], applied: &mut [f64], additive: bool) {
-        applied.copy_from_slice(u);
+        lti::kernel::copy(applied, u);
         for f in self.faults.iter().filter(|f| f.active(k)) {
             match (f.fault.target, f.fault.kind) {
                 (Target::Actuator(i), Kind::Stuck) => applied[i] = f.fault.value,

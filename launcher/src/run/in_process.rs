@@ -2,6 +2,7 @@
 
 use controller::Controller;
 use lockstep::now_ns;
+use lti::kernel::copy;
 use observer::ObserverState;
 use plant::Plant;
 
@@ -46,14 +47,14 @@ pub fn run(cfg: &Configs, session: &mut Session) -> Result<Stop, LaunchError> {
         row.plant.copy_from_slice(plant.sample(k));
         for (i, obs) in observers.iter_mut().enumerate() {
             let xhat = obs.step(&row.plant[lay.y()], &row.plant[lay.u_prev()]);
-            row.xhat[i].copy_from_slice(xhat);
+            copy(&mut row.xhat[i], xhat);
         }
         match (&mut controller, ctrl_obs) {
             (Some(c), Some(o)) => {
-                u.copy_from_slice(c.step(k, &row.xhat[o], &row.plant));
-                row.u.copy_from_slice(&u);
+                copy(&mut u, c.step(k, &row.xhat[o], &row.plant));
+                copy(&mut row.u, &u);
             }
-            _ => u.copy_from_slice(plant.reference()),
+            _ => copy(&mut u, plant.reference()),
         }
         let diverged = plant.advance(k, &u);
         let step_ns = if timed { Some(now_ns() - start) } else { None };

@@ -49,7 +49,7 @@ impl InputEstimate {
                 self.exact_tail = nan_max(self.exact_tail, err);
             }
         }
-        self.prev_w.copy_from_slice(w);
+        lti::kernel::copy(&mut self.prev_w, w);
     }
     /// max |w − ŵ| over the tail [start, …) of the estimates completed; exact for a completed run.
     pub fn tail_max_abs_error(&self, start: u64, completed: bool) -> f64 {
