@@ -160,6 +160,27 @@ pub fn wait_running(launcher_pid: u32, names: &[&str]) {
     std::thread::sleep(std::time::Duration::from_millis(100));
 }
 
+/// Waits until the recording being written (`<out>/<name>.rrd.partial`) grows past what it
+/// held when it appeared: its writer has sent a batch of steps, so the run is stepping — its
+/// components said ready. A test that stops a component or the launcher "mid-run" waits for
+/// this: only having seen the processes, it may stop one before the run began (a loaded
+/// machine can take that long to start them), which is another failure with another message.
+pub fn wait_stepping(partial: &Path) {
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    let size = || std::fs::metadata(partial).map(|m| m.len()).ok();
+    let first = loop {
+        if let Some(n) = size() {
+            break n;
+        }
+        assert!(std::time::Instant::now() < deadline, "{} did not appear", partial.display());
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    };
+    while size().is_some_and(|n| n <= first) {
+        assert!(std::time::Instant::now() < deadline, "{} did not grow", partial.display());
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+}
+
 /// Sends `sig` to `pid` (a process the test started).
 pub fn signal(pid: i32, sig: i32) {
     // SAFETY: kill(2) with a pid and signal number; no memory is shared.

@@ -20,24 +20,6 @@ fn steps_recorded(r: &Recording) -> i64 {
     r.series.iter().find(|(p, _)| p.starts_with("/plant/x/")).map_or(0, |(_, s)| s.values.len() as i64)
 }
 
-/// Waits until the recording being written grows past what it held when it appeared: its
-/// writer has sent a batch of steps, so the run is stepping.
-fn wait_steps_recorded(partial: &std::path::Path) {
-    let deadline = Instant::now() + Duration::from_secs(60);
-    let size = || std::fs::metadata(partial).map(|m| m.len()).ok();
-    let first = loop {
-        if let Some(n) = size() {
-            break n;
-        }
-        assert!(Instant::now() < deadline, "{} did not appear", partial.display());
-        std::thread::sleep(Duration::from_millis(10));
-    };
-    while size().is_some_and(|n| n <= first) {
-        assert!(Instant::now() < deadline, "{} did not grow", partial.display());
-        std::thread::sleep(Duration::from_millis(10));
-    }
-}
-
 #[test]
 fn a_hung_component_is_named_and_the_partial_run_reports_its_own_tail() {
     let s = Scratch::new("sigstop");
@@ -48,7 +30,7 @@ fn a_hung_component_is_named_and_the_partial_run_reports_its_own_tail() {
     let child = launcher(&s).arg("run").arg(&path).arg("--realtime").arg("--out").arg(s.join("out")).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
     let lpid = child.id();
     wait_running(lpid, &["plant", "uio", "luenberger", "controller"]);
-    wait_steps_recorded(&s.join("out/seed002-sine.rrd.partial"));
+    wait_stepping(&s.join("out/seed002-sine.rrd.partial"));
     let victim = component_pid(lpid, "controller").expect("controller running");
     signal(victim, libc::SIGSTOP);
     let stopped = Instant::now();

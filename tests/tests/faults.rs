@@ -42,6 +42,7 @@ fn a_killed_component_stops_the_run_cleanly() {
             let child = start(&s, &path, &[]);
             let lpid = child.id();
             wait_running(lpid, &names);
+            wait_stepping(&s.join("out/seed002-sine.rrd.partial"));
             std::thread::sleep(delay(i as u64 * 10 + trial, 50, 500));
             let pid = component_pid(lpid, victim).expect("victim running");
             signal(pid, libc::SIGKILL);
@@ -153,9 +154,8 @@ fn a_signal_stops_the_run_cleanly(sig: i32, name: &str, code: i32) {
         let lpid = child.id();
         if mode == "processes" {
             wait_running(lpid, &["plant", "uio", "luenberger", "controller"]);
-        } else {
-            std::thread::sleep(Duration::from_millis(500));
         }
+        wait_stepping(&s.join("out/seed002-sine.rrd.partial"));
         signal(lpid as i32, sig);
         let sent = Instant::now();
         let (out, took) = finish(child, sent);
