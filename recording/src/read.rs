@@ -19,7 +19,7 @@ use rerun::external::re_log_types::LogMsg;
 use rerun::log::Chunk;
 use rerun::{Scalars, SeriesLines, TextDocument};
 
-use crate::digest::{self, Integrity};
+use crate::digest::{self, Integrity, Rows};
 use frames::{Fault, Frames, Message};
 
 mod frames;
@@ -135,9 +135,10 @@ pub fn read(path: &Path) -> Result<Recording, ReadError> {
             Some(Item::Rows { path, steps, times, values, width }) => {
                 let lone = [path.clone()];
                 let signals = instances.get(&path).map_or(&lone[..], |v| &v[..]);
+                let mut digest_rows = Rows::new(&steps, times.as_deref());
                 for (i, signal) in signals.iter().enumerate().take(width) {
                     let column: Vec<f64> = values.iter().skip(i).step_by(width).copied().collect();
-                    read_digests.entry(signal.clone()).or_default().update(&steps, times.as_deref(), &column);
+                    read_digests.entry(signal.clone()).or_default().update_rows(&mut digest_rows, column.iter().copied());
                     let series = rec.series.entry(signal.clone()).or_default();
                     series.steps.extend_from_slice(&steps);
                     series.values.extend(column);

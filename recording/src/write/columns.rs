@@ -18,7 +18,7 @@ use rerun::time::Timeline;
 use rerun::{ComponentDescriptor, RecordingStream, SerializedComponentColumn, TimeColumn};
 
 use super::layout::VALUES_COMPONENT;
-use crate::digest::Running;
+use crate::digest::{Rows, Running};
 
 /// Batches in flight between the loop and the recorder's thread.
 const DEPTH: usize = 4;
@@ -84,6 +84,7 @@ fn write_all(rec: &RecordingStream, entities: &[Entity], rx: Receiver<Batch>) ->
         let (step_values, time_values) = (ScalarBuffer::from(batch.steps), ScalarBuffer::from(batch.times_ns));
         let steps = TimeColumn::new(Some(true), Timeline::new_sequence("step"), step_values.clone());
         let times = TimeColumn::new(Some(true), Timeline::new_duration("sim_time"), time_values.clone());
+        let mut digest_rows = Rows::new(&step_values, Some(&time_values));
         for (e, values) in batch.values {
             let entity = &entities[e];
             let width = entity.signals.len();
@@ -91,7 +92,7 @@ fn write_all(rec: &RecordingStream, entities: &[Entity], rx: Receiver<Batch>) ->
                 return Err(format!("{}: {} values for {rows} rows of {width}", entity.path, values.len()));
             }
             for (j, signal) in entity.signals.iter().enumerate() {
-                digests.entry(signal.clone()).or_default().update_iter(&step_values, Some(&time_values), values.iter().skip(j).step_by(width).copied());
+                digests.entry(signal.clone()).or_default().update_rows(&mut digest_rows, values.iter().skip(j).step_by(width).copied());
             }
             let lists = ListArray::new(inner.clone(), OffsetBuffer::<i32>::from_lengths(std::iter::repeat_n(width, rows)), Arc::new(Float64Array::from(values)), None);
             let column = ListArray::new(outer.clone(), OffsetBuffer::<i32>::from_lengths(std::iter::repeat_n(1, rows)), Arc::new(lists), None);
