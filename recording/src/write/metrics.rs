@@ -147,13 +147,13 @@ impl Metrics {
         let lay = self.layout;
         let (x, y) = (&row.plant[lay.x()], &row.plant[lay.y()]);
         let in_tail = k >= self.planned_tail;
-        // The fault-free stretch [0, F) and its last quarter, when step k is in them.
-        let fault_free = match &mut self.fault_free {
-            Some((first, _, ff)) if k < *first => Some((k >= *first - *first / 4, ff)),
+        // When step k is in the fault-free stretch [0, F): whether in its last quarter, and each
+        // observer's maxima there.
+        let mut fault_free = match &mut self.fault_free {
+            Some((first, _, ff)) if k < *first => Some((k >= *first - *first / 4, ff.iter_mut())),
             _ => None,
         };
         let per_observer = row.xhat.iter().zip(&mut self.error).zip(&mut self.residual).zip(&mut self.what).zip(&mut self.observers).zip(&mut self.blocks).zip(&mut self.exact);
-        let mut fault_free = fault_free.map(|(last_quarter, ff)| (last_quarter, ff.iter_mut()));
         for ((((((xhat, error), res), what), f), [be, br]), exact) in per_observer {
             let mut emax: f64 = 0.0;
             for ((e, &xi), &xh) in error.iter_mut().zip(x).zip(xhat) {
