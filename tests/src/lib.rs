@@ -134,17 +134,22 @@ pub fn trajectories(r: &Recording) -> Vec<(&String, &Series)> {
     r.series.iter().filter(|(k, _)| !k.starts_with("/latency")).collect()
 }
 
-/// The pid of a component of launcher `launcher_pid` whose `--name` is `name`.
+/// The pid of a component of launcher `launcher_pid` named `name`: by its `--run` and `--name`
+/// arguments (ours), or by the `UIO_RUN` and `UIO_NAME` every component is started with
+/// (PROTOCOL.md §1), which is all an external command gets.
 pub fn component_pid(launcher_pid: u32, name: &str) -> Option<i32> {
-    let run = format!("--run\0{launcher_pid}x");
-    let named = format!("--name\0{name}\0");
+    let (run, named) = (format!("--run\0{launcher_pid}x"), format!("--name\0{name}\0"));
+    let (run_env, name_env) = (format!("UIO_RUN={launcher_pid}x"), format!("UIO_NAME={name}"));
     for e in std::fs::read_dir("/proc").ok()?.flatten() {
         let Ok(pid) = e.file_name().to_string_lossy().parse::<i32>() else { continue };
-        if let Ok(cmd) = std::fs::read(e.path().join("cmdline")) {
-            let cmd = String::from_utf8_lossy(&cmd);
-            if cmd.contains(&run) && cmd.contains(&named) {
-                return Some(pid);
-            }
+        let read = |f: &str| std::fs::read(e.path().join(f)).map(|c| String::from_utf8_lossy(&c).into_owned()).unwrap_or_default();
+        let cmd = read("cmdline");
+        if cmd.contains(&run) && cmd.contains(&named) {
+            return Some(pid);
+        }
+        let environ = read("environ");
+        if environ.split('\0').any(|v| v.starts_with(&run_env)) && environ.split('\0').any(|v| v == name_env) {
+            return Some(pid);
         }
     }
     None

@@ -61,25 +61,6 @@ fn a_component_that_never_says_ready_is_named() {
     assert!(took < Duration::from_secs(25), "took {took:?}");
 }
 
-/// The pid of the child of `parent` whose command line holds `program`, once it runs.
-fn child_running(parent: u32, program: &str) -> i32 {
-    let deadline = Instant::now() + Duration::from_secs(20);
-    loop {
-        for e in std::fs::read_dir("/proc").unwrap().flatten() {
-            let Ok(pid) = e.file_name().to_string_lossy().parse::<i32>() else { continue };
-            let stat = std::fs::read_to_string(e.path().join("stat")).unwrap_or_default();
-            // The parent pid is the second field after the parenthesised command name.
-            let ppid = stat.rsplit_once(')').and_then(|(_, r)| r.split_whitespace().nth(1)).and_then(|p| p.parse::<u32>().ok());
-            let cmd = std::fs::read(e.path().join("cmdline")).unwrap_or_default();
-            if ppid == Some(parent) && String::from_utf8_lossy(&cmd).contains(program) {
-                return pid;
-            }
-        }
-        assert!(Instant::now() < deadline, "{program} did not start");
-        std::thread::sleep(Duration::from_millis(10));
-    }
-}
-
 /// A component the kernel has stopped before it said ready cannot say it: it is named after the
 /// run's blocked limit (5 s), not the 20 s start-up allowance.
 #[test]
@@ -88,7 +69,8 @@ fn a_component_stopped_before_ready_is_named_at_the_blocked_limit() {
     let path = with_bad_observer(&s, 10, r#"["faulty_observer"]"#, r#"{ fault = "never_ready" }"#);
     let child = launcher(&s).arg("run").arg(&path).arg("--out").arg(s.join("out")).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
     let lpid = child.id();
-    signal(child_running(lpid, "faulty_observer"), libc::SIGSTOP);
+    wait_running(lpid, &["bad"]);
+    signal(component_pid(lpid, "bad").expect("bad observer running"), libc::SIGSTOP);
     let stopped = Instant::now();
     let out = child.wait_with_output().unwrap();
     let took = stopped.elapsed();
