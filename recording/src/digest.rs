@@ -47,30 +47,7 @@ impl Default for Running {
 impl Running {
     /// Adds rows, in the order written: steps, sim_time in ns (None: no such timeline), values.
     pub fn update(&mut self, steps: &[i64], times_ns: Option<&[i64]>, values: &[f64]) {
-        self.update_iter(steps, times_ns, values.iter().copied());
-    }
-
-    /// [`Self::update`] with the values from an iterator (a column of row-major rows).
-    pub fn update_iter(&mut self, steps: &[i64], times_ns: Option<&[i64]>, values: impl Iterator<Item = f64>) {
-        // Rows gathered into a stack buffer and hashed 170 at a time: XXH64's streaming state
-        // gives the same hash however the bytes are cut, and a 4 KB write runs at the hash's
-        // own speed where one 24-byte write per row went through its internal buffer.
-        const ROWS: usize = 170;
-        let mut buf = [0u8; 24 * ROWS];
-        let mut filled = 0;
-        for (i, (k, v)) in steps.iter().zip(values).enumerate() {
-            let t = times_ns.and_then(|t| t.get(i)).copied().unwrap_or(0);
-            let row = &mut buf[filled..filled + 24];
-            row[..8].copy_from_slice(&k.to_le_bytes());
-            row[8..16].copy_from_slice(&t.to_le_bytes());
-            row[16..].copy_from_slice(&v.to_bits().to_le_bytes());
-            filled += 24;
-            if filled == buf.len() {
-                self.0.write(&buf);
-                filled = 0;
-            }
-        }
-        self.0.write(&buf[..filled]);
+        self.update_rows(&mut Rows::new(steps, times_ns), values.iter().copied());
     }
 
     /// Adds one signal's values at the rows of `rows`, in order (as many values as rows).
@@ -93,7 +70,8 @@ impl Running {
 /// The rows of a batch that several signals share (an entity's signals, or the entities of a
 /// group): each row's `step` and `sim_time` words laid out once, so that each signal only
 /// fills in its values before its digest takes the whole batch in one write
-/// ([`Running::update_rows`]: the same bytes as [`Running::update`]).
+/// ([`Running::update_rows`]). XXH64's streaming state gives the same hash however the bytes
+/// are cut, and a batch's one write runs at the hash's own speed.
 pub struct Rows(Vec<u8>);
 
 impl Rows {
