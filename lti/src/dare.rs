@@ -61,7 +61,7 @@
 use nalgebra::DMatrix;
 
 use crate::dd::DdMatrix;
-use crate::eig::{eigenvalues, format_list, spectral_radius, C64};
+use crate::eig::{C64, eigenvalues, format_list, spectral_radius};
 use crate::error::{LtiError, Result};
 use crate::lyapunov;
 use crate::staircase::{controllability_staircase, observability_staircase};
@@ -133,8 +133,14 @@ fn solve(a: &Mat, b: &Mat, q: &Mat, r: &Mat, words: Words) -> Result<Dare> {
     let q = symmetric("Q", q, Definite::Semi)?;
     let r = symmetric("R", r, Definite::Positive)?;
     // G = BR⁻¹Bᵀ = YᵀY with Y = L⁻¹Bᵀ, R = LLᵀ: symmetric ⪰ 0 by construction.
-    let chol = r.clone().cholesky().ok_or_else(|| not_definite("R", &r, "positive definite"))?;
-    let y = chol.l().solve_lower_triangular(&b.transpose()).ok_or(LtiError::Singular("R"))?;
+    let chol = r
+        .clone()
+        .cholesky()
+        .ok_or_else(|| not_definite("R", &r, "positive definite"))?;
+    let y = chol
+        .l()
+        .solve_lower_triangular(&b.transpose())
+        .ok_or(LtiError::Singular("R"))?;
     let g = y.transpose() * &y;
 
     let first = sda(a, &g, &q);
@@ -156,7 +162,11 @@ fn solve(a: &Mat, b: &Mat, q: &Mat, r: &Mat, words: Words) -> Result<Dare> {
         // Any δ > 0 makes (A, Q + δI) observable; its size only sets how far Newton starts from
         // X (1/‖G‖ is X's natural scale when Q = 0).
         let delta = 1e-2 * one_norm(&q).max(1.0 / one_norm(&g));
-        let delta = if delta.is_finite() && delta > 0.0 { delta } else { 1.0 };
+        let delta = if delta.is_finite() && delta > 0.0 {
+            delta
+        } else {
+            1.0
+        };
         let shifted = &q + Mat::identity(n, n) * delta;
         let Some((start, steps)) = sda(a, &g, &shifted) else {
             return Err(no_solution(a, b, &q, None, words));
@@ -174,7 +184,8 @@ fn solve(a: &Mat, b: &Mat, q: &Mat, r: &Mat, words: Words) -> Result<Dare> {
         // singular (A − BK has a mode on the circle): the steps fail, and the radius check below
         // names the cause.
         if let Ok((refined, steps, _)) = newton_steps(a, b, &q, &r, x.clone(), MAX_REFINE)
-            && let (Ok((new, _)), Ok((old, _))) = (residual(a, b, &q, &r, &refined), residual(a, b, &q, &r, &x))
+            && let (Ok((new, _)), Ok((old, _))) =
+                (residual(a, b, &q, &r, &refined), residual(a, b, &q, &r, &x))
             && new <= old
         {
             x = refined;
@@ -195,9 +206,17 @@ fn solve(a: &Mat, b: &Mat, q: &Mat, r: &Mat, words: Words) -> Result<Dare> {
     let (res, k) = residual(a, b, &q, &r, &x)?;
     let small = res <= RESIDUAL_TOL;
     if !small {
-        return Err(LtiError::NoConvergence("the DARE solution (relative residual above 1e-10)"));
+        return Err(LtiError::NoConvergence(
+            "the DARE solution (relative residual above 1e-10)",
+        ));
     }
-    Ok(Dare { x, k, closed_loop_radius: rho, residual: res, iterations: (doubling, newton) })
+    Ok(Dare {
+        x,
+        k,
+        closed_loop_radius: rho,
+        residual: res,
+        iterations: (doubling, newton),
+    })
 }
 
 /// The steady-state Kalman filter of x_{k+1} = A x_k + w_k, y_k = C x_k + v_k, with
@@ -233,11 +252,21 @@ pub fn steady_state_kalman(a: &Mat, c: &Mat, qd: &Mat, r: &Mat) -> Result<Kalman
     let pm = d.x;
     let s = sym(&(c * &pm * c.transpose() + &r));
     // L = P Cᵀ S⁻¹ = (S⁻¹ C P)ᵀ, S symmetric positive definite.
-    let chol = s.clone().cholesky().ok_or(LtiError::Singular("the innovation covariance"))?;
+    let chol = s
+        .clone()
+        .cholesky()
+        .ok_or(LtiError::Singular("the innovation covariance"))?;
     let gain = chol.solve(&(c * &pm)).transpose();
     let i_lc = Mat::identity(n, n) - &gain * c;
     let p_updated = sym(&(&i_lc * &pm * i_lc.transpose() + &gain * &r * gain.transpose()));
-    Ok(Kalman { predictor_gain: a * &gain, p: pm, gain, p_updated, innovation: s, radius: d.closed_loop_radius })
+    Ok(Kalman {
+        predictor_gain: a * &gain,
+        p: pm,
+        gain,
+        p_updated,
+        innovation: s,
+        radius: d.closed_loop_radius,
+    })
 }
 
 /// SDA from (A, G, H): (X, steps), or None if it broke down or did not converge.
@@ -251,7 +280,12 @@ fn sda(a: &Mat, g: &Mat, h: &Mat) -> Option<(Mat, usize)> {
         let h_next = sym(&(&hk + ak.transpose() * &hk * &wa));
         let g_next = sym(&(&gk + &ak * wg * ak.transpose()));
         let a_next = &ak * wa;
-        if !(h_next.iter().chain(g_next.iter()).chain(a_next.iter()).all(|v| v.is_finite())) {
+        if !(h_next
+            .iter()
+            .chain(g_next.iter())
+            .chain(a_next.iter())
+            .all(|v| v.is_finite()))
+        {
             return None;
         }
         // H_k increases to X; the step is A_kᵀ(…)A_k, so it dies with A_k (quadratically). A few
@@ -270,7 +304,14 @@ fn sda(a: &Mat, g: &Mat, h: &Mat) -> Option<(Mat, usize)> {
 
 /// Up to `max` Newton steps from X, stopping when the correction is below rounding or stops
 /// shrinking: (X, steps kept, converged).
-fn newton_steps(a: &Mat, b: &Mat, q: &Mat, r: &Mat, mut x: Mat, max: usize) -> Result<(Mat, usize, bool)> {
+fn newton_steps(
+    a: &Mat,
+    b: &Mat,
+    q: &Mat,
+    r: &Mat,
+    mut x: Mat,
+    max: usize,
+) -> Result<(Mat, usize, bool)> {
     let mut last = f64::INFINITY;
     for step in 1..=max {
         let (k, ac) = gain(a, b, r, &x)?;
@@ -334,7 +375,10 @@ fn riccati_residual(a: &Mat, b: &Mat, q: &Mat, r: &Mat, x: &Mat, k: &Mat) -> Mat
 fn residual(a: &Mat, b: &Mat, q: &Mat, r: &Mat, x: &Mat) -> Result<(f64, Mat)> {
     let (k, ac) = gain(a, b, r, x)?;
     let res = one_norm(&riccati_residual(a, b, q, r, x, &k));
-    let scale = one_norm(q) + one_norm(&(ac.transpose() * x * &ac)) + one_norm(&(k.transpose() * r * &k)) + one_norm(x);
+    let scale = one_norm(q)
+        + one_norm(&(ac.transpose() * x * &ac))
+        + one_norm(&(k.transpose() * r * &k))
+        + one_norm(x);
     Ok((if scale > 0.0 { res / scale } else { res }, k))
 }
 
@@ -354,8 +398,13 @@ fn obstruction(a: &Mat, b: &Mat, q: &Mat, words: Words) -> Option<String> {
         if s > 0.0 { m / s } else { m.clone() }
     };
     let mut why = Vec::new();
-    let uc = controllability_staircase(a, &unit(b)).uncontrollable_modes().unwrap_or_default();
-    let bad: Vec<C64> = uc.into_iter().filter(|e| e.norm() >= 1.0 - NEAR_UNIT).collect();
+    let uc = controllability_staircase(a, &unit(b))
+        .uncontrollable_modes()
+        .unwrap_or_default();
+    let bad: Vec<C64> = uc
+        .into_iter()
+        .filter(|e| e.norm() >= 1.0 - NEAR_UNIT)
+        .collect();
     let mut near = bad.clone();
     if !bad.is_empty() {
         let modes = format_list(&bad);
@@ -364,8 +413,13 @@ fn obstruction(a: &Mat, b: &Mat, q: &Mat, words: Words) -> Option<String> {
             Words::Filter => format!("(A, C) is not detectable: unobservable modes {modes} not inside the unit circle"),
         });
     }
-    let uo = observability_staircase(a, &unit(q)).unobservable_modes().unwrap_or_default();
-    let bad: Vec<C64> = uo.into_iter().filter(|e| (e.norm() - 1.0).abs() < NEAR_UNIT).collect();
+    let uo = observability_staircase(a, &unit(q))
+        .unobservable_modes()
+        .unwrap_or_default();
+    let bad: Vec<C64> = uo
+        .into_iter()
+        .filter(|e| (e.norm() - 1.0).abs() < NEAR_UNIT)
+        .collect();
     near.extend(&bad);
     if !bad.is_empty() {
         why.push(match words {
@@ -391,16 +445,26 @@ fn obstruction(a: &Mat, b: &Mat, q: &Mat, words: Words) -> Option<String> {
 
 /// The refusal when the iteration failed: the structural cause if there is one.
 fn no_solution(a: &Mat, b: &Mat, q: &Mat, rho: Option<f64>, words: Words) -> LtiError {
-    let loop_name = if words == Words::Control { "A − BK" } else { "A − ALC" };
+    let loop_name = if words == Words::Control {
+        "A − BK"
+    } else {
+        "A − ALC"
+    };
     LtiError::NoStabilisingSolution(obstruction(a, b, q, words).unwrap_or_else(|| match rho {
-        Some(rho) => format!("the closed loop {loop_name} is not Schur-stable (spectral radius {rho:.6})"),
+        Some(rho) => {
+            format!("the closed loop {loop_name} is not Schur-stable (spectral radius {rho:.6})")
+        }
         None => "the doubling iteration did not converge".into(),
     }))
 }
 
 fn conform(name: &str, m: &Mat, rows: usize, cols: usize) -> Result<()> {
     if m.shape() != (rows, cols) {
-        return Err(LtiError::Dimension(format!("{name} is {}×{}, expected {rows}×{cols}", m.nrows(), m.ncols())));
+        return Err(LtiError::Dimension(format!(
+            "{name} is {}×{}, expected {rows}×{cols}",
+            m.nrows(),
+            m.ncols()
+        )));
     }
     Ok(())
 }
@@ -409,7 +473,9 @@ pub(crate) fn finite(name: &str, m: &Mat) -> Result<()> {
     if m.iter().all(|v| v.is_finite()) {
         Ok(())
     } else {
-        Err(LtiError::InvalidInput(format!("{name} has non-finite entries")))
+        Err(LtiError::InvalidInput(format!(
+            "{name} has non-finite entries"
+        )))
     }
 }
 
@@ -445,7 +511,15 @@ pub fn symmetric(name: &str, m: &Mat, definite: Definite) -> Result<Mat> {
     if ok {
         Ok(s)
     } else {
-        Err(not_definite(name, &s, if definite == Definite::Semi { "positive semi-definite" } else { "positive definite" }))
+        Err(not_definite(
+            name,
+            &s,
+            if definite == Definite::Semi {
+                "positive semi-definite"
+            } else {
+                "positive definite"
+            },
+        ))
     }
 }
 
@@ -463,7 +537,9 @@ pub(crate) fn sym(m: &Mat) -> Mat {
 }
 
 pub(crate) fn one_norm(m: &Mat) -> f64 {
-    m.column_iter().map(|c| c.iter().map(|x| x.abs()).sum::<f64>()).fold(0.0, f64::max)
+    m.column_iter()
+        .map(|c| c.iter().map(|x| x.abs()).sum::<f64>())
+        .fold(0.0, f64::max)
 }
 
 #[cfg(test)]
@@ -476,7 +552,11 @@ mod tests {
         let m = |v: f64| Mat::from_element(1, 1, v);
         let d = solve_dare(&m(2.0), &m(1.0), &m(1.0), &m(1.0)).unwrap();
         let want = 2.0 + 5f64.sqrt();
-        assert!((d.x[(0, 0)] - want).abs() <= 2.0 * f64::EPSILON * want, "{}", d.x[(0, 0)]);
+        assert!(
+            (d.x[(0, 0)] - want).abs() <= 2.0 * f64::EPSILON * want,
+            "{}",
+            d.x[(0, 0)]
+        );
         assert!(d.closed_loop_radius < 1.0);
     }
 
@@ -484,14 +564,40 @@ mod tests {
     fn zero_weight_and_no_input() {
         // Q = 0 with A stable: X = 0. No input columns: X solves the Stein equation X = AᵀXA + Q.
         let a = Mat::from_row_slice(2, 2, &[0.5, 0.2, 0.0, -0.3]);
-        let d = solve_dare(&a, &Mat::identity(2, 2), &Mat::zeros(2, 2), &Mat::identity(2, 2)).unwrap();
+        let d = solve_dare(
+            &a,
+            &Mat::identity(2, 2),
+            &Mat::zeros(2, 2),
+            &Mat::identity(2, 2),
+        )
+        .unwrap();
         assert_eq!(d.x, Mat::zeros(2, 2));
-        let d = solve_dare(&a, &Mat::zeros(2, 0), &Mat::identity(2, 2), &Mat::zeros(0, 0)).unwrap();
+        let d = solve_dare(
+            &a,
+            &Mat::zeros(2, 0),
+            &Mat::identity(2, 2),
+            &Mat::zeros(0, 0),
+        )
+        .unwrap();
         let stein = lyapunov::discrete(&a, &Mat::identity(2, 2)).unwrap();
-        assert!((&d.x - &stein).amax() <= 4.0 * f64::EPSILON * stein.amax(), "{} vs {stein}", d.x);
+        assert!(
+            (&d.x - &stein).amax() <= 4.0 * f64::EPSILON * stein.amax(),
+            "{} vs {stein}",
+            d.x
+        );
         let unstable = Mat::from_row_slice(2, 2, &[1.5, 0.0, 0.0, 0.5]);
-        let e = solve_dare(&unstable, &Mat::zeros(2, 0), &Mat::identity(2, 2), &Mat::zeros(0, 0)).unwrap_err();
-        assert!(e.to_string().ends_with("uncontrollable modes 1.5 not inside the unit circle"), "{e}");
+        let e = solve_dare(
+            &unstable,
+            &Mat::zeros(2, 0),
+            &Mat::identity(2, 2),
+            &Mat::zeros(0, 0),
+        )
+        .unwrap_err();
+        assert!(
+            e.to_string()
+                .ends_with("uncontrollable modes 1.5 not inside the unit circle"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -500,7 +606,9 @@ mod tests {
         // a marginal one: refused, and the message says why a stable modulus is listed.
         let a = Mat::from_row_slice(2, 2, &[1.0 - 1e-8, 0.0, 0.0, 2.0]);
         let b = Mat::from_row_slice(2, 1, &[0.0, 1.0]);
-        let e = solve_dare(&a, &b, &Mat::identity(2, 2), &Mat::identity(1, 1)).unwrap_err().to_string();
+        let e = solve_dare(&a, &b, &Mat::identity(2, 2), &Mat::identity(1, 1))
+            .unwrap_err()
+            .to_string();
         assert_eq!(
             e,
             "no stabilising solution: (A, B) is not stabilisable: uncontrollable modes 1 not inside the unit circle \
@@ -513,7 +621,11 @@ mod tests {
         // q = 0, a = 2: x = 0 solves but does not stabilise; x = 3 does (a − bk = 1/2).
         let m = |v: f64| Mat::from_element(1, 1, v);
         let d = solve_dare(&m(2.0), &m(1.0), &m(0.0), &m(1.0)).unwrap();
-        assert!((d.x[(0, 0)] - 3.0).abs() <= 4.0 * f64::EPSILON * 3.0, "{}", d.x[(0, 0)]);
+        assert!(
+            (d.x[(0, 0)] - 3.0).abs() <= 4.0 * f64::EPSILON * 3.0,
+            "{}",
+            d.x[(0, 0)]
+        );
         assert!((d.closed_loop_radius - 0.5).abs() < 1e-15);
     }
 }

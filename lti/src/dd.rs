@@ -23,19 +23,28 @@ impl From<f64> for Dd {
 pub(crate) fn two_sum(a: f64, b: f64) -> Dd {
     let s = a + b;
     let bb = s - a;
-    Dd { hi: s, lo: (a - (s - bb)) + (b - bb) }
+    Dd {
+        hi: s,
+        lo: (a - (s - bb)) + (b - bb),
+    }
 }
 
 /// a + b exactly, for |a| ≥ |b| (Dekker).
 pub(crate) fn quick_two_sum(a: f64, b: f64) -> Dd {
     let s = a + b;
-    Dd { hi: s, lo: b - (s - a) }
+    Dd {
+        hi: s,
+        lo: b - (s - a),
+    }
 }
 
 /// a·b exactly: the fused multiply-add returns the rounding error of the product.
 pub(crate) fn two_prod(a: f64, b: f64) -> Dd {
     let p = a * b;
-    Dd { hi: p, lo: a.mul_add(b, -p) }
+    Dd {
+        hi: p,
+        lo: a.mul_add(b, -p),
+    }
 }
 
 impl Dd {
@@ -56,7 +65,10 @@ impl Dd {
     }
 
     pub(crate) fn neg(self) -> Dd {
-        Dd { hi: -self.hi, lo: -self.lo }
+        Dd {
+            hi: -self.hi,
+            lo: -self.lo,
+        }
     }
 
     pub(crate) fn sub(self, o: Dd) -> Dd {
@@ -95,12 +107,20 @@ impl DdMatrix {
     /// The exact value of a double matrix.
     pub(crate) fn from_f64(m: &DMatrix<f64>) -> Self {
         let (rows, cols) = m.shape();
-        DdMatrix { rows, cols, v: (0..rows * cols).map(|k| Dd::from(m[(k / cols, k % cols)])).collect() }
+        DdMatrix {
+            rows,
+            cols,
+            v: (0..rows * cols)
+                .map(|k| Dd::from(m[(k / cols, k % cols)]))
+                .collect(),
+        }
     }
 
     /// Each entry rounded to the nearest double.
     pub(crate) fn to_f64(&self) -> DMatrix<f64> {
-        DMatrix::from_fn(self.rows, self.cols, |i, j| self.v[i * self.cols + j].to_f64())
+        DMatrix::from_fn(self.rows, self.cols, |i, j| {
+            self.v[i * self.cols + j].to_f64()
+        })
     }
 
     pub(crate) fn transpose(&self) -> Self {
@@ -110,12 +130,23 @@ impl DdMatrix {
                 v.push(self.v[i * self.cols + j]);
             }
         }
-        DdMatrix { rows: self.cols, cols: self.rows, v }
+        DdMatrix {
+            rows: self.cols,
+            cols: self.rows,
+            v,
+        }
     }
 
     pub(crate) fn mul(&self, o: &DdMatrix) -> Self {
-        assert_eq!(self.cols, o.rows, "double-double product of non-conforming matrices");
-        let mut out = DdMatrix { rows: self.rows, cols: o.cols, v: vec![Dd::ZERO; self.rows * o.cols] };
+        assert_eq!(
+            self.cols, o.rows,
+            "double-double product of non-conforming matrices"
+        );
+        let mut out = DdMatrix {
+            rows: self.rows,
+            cols: o.cols,
+            v: vec![Dd::ZERO; self.rows * o.cols],
+        };
         for i in 0..self.rows {
             for k in 0..self.cols {
                 let a = self.v[i * self.cols + k];
@@ -133,9 +164,27 @@ impl DdMatrix {
 
     /// self + sign·o, sign = ±1.
     pub(crate) fn add(&self, o: &DdMatrix, sign: f64) -> Self {
-        assert_eq!((self.rows, self.cols), (o.rows, o.cols), "double-double sum of non-conforming matrices");
-        let v = self.v.iter().zip(&o.v).map(|(a, b)| a.add(Dd { hi: sign * b.hi, lo: sign * b.lo })).collect();
-        DdMatrix { rows: self.rows, cols: self.cols, v }
+        assert_eq!(
+            (self.rows, self.cols),
+            (o.rows, o.cols),
+            "double-double sum of non-conforming matrices"
+        );
+        let v = self
+            .v
+            .iter()
+            .zip(&o.v)
+            .map(|(a, b)| {
+                a.add(Dd {
+                    hi: sign * b.hi,
+                    lo: sign * b.lo,
+                })
+            })
+            .collect();
+        DdMatrix {
+            rows: self.rows,
+            cols: self.cols,
+            v,
+        }
     }
 }
 
@@ -166,6 +215,9 @@ mod tests {
         assert_eq!((p.v[0].hi, p.v[0].lo), (1.0, -t * t));
         let d = p.add(&DdMatrix::from_f64(&DMatrix::from_element(1, 1, 1.0)), -1.0);
         assert_eq!(d.to_f64()[(0, 0)], -t * t);
-        assert_eq!(a.transpose().mul(&a).to_f64(), DMatrix::from_row_slice(2, 2, &[1.0, t, t, t * t]));
+        assert_eq!(
+            a.transpose().mul(&a).to_f64(),
+            DMatrix::from_row_slice(2, 2, &[1.0, t, t, t * t])
+        );
     }
 }

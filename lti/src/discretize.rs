@@ -19,7 +19,12 @@ use nalgebra::DMatrix;
 use crate::expm::expm;
 
 /// Top block row [Φ, Γ] of exp([[A, G], [0, W]]·h).
-pub fn exp_upper(a: &DMatrix<f64>, g: &DMatrix<f64>, w: &DMatrix<f64>, h: f64) -> (DMatrix<f64>, DMatrix<f64>) {
+pub fn exp_upper(
+    a: &DMatrix<f64>,
+    g: &DMatrix<f64>,
+    w: &DMatrix<f64>,
+    h: f64,
+) -> (DMatrix<f64>, DMatrix<f64>) {
     let n = a.nrows();
     let k = w.nrows();
     let mut big = DMatrix::<f64>::zeros(n + k, n + k);
@@ -27,7 +32,10 @@ pub fn exp_upper(a: &DMatrix<f64>, g: &DMatrix<f64>, w: &DMatrix<f64>, h: f64) -
     big.view_mut((0, n), (n, k)).copy_from(g);
     big.view_mut((n, n), (k, k)).copy_from(w);
     let e = expm(&big, h);
-    (e.view((0, 0), (n, n)).into_owned(), e.view((0, n), (n, k)).into_owned())
+    (
+        e.view((0, 0), (n, n)).into_owned(),
+        e.view((0, n), (n, k)).into_owned(),
+    )
 }
 
 /// Zero-order-hold discretization: (Φ, Γ) = (e^{Ah}, ∫₀ʰ e^{As} ds B).

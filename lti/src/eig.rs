@@ -1,11 +1,12 @@
-//! Eigenvalues of a real square matrix: balancing, then the real Schur form.
+//! Eigenvalues of a real square matrix: balancing, then the real Schur form (faer's multishift
+//! QR, [`crate::linalg::evd`]).
 //!
 //! Balancing (Parlett & Reinsch; LAPACK `xGEBAL` with job 'S') scales A by a diagonal D of powers
 //! of two, D⁻¹AD, so that each row and column have comparable norms. The scaling is exact in
 //! floating point and leaves the eigenvalues unchanged, but it makes the Schur iteration much
 //! more accurate for models like the missile autopilot, whose entries span 10⁻³ … 10⁴.
 
-use nalgebra::{Complex, DMatrix, Schur};
+use nalgebra::{Complex, DMatrix};
 
 use crate::error::{LtiError, Result};
 
@@ -59,17 +60,21 @@ pub fn balance(a: &DMatrix<f64>) -> DMatrix<f64> {
 pub fn eigenvalues(a: &DMatrix<f64>) -> Result<Vec<C64>> {
     let n = a.nrows();
     if n != a.ncols() {
-        return Err(LtiError::Dimension(format!("eigenvalues of a {}×{} matrix", n, a.ncols())));
+        return Err(LtiError::Dimension(format!(
+            "eigenvalues of a {}×{} matrix",
+            n,
+            a.ncols()
+        )));
     }
     if n == 0 {
         return Ok(Vec::new());
     }
     if a.iter().any(|x| !x.is_finite()) {
-        return Err(LtiError::NoConvergence("eigenvalues of a non-finite matrix"));
+        return Err(LtiError::NoConvergence(
+            "eigenvalues of a non-finite matrix",
+        ));
     }
-    let schur = Schur::try_new(balance(a), f64::EPSILON, 1000 * n)
-        .ok_or(LtiError::NoConvergence("Schur decomposition"))?;
-    let mut ev: Vec<C64> = schur.complex_eigenvalues().iter().copied().collect();
+    let mut ev = crate::linalg::evd::eigenvalues(a)?;
     // A real matrix has exactly conjugate pairs; make them so bit for bit.
     for e in ev.iter_mut() {
         if e.im.abs() <= 8.0 * f64::EPSILON * e.re.abs() {
@@ -93,7 +98,11 @@ pub fn spectral_abscissa(ev: &[C64]) -> f64 {
 /// ln(z)/dt of each sampled eigenvalue (the continuous one it is the image of, e^{s·dt} = z),
 /// and how many were left out as deadbeat (z = 0 to rounding: no continuous image).
 pub fn continuous_image(discrete: &[C64], dt: f64) -> (Vec<C64>, usize) {
-    let kept: Vec<C64> = discrete.iter().filter(|z| z.norm() >= 1e-12).map(|z| z.ln() / dt).collect();
+    let kept: Vec<C64> = discrete
+        .iter()
+        .filter(|z| z.norm() >= 1e-12)
+        .map(|z| z.ln() / dt)
+        .collect();
     let dropped = discrete.len() - kept.len();
     (kept, dropped)
 }
@@ -188,7 +197,11 @@ pub fn sig(x: f64) -> String {
     let mag = x.abs().log10().floor() as i32;
     if (-3..7).contains(&mag) {
         let s = format!("{:.*}", (5 - mag).max(0) as usize, x);
-        if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s }
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
     } else {
         format!("{x:.5e}")
     }
@@ -203,7 +216,11 @@ mod tests {
         // s³ + 6s² + 11s + 6 = (s+1)(s+2)(s+3)
         let a = DMatrix::from_row_slice(3, 3, &[0.0, 1.0, 0.0, 0.0, 0.0, 1.0, -6.0, -11.0, -6.0]);
         let ev = eigenvalues(&a).unwrap();
-        let want = [C64::new(-3.0, 0.0), C64::new(-2.0, 0.0), C64::new(-1.0, 0.0)];
+        let want = [
+            C64::new(-3.0, 0.0),
+            C64::new(-2.0, 0.0),
+            C64::new(-1.0, 0.0),
+        ];
         assert!(match_error(&want, &ev) < 1e-12);
     }
 
@@ -218,7 +235,11 @@ mod tests {
 
     #[test]
     fn formatting() {
-        let v = [C64::new(-84.2607, -127.9594), C64::new(-84.2607, 127.9594), C64::new(-1.0, 0.0)];
+        let v = [
+            C64::new(-84.2607, -127.9594),
+            C64::new(-84.2607, 127.9594),
+            C64::new(-1.0, 0.0),
+        ];
         assert_eq!(format_list(&v), "-84.2607 ± j127.959, -1");
     }
 
@@ -230,12 +251,23 @@ mod tests {
         assert_eq!(format_list(&[C64::new(-0.0, 0.0)]), "0");
         // The missile's undamped airframe pair ±j11.77 next to the actuator: the real part's noise
         // is relative to the largest modulus (180) and the conjugate pair still prints once.
-        let v = [C64::new(3e-14, 11.77), C64::new(3e-14, -11.77), C64::new(-108.0, 144.0), C64::new(-108.0, -144.0)];
+        let v = [
+            C64::new(3e-14, 11.77),
+            C64::new(3e-14, -11.77),
+            C64::new(-108.0, 144.0),
+            C64::new(-108.0, -144.0),
+        ];
         assert_eq!(format_list(&v), "0 ± j11.77, -108 ± j144");
         // Imaginary noise on a real value, and a conjugate pair whose noise differs in sign.
         assert_eq!(format_list(&[C64::new(-5.0, 1e-14)]), "-5");
-        assert_eq!(format_list(&[C64::new(-1e-15, 2.0), C64::new(1e-15, -2.0)]), "0 ± j2");
+        assert_eq!(
+            format_list(&[C64::new(-1e-15, 2.0), C64::new(1e-15, -2.0)]),
+            "0 ± j2"
+        );
         // Small but real values are not hidden.
-        assert_eq!(format_list(&[C64::new(-1e-3, 0.0), C64::new(-3e-9, 0.0)]), "-0.001, -3.00000e-9");
+        assert_eq!(
+            format_list(&[C64::new(-1e-3, 0.0), C64::new(-3e-9, 0.0)]),
+            "-0.001, -3.00000e-9"
+        );
     }
 }

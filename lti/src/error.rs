@@ -34,7 +34,9 @@ pub enum LtiError {
         modes: String,
     },
     /// The placement finished but the achieved eigenvalues are off.
-    #[error("placement missed: requested {requested}, achieved {achieved} (max error {error:.3e}; {how})")]
+    #[error(
+        "placement missed: requested {requested}, achieved {achieved} (max error {error:.3e}; {how})"
+    )]
     PlacementMissed {
         /// Requested eigenvalues, formatted.
         requested: String,

@@ -58,7 +58,7 @@
 
 use nalgebra::DMatrix;
 
-use crate::dd::{two_prod, Dd};
+use crate::dd::{Dd, two_prod};
 
 /// Unit roundoff of IEEE double precision, the u of the paper's θ_m.
 const U: f64 = 1.1102230246251565e-16;
@@ -89,7 +89,10 @@ pub fn expm(m: &DMatrix<f64>, h: f64) -> DMatrix<f64> {
         return (m * h).exp();
     }
     // X = M h exactly, row-major.
-    let x = DdMat { n, v: (0..n * n).map(|k| two_prod(m[(k / n, k % n)], h)).collect() };
+    let x = DdMat {
+        n,
+        v: (0..n * n).map(|k| two_prod(m[(k / n, k % n)], h)).collect(),
+    };
     let xf = DMatrix::from_fn(n, n, |i, j| x.v[i * n + j].hi);
     let (deg, s) = degree_and_scaling(&xf);
     // Step 2: truncation bound from u to u².
@@ -122,7 +125,11 @@ fn degree_and_scaling(a: &DMatrix<f64>) -> (usize, usize) {
     }
     let eta5 = eta3.min(d8.max(d10));
     let theta13 = THETA[4].1;
-    let mut s = if eta5 > 0.0 { (eta5 / theta13).log2().ceil().max(0.0) as usize } else { 0 };
+    let mut s = if eta5 > 0.0 {
+        (eta5 / theta13).log2().ceil().max(0.0) as usize
+    } else {
+        0
+    };
     // A norm so large that e^X overflows anyway: no point squaring more than that.
     s = s.min(1100);
     s += ell(&(a * 2f64.powi(-(s as i32))), 13);
@@ -159,13 +166,17 @@ fn ell(a: &DMatrix<f64>, m: usize) -> usize {
 }
 
 fn one_norm(a: &DMatrix<f64>) -> f64 {
-    a.column_iter().map(|c| c.iter().map(|x| x.abs()).sum::<f64>()).fold(0.0, f64::max)
+    a.column_iter()
+        .map(|c| c.iter().map(|x| x.abs()).sum::<f64>())
+        .fold(0.0, f64::max)
 }
 
 /// b_j = (2m − j)! / (j! (m − j)!), j = 0 … m: integers (exact in u128 and in double-double).
 fn pade_coefficients(m: usize) -> Vec<Dd> {
     let fact = |k: usize| (1..=k as u128).product::<u128>();
-    (0..=m).map(|j| Dd::from_u128(fact(2 * m - j) / (fact(j) * fact(m - j)))).collect()
+    (0..=m)
+        .map(|j| Dd::from_u128(fact(2 * m - j) / (fact(j) * fact(m - j))))
+        .collect()
 }
 
 /// r_m(Y) = q_m(Y)⁻¹ p_m(Y) in double-double.
@@ -224,7 +235,10 @@ struct DdMat {
 
 impl DdMat {
     fn zeros(n: usize) -> Self {
-        DdMat { n, v: vec![Dd::ZERO; n * n] }
+        DdMat {
+            n,
+            v: vec![Dd::ZERO; n * n],
+        }
     }
 
     fn identity(n: usize) -> Self {
@@ -237,7 +251,17 @@ impl DdMat {
 
     /// Every entry times a power of two (exact).
     fn scaled(&self, pow2: f64) -> Self {
-        DdMat { n: self.n, v: self.v.iter().map(|x| Dd { hi: x.hi * pow2, lo: x.lo * pow2 }).collect() }
+        DdMat {
+            n: self.n,
+            v: self
+                .v
+                .iter()
+                .map(|x| Dd {
+                    hi: x.hi * pow2,
+                    lo: x.lo * pow2,
+                })
+                .collect(),
+        }
     }
 
     fn mul(&self, o: &DdMat) -> DdMat {
@@ -273,7 +297,14 @@ impl DdMat {
     fn solve(mut self, mut rhs: DdMat) -> DdMat {
         let n = self.n;
         for c in 0..n {
-            let p = (c..n).max_by(|&i, &j| self.v[i * n + c].hi.abs().total_cmp(&self.v[j * n + c].hi.abs())).unwrap_or(c);
+            let p = (c..n)
+                .max_by(|&i, &j| {
+                    self.v[i * n + c]
+                        .hi
+                        .abs()
+                        .total_cmp(&self.v[j * n + c].hi.abs())
+                })
+                .unwrap_or(c);
             if p != c {
                 for j in 0..n {
                     self.v.swap(c * n + j, p * n + j);
@@ -322,10 +353,22 @@ mod tests {
         // e^x − r_3(x) = ±(3!)²/(6!·7!)·x⁷·(1 + O(x)): a wrong b_j would leave
         // an error of order x^j, j ≤ 6, hundreds of times larger at x = 0.1.
         let x = 0.1f64;
-        let p: f64 = b3.iter().enumerate().map(|(j, b)| b * x.powi(j as i32)).sum();
-        let q: f64 = b3.iter().enumerate().map(|(j, b)| b * (-x).powi(j as i32)).sum();
+        let p: f64 = b3
+            .iter()
+            .enumerate()
+            .map(|(j, b)| b * x.powi(j as i32))
+            .sum();
+        let q: f64 = b3
+            .iter()
+            .enumerate()
+            .map(|(j, b)| b * (-x).powi(j as i32))
+            .sum();
         let lead = 36.0 / (720.0 * 5040.0) * x.powi(7);
-        assert!(((p / q - x.exp()) / lead - 1.0).abs() < 0.2, "{}", (p / q - x.exp()) / lead);
+        assert!(
+            ((p / q - x.exp()) / lead - 1.0).abs() < 0.2,
+            "{}",
+            (p / q - x.exp()) / lead
+        );
     }
 
     #[test]
@@ -337,7 +380,10 @@ mod tests {
         let r = expm(&DMatrix::from_row_slice(2, 2, &[0.0, w, -w, 0.0]), 0.25);
         let (s, c) = (1.75f64).sin_cos();
         for (got, want) in r.iter().zip([c, -s, s, c]) {
-            assert!((got - want).abs() <= f64::EPSILON * want.abs(), "{got} vs {want}");
+            assert!(
+                (got - want).abs() <= f64::EPSILON * want.abs(),
+                "{got} vs {want}"
+            );
         }
     }
 
@@ -346,9 +392,15 @@ mod tests {
         // e^{N} = I + N + N²/2 exactly for a nilpotent Jordan block.
         let nil = DMatrix::from_row_slice(3, 3, &[0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]);
         let e = expm(&nil, 3.0);
-        assert_eq!(e, DMatrix::from_row_slice(3, 3, &[1.0, 3.0, 4.5, 0.0, 1.0, 3.0, 0.0, 0.0, 1.0]));
+        assert_eq!(
+            e,
+            DMatrix::from_row_slice(3, 3, &[1.0, 3.0, 4.5, 0.0, 1.0, 3.0, 0.0, 0.0, 1.0])
+        );
         // Many squarings: diag(−50, −60)·1: e^{−50}, e^{−60} to the last bit.
-        let e = expm(&DMatrix::from_row_slice(2, 2, &[-50.0, 0.0, 0.0, -60.0]), 1.0);
+        let e = expm(
+            &DMatrix::from_row_slice(2, 2, &[-50.0, 0.0, 0.0, -60.0]),
+            1.0,
+        );
         assert_eq!(e[(0, 1)], 0.0);
         assert!((e[(0, 0)] / (-50.0f64).exp() - 1.0).abs() <= f64::EPSILON);
         assert!((e[(1, 1)] / (-60.0f64).exp() - 1.0).abs() <= f64::EPSILON);
@@ -361,7 +413,11 @@ mod tests {
         // e^{diag(A₁, A₂)} = diag(e^{A₁}, e^{A₂}): the 140×140 matrix takes the double path, its
         // 70×70 blocks the double-double one.
         let k = 70;
-        let block = |seed: f64| DMatrix::from_fn(k, k, |i, j| ((i * 31 + j * 17) as f64 * seed).sin() / 4.0 - if i == j { 1.0 } else { 0.0 });
+        let block = |seed: f64| {
+            DMatrix::from_fn(k, k, |i, j| {
+                ((i * 31 + j * 17) as f64 * seed).sin() / 4.0 - if i == j { 1.0 } else { 0.0 }
+            })
+        };
         let (a1, a2) = (block(0.37), block(0.91));
         let mut big = DMatrix::zeros(2 * k, 2 * k);
         big.view_mut((0, 0), (k, k)).copy_from(&a1);

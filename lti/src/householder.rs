@@ -21,13 +21,19 @@ pub struct FullQr<T: ComplexField> {
 pub fn full_qr<T: ComplexField<RealField = f64>>(a: &DMatrix<T>) -> FullQr<T> {
     let m = a.nrows();
     let (r, vs) = reflectors(a);
-    FullQr { q: q_columns(&vs, m, 0..m), r }
+    FullQr {
+        q: q_columns(&vs, m, 0..m),
+        r,
+    }
 }
 
 /// Columns `cols` of the Q of `a`'s Householder QR (the same bits as [`full_qr`]'s Q there:
 /// each column of Q is transformed by the reflectors on its own), at O(m·k) per column
 /// instead of the O(m²·k) of the whole Q — for a basis of the complement of `a`'s columns.
-pub fn qr_q_columns<T: ComplexField<RealField = f64>>(a: &DMatrix<T>, cols: std::ops::Range<usize>) -> DMatrix<T> {
+pub fn qr_q_columns<T: ComplexField<RealField = f64>>(
+    a: &DMatrix<T>,
+    cols: std::ops::Range<usize>,
+) -> DMatrix<T> {
     let m = a.nrows();
     let (_, vs) = reflectors(a);
     q_columns(&vs, m, cols)
@@ -66,7 +72,11 @@ fn reflectors<T: ComplexField<RealField = f64>>(a: &DMatrix<T>) -> (DMatrix<T>, 
 }
 
 /// Columns `cols` of Q = H₁ ⋯ H_k, each accumulated backwards from the identity's as xUNGQR does.
-fn q_columns<T: ComplexField<RealField = f64>>(vs: &[(Vec<T>, T)], m: usize, cols: std::ops::Range<usize>) -> DMatrix<T> {
+fn q_columns<T: ComplexField<RealField = f64>>(
+    vs: &[(Vec<T>, T)],
+    m: usize,
+    cols: std::ops::Range<usize>,
+) -> DMatrix<T> {
     let mut q = DMatrix::<T>::zeros(m, cols.len());
     for (c, j) in cols.enumerate() {
         let col = &mut q.as_mut_slice()[c * m..(c + 1) * m];
@@ -89,7 +99,11 @@ fn q_columns<T: ComplexField<RealField = f64>>(vs: &[(Vec<T>, T)], m: usize, col
 /// `xLARFG`: the reflector that maps `col = (α, x)` to (β, 0). Returns (v with v₀ = 1, τ, β).
 fn reflector<T: ComplexField<RealField = f64>>(col: &[T]) -> (Vec<T>, T, T) {
     let alpha = col[0].clone();
-    let xnorm = col[1..].iter().map(|c| c.clone().modulus_squared()).sum::<f64>().sqrt();
+    let xnorm = col[1..]
+        .iter()
+        .map(|c| c.clone().modulus_squared())
+        .sum::<f64>()
+        .sqrt();
     let mut v = vec![T::one(); col.len()];
     if xnorm == 0.0 && alpha.clone().imaginary() == 0.0 {
         for e in v.iter_mut().skip(1) {
@@ -113,7 +127,11 @@ fn imaginary_unit<T: ComplexField<RealField = f64>>() -> T {
     // For real T, `ai` is 0, so the value returned here is multiplied by zero.
     let minus_one = T::from_real(-1.0);
     let s = minus_one.sqrt();
-    if s.clone().imaginary() == 1.0 { s } else { T::zero() }
+    if s.clone().imaginary() == 1.0 {
+        s
+    } else {
+        T::zero()
+    }
 }
 
 #[cfg(test)]
@@ -123,7 +141,11 @@ mod tests {
 
     #[test]
     fn reconstructs_and_is_orthogonal() {
-        let a = DMatrix::from_row_slice(4, 3, &[1.0, 2.0, 3.0, 4.0, 5.0, 6.5, 7.0, 8.0, 10.0, -1.0, 0.5, 2.0]);
+        let a = DMatrix::from_row_slice(
+            4,
+            3,
+            &[1.0, 2.0, 3.0, 4.0, 5.0, 6.5, 7.0, 8.0, 10.0, -1.0, 0.5, 2.0],
+        );
         let FullQr { q, r } = full_qr(&a);
         assert!((&q * &r - &a).norm() < 1e-13);
         assert!((q.transpose() * &q - DMatrix::identity(4, 4)).norm() < 1e-14);
@@ -150,7 +172,9 @@ mod tests {
 
     #[test]
     fn complex_reconstructs() {
-        let a = DMatrix::from_fn(3, 2, |i, j| Complex::new(i as f64 + 1.0, j as f64 - 0.5 * i as f64));
+        let a = DMatrix::from_fn(3, 2, |i, j| {
+            Complex::new(i as f64 + 1.0, j as f64 - 0.5 * i as f64)
+        });
         let FullQr { q, r } = full_qr(&a);
         assert!((&q * &r - &a).norm() < 1e-13);
         assert!((q.adjoint() * &q - DMatrix::identity(3, 3)).norm() < 1e-14);

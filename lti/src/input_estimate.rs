@@ -9,8 +9,8 @@
 //! matrices (MW, MWCΦ, MWCΓ_B) to get Mŵ directly — the controller's cancellation of w. One pass
 //! of products and sums, in a fixed order, so the recorder and the controller form the same bits.
 
-use crate::kernel::{copy, mul_into};
 use crate::Mat;
+use crate::kernel::{copy, mul_into};
 
 /// ŵ_{k−1} from sample k, step by step.
 #[derive(Debug, Clone)]
@@ -36,7 +36,14 @@ impl InputEstimateStep {
         m.columns_mut(0, p).copy_from(&w);
         m.columns_mut(p, n).copy_from(&-w_c_phi);
         m.columns_mut(p + n, l).copy_from(&-w_c_gamma_b);
-        InputEstimateStep { m, stacked: vec![0.0; p + n + l], p, n, started: false, value: vec![0.0; q] }
+        InputEstimateStep {
+            m,
+            stacked: vec![0.0; p + n + l],
+            p,
+            n,
+            started: false,
+            value: vec![0.0; q],
+        }
     }
 
     /// Sample k: y_k, the u_{k−1} the plant held over step k − 1, and x̂_k. Returns whether
@@ -63,7 +70,11 @@ mod tests {
     #[test]
     fn it_recovers_the_unknown_input_of_a_sampled_plant() {
         let phi = Mat::from_row_slice(2, 2, &[0.9, 0.1, 0.0, 0.8]);
-        let (gb, ge, c) = (Mat::from_row_slice(2, 1, &[0.0, 1.0]), Mat::from_row_slice(2, 1, &[1.0, 0.5]), Mat::identity(2, 2));
+        let (gb, ge, c) = (
+            Mat::from_row_slice(2, 1, &[0.0, 1.0]),
+            Mat::from_row_slice(2, 1, &[1.0, 0.5]),
+            Mat::identity(2, 2),
+        );
         let w = crate::pinv::pinv(&(&c * &ge));
         let mut est = InputEstimateStep::new(w.clone(), &(&w * &c * &phi), &(&w * &c * &gb));
         let mut x = nalgebra::DVector::from_vec(vec![1.0, -1.0]);
@@ -72,7 +83,11 @@ mod tests {
         for k in 0..20 {
             let y = &c * &x;
             if est.push(y.as_slice(), &u_prev, x.as_slice()) {
-                assert!((est.value[0] - w_prev).abs() < 1e-12, "step {k}: {} vs {w_prev}", est.value[0]);
+                assert!(
+                    (est.value[0] - w_prev).abs() < 1e-12,
+                    "step {k}: {} vs {w_prev}",
+                    est.value[0]
+                );
             }
             let (u, wk) = ((k as f64).sin(), 0.3 * k as f64);
             x = &phi * &x + &gb * u + &ge * wk;

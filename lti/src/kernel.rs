@@ -26,7 +26,10 @@ pub fn mul_acc(out: &mut [f64], m: &DMatrix<f64>, v: &[f64]) {
 fn product(out: &mut [f64], m: &DMatrix<f64>, v: &[f64], add: bool) {
     let rows = m.nrows();
     let data = m.as_slice();
-    assert!(out.len() == rows && data.len() == rows * v.len(), "matrix–vector product: shapes do not conform");
+    assert!(
+        out.len() == rows && data.len() == rows * v.len(),
+        "matrix–vector product: shapes do not conform"
+    );
     let mut i0 = 0;
     while rows - i0 >= 4 {
         block::<4>(out, data, rows, i0, v, add);
@@ -42,7 +45,14 @@ fn product(out: &mut [f64], m: &DMatrix<f64>, v: &[f64], add: bool) {
 
 /// Rows i0 … i0 + B − 1 of [`product`].
 #[inline(always)]
-fn block<const B: usize>(out: &mut [f64], data: &[f64], rows: usize, i0: usize, v: &[f64], add: bool) {
+fn block<const B: usize>(
+    out: &mut [f64],
+    data: &[f64],
+    rows: usize,
+    i0: usize,
+    v: &[f64],
+    add: bool,
+) {
     let out = &mut out[i0..i0 + B];
     let mut acc = [0.0; B];
     if add {
@@ -80,7 +90,10 @@ pub fn copy(dst: &mut [f64], src: &[f64]) {
 
 #[inline(always)]
 fn fixed<const N: usize>(dst: &mut [f64], src: &[f64]) {
-    let (d, s): (&mut [f64; N], &[f64; N]) = (dst.try_into().expect("length N"), src.try_into().expect("length N"));
+    let (d, s): (&mut [f64; N], &[f64; N]) = (
+        dst.try_into().expect("length N"),
+        src.try_into().expect("length N"),
+    );
     *d = *s;
 }
 
@@ -107,7 +120,9 @@ mod tests {
     fn blocks_sum_each_row_in_column_order() {
         for rows in 0..11 {
             for cols in 0..7 {
-                let m = DMatrix::from_fn(rows, cols, |i, j| ((i * 7 + j * 3) as f64 * 0.37).sin() * 10f64.powi((i + j) as i32 % 5 - 2));
+                let m = DMatrix::from_fn(rows, cols, |i, j| {
+                    ((i * 7 + j * 3) as f64 * 0.37).sin() * 10f64.powi((i + j) as i32 % 5 - 2)
+                });
                 let v: Vec<f64> = (0..cols).map(|j| (j as f64 * 1.3).cos() * 1e3).collect();
                 let start: Vec<f64> = (0..rows).map(|i| i as f64 * 1e-3 - 0.1).collect();
                 let mut into = vec![f64::NAN; rows];
@@ -120,11 +135,18 @@ mod tests {
                         a += m[(i, j)] * v[j];
                         b += m[(i, j)] * v[j];
                     }
-                    assert_eq!((into[i].to_bits(), acc[i].to_bits()), (a.to_bits(), b.to_bits()), "{rows}×{cols} row {i}");
+                    assert_eq!(
+                        (into[i].to_bits(), acc[i].to_bits()),
+                        (a.to_bits(), b.to_bits()),
+                        "{rows}×{cols} row {i}"
+                    );
                 }
                 let mut copied = vec![0.0; rows];
                 copy(&mut copied, &acc);
-                assert_eq!(copied.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), acc.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
+                assert_eq!(
+                    copied.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                    acc.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+                );
             }
         }
     }

@@ -23,24 +23,25 @@ pub mod expm;
 pub mod householder;
 pub mod input_estimate;
 pub mod kernel;
+pub mod linalg;
 pub mod lyapunov;
 pub mod model;
 pub mod pinv;
 pub mod place;
-pub mod sampled;
 pub mod poles;
+pub mod sampled;
 pub mod signal;
 pub mod staircase;
 pub mod subspace;
 pub mod van_loan;
 pub mod zeros;
 
-pub use dare::{solve_dare, steady_state_kalman, Dare, Kalman};
+pub use dare::{Dare, Kalman, solve_dare, steady_state_kalman};
 pub use eig::C64;
 pub use error::{LtiError, Result};
-pub use nalgebra::DMatrix;
 pub use model::{Discrete, MatData, Model};
-pub use poles::{re_im, PoleSpec, Poles};
+pub use nalgebra::DMatrix;
+pub use poles::{PoleSpec, Poles, re_im};
 pub use van_loan::{discrete_noise_covariance, process_noise_covariance};
 
 /// A real matrix.

@@ -44,10 +44,17 @@ pub fn discrete(a: &DMatrix<f64>, q: &DMatrix<f64>) -> Result<DMatrix<f64>> {
 
 fn solve(k: DMatrix<f64>, q: &DMatrix<f64>, n: usize) -> Result<DMatrix<f64>> {
     if q.shape() != (n, n) {
-        return Err(LtiError::Dimension(format!("Q is {}×{}, expected {n}×{n}", q.nrows(), q.ncols())));
+        return Err(LtiError::Dimension(format!(
+            "Q is {}×{}, expected {n}×{n}",
+            q.nrows(),
+            q.ncols()
+        )));
     }
     let rhs = -DMatrix::from_column_slice(n * n, 1, q.as_slice());
-    let v = k.lu().solve(&rhs).ok_or(LtiError::Singular("the Lyapunov operator"))?;
+    let v = k
+        .lu()
+        .solve(&rhs)
+        .ok_or(LtiError::Singular("the Lyapunov operator"))?;
     let p = DMatrix::from_column_slice(n, n, v.as_slice());
     Ok((&p + p.transpose()) * 0.5)
 }
@@ -57,9 +64,17 @@ fn solve(k: DMatrix<f64>, q: &DMatrix<f64>, n: usize) -> Result<DMatrix<f64>> {
 fn smith(a: &DMatrix<f64>, q: &DMatrix<f64>) -> Result<DMatrix<f64>> {
     let n = a.nrows();
     if q.shape() != (n, n) {
-        return Err(LtiError::Dimension(format!("Q is {}×{}, expected {n}×{n}", q.nrows(), q.ncols())));
+        return Err(LtiError::Dimension(format!(
+            "Q is {}×{}, expected {n}×{n}",
+            q.nrows(),
+            q.ncols()
+        )));
     }
-    let norm = |m: &DMatrix<f64>| m.column_iter().map(|c| c.iter().map(|v| v.abs()).sum::<f64>()).fold(0.0, f64::max);
+    let norm = |m: &DMatrix<f64>| {
+        m.column_iter()
+            .map(|c| c.iter().map(|v| v.abs()).sum::<f64>())
+            .fold(0.0, f64::max)
+    };
     let (mut p, mut ak) = (q.clone(), a.clone());
     for _ in 0..64 {
         let step = ak.transpose() * &p * &ak;
@@ -73,7 +88,9 @@ fn smith(a: &DMatrix<f64>, q: &DMatrix<f64>) -> Result<DMatrix<f64>> {
         }
         ak = &ak * &ak;
     }
-    Err(LtiError::Singular("the Stein operator (A is not Schur-stable)"))
+    Err(LtiError::Singular(
+        "the Stein operator (A is not Schur-stable)",
+    ))
 }
 
 /// Smallest eigenvalue of a symmetric matrix.
@@ -99,11 +116,27 @@ mod tests {
     #[test]
     fn smith_matches_kronecker() {
         let n = 12;
-        let a = DMatrix::from_fn(n, n, |i, j| if i == j { 0.9 - 0.05 * i as f64 } else { 0.02 * ((i * 7 + j * 3) % 5) as f64 - 0.04 });
-        let q = DMatrix::from_fn(n, n, |i, j| if i == j { 2.0 } else { 0.1 / (1.0 + (i + j) as f64) });
+        let a = DMatrix::from_fn(n, n, |i, j| {
+            if i == j {
+                0.9 - 0.05 * i as f64
+            } else {
+                0.02 * ((i * 7 + j * 3) % 5) as f64 - 0.04
+            }
+        });
+        let q = DMatrix::from_fn(n, n, |i, j| {
+            if i == j {
+                2.0
+            } else {
+                0.1 / (1.0 + (i + j) as f64)
+            }
+        });
         let exact = discrete(&a, &q).unwrap();
         let doubled = smith(&a, &q).unwrap();
-        assert!((&exact - &doubled).amax() <= 1e-12 * exact.amax(), "{}", (&exact - &doubled).amax());
+        assert!(
+            (&exact - &doubled).amax() <= 1e-12 * exact.amax(),
+            "{}",
+            (&exact - &doubled).amax()
+        );
         assert!(smith(&(a * 1.5), &q).is_err());
     }
 }

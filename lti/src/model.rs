@@ -65,7 +65,14 @@ impl Model {
     pub fn discretize(&self, dt: f64) -> Discrete {
         let (a, b) = zoh(&self.a, &self.b, dt);
         let (_, e) = zoh(&self.a, &self.e, dt);
-        Discrete { a, b, c: self.c.clone(), e, d: self.d.clone(), dt }
+        Discrete {
+            a,
+            b,
+            c: self.c.clone(),
+            e,
+            d: self.d.clone(),
+            dt,
+        }
     }
 }
 
@@ -82,8 +89,14 @@ pub struct MatData {
 
 impl From<&DMatrix<f64>> for MatData {
     fn from(m: &DMatrix<f64>) -> Self {
-        let data = (0..m.nrows()).flat_map(|i| m.row(i).iter().copied().collect::<Vec<_>>()).collect();
-        MatData { rows: m.nrows(), cols: m.ncols(), data }
+        let data = (0..m.nrows())
+            .flat_map(|i| m.row(i).iter().copied().collect::<Vec<_>>())
+            .collect();
+        MatData {
+            rows: m.nrows(),
+            cols: m.ncols(),
+            data,
+        }
     }
 }
 
@@ -92,4 +105,3 @@ impl From<&MatData> for DMatrix<f64> {
         DMatrix::from_row_slice(m.rows, m.cols, &m.data)
     }
 }
-

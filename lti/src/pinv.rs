@@ -1,4 +1,5 @@
-//! Rank and Moore–Penrose pseudo-inverse from the SVD, with numpy's relative tolerances.
+//! Rank and Moore–Penrose pseudo-inverse from the SVD ([`crate::linalg::svd`]), with numpy's
+//! relative tolerances.
 //!
 //! With A = U Σ Vᵀ and singular values σ₁ ≥ … ≥ σ_k:
 //! * `rank(A)` counts σᵢ > σ₁ · max(m, n) · ε (numpy `matrix_rank`);
@@ -9,47 +10,27 @@
 
 use nalgebra::DMatrix;
 
+use crate::linalg::svd::Svd;
+pub use crate::linalg::svd::{rank, rank_tolerance, singular_values};
+
 /// numpy's default `rcond` for `pinv`.
 pub const PINV_RCOND: f64 = 1e-15;
 
-/// Singular values, largest first (empty for an empty matrix).
-pub fn singular_values(a: &DMatrix<f64>) -> Vec<f64> {
-    if a.is_empty() {
-        return Vec::new();
-    }
-    let mut s: Vec<f64> = a.clone().svd(false, false).singular_values.iter().copied().collect();
-    s.sort_by(|x, y| y.total_cmp(x));
-    s
-}
-
-/// Tolerance under which a singular value counts as zero for `rank` (numpy `matrix_rank`).
-pub fn rank_tolerance(a: &DMatrix<f64>) -> f64 {
-    let smax = singular_values(a).first().copied().unwrap_or(0.0);
-    smax * a.nrows().max(a.ncols()) as f64 * f64::EPSILON
-}
-
-/// Numerical rank with numpy's rule.
-pub fn rank(a: &DMatrix<f64>) -> usize {
-    let s = singular_values(a);
-    let Some(&smax) = s.first() else { return 0 };
-    let tol = smax * a.nrows().max(a.ncols()) as f64 * f64::EPSILON;
-    s.iter().filter(|&&x| x > tol).count()
-}
-
-/// Moore–Penrose pseudo-inverse (n×m for an m×n matrix) with numpy's default cut-off.
+/// Moore–Penrose pseudo-inverse (n×m for an m×n matrix) with numpy's default cut-off; all NaN
+/// for a matrix with a non-finite entry.
 pub fn pinv(a: &DMatrix<f64>) -> DMatrix<f64> {
     let (m, n) = a.shape();
     if a.is_empty() {
         return DMatrix::zeros(n, m);
     }
-    let svd = a.clone().svd(true, true);
-    let u = svd.u.expect("requested U");
-    let vt = svd.v_t.expect("requested Vᵀ");
-    let smax = svd.singular_values.max();
+    let Some(svd) = Svd::new(a) else {
+        return DMatrix::from_element(n, m, f64::NAN);
+    };
+    let smax = svd.s.first().copied().unwrap_or(0.0);
     let mut out = DMatrix::zeros(n, m);
-    for (i, &s) in svd.singular_values.iter().enumerate() {
+    for (i, &s) in svd.s.iter().enumerate() {
         if s > PINV_RCOND * smax {
-            out += vt.row(i).transpose() * u.column(i).transpose() / s;
+            out += svd.v.column(i) * svd.u.column(i).transpose() / s;
         }
     }
     out

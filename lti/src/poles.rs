@@ -22,7 +22,9 @@ impl Poles {
                 }
                 PoleSpec::Pair(re, im) => {
                     if !re.is_finite() || !im.is_finite() {
-                        return Err(LtiError::InvalidPoles(format!("[{re}, {im}] is not finite")));
+                        return Err(LtiError::InvalidPoles(format!(
+                            "[{re}, {im}] is not finite"
+                        )));
                     }
                     if im == 0.0 {
                         v.push(C64::new(re, 0.0));
@@ -122,7 +124,14 @@ mod tests {
     #[test]
     fn pair_expands_to_conjugates() {
         let p = Poles::new([PoleSpec::Real(-1.0), PoleSpec::Pair(-2.0, -3.0)]).unwrap();
-        assert_eq!(p.values(), &[C64::new(-1.0, 0.0), C64::new(-2.0, 3.0), C64::new(-2.0, -3.0)]);
+        assert_eq!(
+            p.values(),
+            &[
+                C64::new(-1.0, 0.0),
+                C64::new(-2.0, 3.0),
+                C64::new(-2.0, -3.0)
+            ]
+        );
     }
 
     #[test]

@@ -13,7 +13,7 @@
 //! The values are the signal's own, in the same expressions: the same bits as
 //! [`Signal::sample_step`] and [`Signal::held_at_step`].
 
-use crate::signal::{in_effect, Signal};
+use crate::signal::{Signal, in_effect};
 
 /// A signal sampled at t_k = k·dt.
 #[derive(Debug, Clone)]
@@ -31,11 +31,27 @@ impl SampledSignal {
     /// `signal` on the grid of period `dt`.
     pub fn new(signal: &Signal, dt: f64) -> Self {
         let (before, switches) = match signal {
-            Signal::Step { time, before, after } => (*before, vec![(first_in_effect(*time, dt), *after)]),
-            Signal::Piecewise { times, values } => (0.0, times.iter().zip(values).map(|(&t, &v)| (first_in_effect(t, dt), v)).collect()),
+            Signal::Step {
+                time,
+                before,
+                after,
+            } => (*before, vec![(first_in_effect(*time, dt), *after)]),
+            Signal::Piecewise { times, values } => (
+                0.0,
+                times
+                    .iter()
+                    .zip(values)
+                    .map(|(&t, &v)| (first_in_effect(t, dt), v))
+                    .collect(),
+            ),
             _ => (signal.held(0.0), Vec::new()),
         };
-        SampledSignal { dt, sine: signal.sine(), before, switches }
+        SampledSignal {
+            dt,
+            sine: signal.sine(),
+            before,
+            switches,
+        }
     }
 
     /// Each of `signals` on the grid of period `dt`.
@@ -92,18 +108,55 @@ mod tests {
     /// decision: times on the grid, just off it, beyond any run, and at or before 0.
     #[test]
     fn it_gives_the_signals_own_samples() {
-        let times = [5.0, 5.0000000000001, 4.9999999999999, 0.3, 0.30000000000000004, 1e-9, 0.0, -1.0, 1e300, f64::INFINITY, f64::NAN, 123.456789];
+        let times = [
+            5.0,
+            5.0000000000001,
+            4.9999999999999,
+            0.3,
+            0.30000000000000004,
+            1e-9,
+            0.0,
+            -1.0,
+            1e300,
+            f64::INFINITY,
+            f64::NAN,
+            123.456789,
+        ];
         for dt in [0.001, 0.1, 0.01, 1.0 / 3.0, 0.0025] {
             for &t in &times {
-                let step = Signal::Step { time: t, before: -1.5, after: 2.5 };
-                let sine = Signal::Sine { amplitude: 0.7, frequency_hz: 0.5, phase: 0.2, offset: 0.1 };
-                let pw = Signal::Piecewise { times: vec![t.min(1.0), t, t + 0.5], values: vec![1.0, -2.0, 3.0] };
+                let step = Signal::Step {
+                    time: t,
+                    before: -1.5,
+                    after: 2.5,
+                };
+                let sine = Signal::Sine {
+                    amplitude: 0.7,
+                    frequency_hz: 0.5,
+                    phase: 0.2,
+                    offset: 0.1,
+                };
+                let pw = Signal::Piecewise {
+                    times: vec![t.min(1.0), t, t + 0.5],
+                    values: vec![1.0, -2.0, 3.0],
+                };
                 for s in [step, sine, pw, Signal::Constant { value: 4.0 }] {
                     let sampled = SampledSignal::new(&s, dt);
-                    let at = if t.is_finite() && t > 0.0 && t / dt < 1e15 { (t / dt) as u64 } else { 0 };
+                    let at = if t.is_finite() && t > 0.0 && t / dt < 1e15 {
+                        (t / dt) as u64
+                    } else {
+                        0
+                    };
                     for k in (at.saturating_sub(3)..at + 4).chain([0, 1, 2, 1 << 40]) {
-                        assert_eq!(sampled.sample_step(k).to_bits(), s.sample_step(k, dt).to_bits(), "{s:?} dt {dt} k {k}");
-                        assert_eq!(sampled.held_at_step(k).to_bits(), s.held_at_step(k, dt).to_bits(), "{s:?} dt {dt} k {k}");
+                        assert_eq!(
+                            sampled.sample_step(k).to_bits(),
+                            s.sample_step(k, dt).to_bits(),
+                            "{s:?} dt {dt} k {k}"
+                        );
+                        assert_eq!(
+                            sampled.held_at_step(k).to_bits(),
+                            s.held_at_step(k, dt).to_bits(),
+                            "{s:?} dt {dt} k {k}"
+                        );
                     }
                 }
             }

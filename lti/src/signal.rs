@@ -55,12 +55,21 @@ pub fn locate(time: f64, dt: f64) -> Switch {
     };
     match decimal_offset(time, k, dt).map(|o| o.0) {
         Some(Ordering::Equal) => Switch::OnSample(k),
-        Some(Ordering::Greater) => Switch::Inside { step: k, offset: inside(k) },
+        Some(Ordering::Greater) => Switch::Inside {
+            step: k,
+            offset: inside(k),
+        },
         // (k ≥ 1 here: T > 0 = 0·dt.)
-        Some(Ordering::Less) => Switch::Inside { step: k - 1, offset: inside(k - 1) },
+        Some(Ordering::Less) => Switch::Inside {
+            step: k - 1,
+            offset: inside(k - 1),
+        },
         // Too many digits for 128-bit integers: fall back to the binary values.
         None if q == q.floor() => Switch::OnSample(q as u64),
-        None => Switch::Inside { step: q.floor() as u64, offset: time - q.floor() * dt },
+        None => Switch::Inside {
+            step: q.floor() as u64,
+            offset: time - q.floor() * dt,
+        },
     }
 }
 
@@ -101,7 +110,10 @@ struct StackText {
 
 impl StackText {
     fn new() -> Self {
-        StackText { buf: [0; 64], len: 0 }
+        StackText {
+            buf: [0; 64],
+            len: 0,
+        }
     }
 
     fn as_str(&self) -> &str {
@@ -152,7 +164,9 @@ fn decimal_offset(time: f64, k: u64, dt: f64) -> Option<(Ordering, u128, i32)> {
     let e = et.min(ed);
     let pow10 = |p: i32| 10u128.checked_pow(p as u32);
     let lhs = (mt as u128).checked_mul(pow10(et - e)?)?;
-    let rhs = (md as u128).checked_mul(k as u128)?.checked_mul(pow10(ed - e)?)?;
+    let rhs = (md as u128)
+        .checked_mul(k as u128)?
+        .checked_mul(pow10(ed - e)?)?;
     Some((lhs.cmp(&rhs), lhs.abs_diff(rhs), e))
 }
 
@@ -208,16 +222,29 @@ impl Signal {
     /// Checks the parameters; returns the name of the offending field and the reason.
     pub fn validate(&self) -> Result<(), (&'static str, String)> {
         let finite = |name: &'static str, v: f64| {
-            if v.is_finite() { Ok(()) } else { Err((name, format!("{v} is not finite"))) }
+            if v.is_finite() {
+                Ok(())
+            } else {
+                Err((name, format!("{v} is not finite")))
+            }
         };
         match self {
             Signal::Constant { value } => finite("value", *value),
-            Signal::Step { time, before, after } => {
+            Signal::Step {
+                time,
+                before,
+                after,
+            } => {
                 finite("time", *time)?;
                 finite("before", *before)?;
                 finite("after", *after)
             }
-            Signal::Sine { amplitude, frequency_hz, phase, offset } => {
+            Signal::Sine {
+                amplitude,
+                frequency_hz,
+                phase,
+                offset,
+            } => {
                 finite("amplitude", *amplitude)?;
                 finite("frequency_hz", *frequency_hz)?;
                 finite("phase", *phase)?;
@@ -232,7 +259,10 @@ impl Signal {
                     return Err(("times", "must not be empty".into()));
                 }
                 if times.len() != values.len() {
-                    return Err(("values", format!("has {} entries, times has {}", values.len(), times.len())));
+                    return Err((
+                        "values",
+                        format!("has {} entries, times has {}", values.len(), times.len()),
+                    ));
                 }
                 for t in times {
                     finite("times", *t)?;
@@ -270,17 +300,23 @@ impl Signal {
     /// exactly (module documentation). A switch strictly inside step k − 1 shows from sample k.
     pub fn held_at_step(&self, k: u64, dt: f64) -> f64 {
         match self {
-            Signal::Step { time, before, after } => {
+            Signal::Step {
+                time,
+                before,
+                after,
+            } => {
                 if in_effect(*time, k, dt) {
                     *after
                 } else {
                     *before
                 }
             }
-            Signal::Piecewise { times, values } => match times.iter().rposition(|&ti| in_effect(ti, k, dt)) {
-                Some(i) => values[i],
-                None => 0.0,
-            },
+            Signal::Piecewise { times, values } => {
+                match times.iter().rposition(|&ti| in_effect(ti, k, dt)) {
+                    Some(i) => values[i],
+                    None => 0.0,
+                }
+            }
             _ => self.held(0.0),
         }
     }
@@ -297,9 +333,16 @@ impl Signal {
     /// The sinusoidal part: (amplitude, ω in rad/s, phase), if any.
     pub fn sine(&self) -> Option<(f64, f64, f64)> {
         match self {
-            Signal::Sine { amplitude, frequency_hz, phase, .. } if *amplitude != 0.0 => {
-                Some((*amplitude, 2.0 * std::f64::consts::PI * frequency_hz, *phase))
-            }
+            Signal::Sine {
+                amplitude,
+                frequency_hz,
+                phase,
+                ..
+            } if *amplitude != 0.0 => Some((
+                *amplitude,
+                2.0 * std::f64::consts::PI * frequency_hz,
+                *phase,
+            )),
             _ => None,
         }
     }
@@ -314,7 +357,11 @@ impl Signal {
     pub fn held(&self, t: f64) -> f64 {
         match self {
             Signal::Constant { value } => *value,
-            Signal::Step { time, before, after } => {
+            Signal::Step {
+                time,
+                before,
+                after,
+            } => {
                 if t < *time {
                     *before
                 } else {
@@ -343,7 +390,9 @@ impl Signal {
         match self {
             Signal::Constant { value } => value.abs(),
             Signal::Step { before, after, .. } => before.abs().max(after.abs()),
-            Signal::Sine { amplitude, offset, .. } => amplitude.abs() + offset.abs(),
+            Signal::Sine {
+                amplitude, offset, ..
+            } => amplitude.abs() + offset.abs(),
             Signal::Piecewise { values, .. } => values.iter().fold(0.0, |m, v| m.max(v.abs())),
         }
     }
@@ -355,7 +404,10 @@ mod tests {
 
     #[test]
     fn piecewise_holds_from_its_time_on() {
-        let s = Signal::Piecewise { times: vec![0.0, 5.0, 10.0], values: vec![0.0, 1.0, -0.5] };
+        let s = Signal::Piecewise {
+            times: vec![0.0, 5.0, 10.0],
+            values: vec![0.0, 1.0, -0.5],
+        };
         assert_eq!(s.value(4.999), 0.0);
         assert_eq!(s.value(5.0), 1.0);
         assert_eq!(s.value(12.0), -0.5);
@@ -370,11 +422,35 @@ mod tests {
         assert_eq!(locate(0.7, 0.1), Switch::OnSample(7));
         assert_eq!(locate(0.0003, 1e-4), Switch::OnSample(3));
         // A time computed as 3·10⁻⁴ in binary is another decimal, 3.0000000000000003e-4.
-        assert_eq!(locate(1e-4 * 3.0, 1e-4), Switch::Inside { step: 3, offset: 3e-20 });
+        assert_eq!(
+            locate(1e-4 * 3.0, 1e-4),
+            Switch::Inside {
+                step: 3,
+                offset: 3e-20
+            }
+        );
         // 10⁻¹³ after sample 5000, and 10⁻¹³ before it: inside the neighbouring steps.
-        assert_eq!(locate(5.0000000000001, 0.001), Switch::Inside { step: 5000, offset: 1e-13 });
-        assert_eq!(locate(4.9999999999999, 0.001), Switch::Inside { step: 4999, offset: 0.0009999999999 });
-        assert_eq!(locate(0.00105, 0.001), Switch::Inside { step: 1, offset: 5e-5 });
+        assert_eq!(
+            locate(5.0000000000001, 0.001),
+            Switch::Inside {
+                step: 5000,
+                offset: 1e-13
+            }
+        );
+        assert_eq!(
+            locate(4.9999999999999, 0.001),
+            Switch::Inside {
+                step: 4999,
+                offset: 0.0009999999999
+            }
+        );
+        assert_eq!(
+            locate(0.00105, 0.001),
+            Switch::Inside {
+                step: 1,
+                offset: 5e-5
+            }
+        );
         assert_eq!(locate(0.0, 0.001), Switch::OnSample(0));
         assert_eq!(locate(-2.0, 0.001), Switch::OnSample(0));
         assert_eq!(locate(1e300, 0.001), Switch::Beyond);
@@ -382,7 +458,11 @@ mod tests {
 
     #[test]
     fn a_switch_shows_from_its_sample_on_and_no_earlier() {
-        let at = |time: f64| Signal::Step { time, before: 0.0, after: 1.0 };
+        let at = |time: f64| Signal::Step {
+            time,
+            before: 0.0,
+            after: 1.0,
+        };
         // On sample 5000: made there.
         assert_eq!(at(5.0).sample(5000.0 * 0.001, 0.001), 1.0);
         assert_eq!(at(5.0).sample_step(4999, 0.001), 0.0);
@@ -393,8 +473,14 @@ mod tests {
         assert_eq!(at(4.9999999999999).sample_step(5000, 0.001), 1.0);
         assert_eq!(at(4.9999999999999).sample_step(4999, 0.001), 0.0);
         // 3·0.1 = 0.30000000000000004 > 0.3, 0.3 itself on sample 3 all the same.
-        let p = Signal::Piecewise { times: vec![0.1, 0.3], values: vec![2.0, 3.0] };
-        assert_eq!([0, 1, 2, 3].map(|k| p.sample_step(k, 0.1)), [0.0, 2.0, 2.0, 3.0]);
+        let p = Signal::Piecewise {
+            times: vec![0.1, 0.3],
+            values: vec![2.0, 3.0],
+        };
+        assert_eq!(
+            [0, 1, 2, 3].map(|k| p.sample_step(k, 0.1)),
+            [0.0, 2.0, 2.0, 3.0]
+        );
         assert_eq!(p.held_after(1), 3.0);
     }
 
@@ -408,7 +494,12 @@ mod tests {
 
     #[test]
     fn sine_with_offset() {
-        let s = Signal::Sine { amplitude: 2.0, frequency_hz: 0.25, phase: 0.0, offset: 1.0 };
+        let s = Signal::Sine {
+            amplitude: 2.0,
+            frequency_hz: 0.25,
+            phase: 0.0,
+            offset: 1.0,
+        };
         assert!((s.value(1.0) - 3.0).abs() < 1e-15);
         assert_eq!(s.held(1.0), 1.0);
     }

@@ -15,7 +15,7 @@
 
 use nalgebra::DMatrix;
 
-use crate::eig::{eigenvalues, C64};
+use crate::eig::{C64, eigenvalues};
 use crate::error::Result;
 use crate::subspace::orthogonal_complement;
 
@@ -36,7 +36,12 @@ impl ControllabilityStaircase {
     /// Eigenvalues of the uncontrollable block A_u.
     pub fn uncontrollable_modes(&self) -> Result<Vec<C64>> {
         let n = self.a.nrows();
-        eigenvalues(&self.a.view((self.nc, self.nc), (n - self.nc, n - self.nc)).into_owned())
+        eigenvalues(
+            &self
+                .a
+                .view((self.nc, self.nc), (n - self.nc, n - self.nc))
+                .into_owned(),
+        )
     }
 }
 
@@ -58,7 +63,12 @@ impl ObservabilityStaircase {
     /// Eigenvalues of the unobservable block A_u.
     pub fn unobservable_modes(&self) -> Result<Vec<C64>> {
         let n = self.a.nrows();
-        eigenvalues(&self.a.view((self.no, self.no), (n - self.no, n - self.no)).into_owned())
+        eigenvalues(
+            &self
+                .a
+                .view((self.no, self.no), (n - self.no, n - self.no))
+                .into_owned(),
+        )
     }
 
     /// The observable pair (A_o, C_o).
@@ -74,7 +84,9 @@ impl ObservabilityStaircase {
 pub fn controllability_staircase(a: &DMatrix<f64>, b: &DMatrix<f64>) -> ControllabilityStaircase {
     let n = a.nrows();
     let norm1 = |m: &DMatrix<f64>| {
-        (0..m.ncols()).map(|j| m.column(j).iter().map(|x| x.abs()).sum::<f64>()).fold(0.0, f64::max)
+        (0..m.ncols())
+            .map(|j| m.column(j).iter().map(|x| x.abs()).sum::<f64>())
+            .fold(0.0, f64::max)
     };
     let tol = tolerance(n, norm1(a).max(norm1(b)));
     let mut q = DMatrix::<f64>::identity(n, n);
@@ -89,7 +101,8 @@ pub fn controllability_staircase(a: &DMatrix<f64>, b: &DMatrix<f64>) -> Controll
             break;
         }
         let mut uf = u.clone().resize_horizontally(n - k, 0.0);
-        uf.columns_mut(r, n - k - r).copy_from(&orthogonal_complement(&u));
+        uf.columns_mut(r, n - k - r)
+            .copy_from(&orthogonal_complement(&u));
         // Rotate coordinates k.. by uf.
         let rows = uf.transpose() * at.rows(k, n - k);
         at.rows_mut(k, n - k).copy_from(&rows);
@@ -112,7 +125,12 @@ pub fn controllability_staircase(a: &DMatrix<f64>, b: &DMatrix<f64>) -> Controll
             bt[(i, j)] = 0.0;
         }
     }
-    ControllabilityStaircase { q, a: at, b: bt, nc: k }
+    ControllabilityStaircase {
+        q,
+        a: at,
+        b: bt,
+        nc: k,
+    }
 }
 
 /// Staircase reduction of (A, C), by duality with (Aᵀ, Cᵀ).
@@ -202,7 +220,17 @@ mod tests {
         let ta = DMatrix::from_row_slice(
             3,
             3,
-            &[0.0, 1.0 / 17.0, 8.0 / 17.0, -2.0, -3.0, 0.0, 0.0, -4.0 / 17.0, -32.0 / 17.0],
+            &[
+                0.0,
+                1.0 / 17.0,
+                8.0 / 17.0,
+                -2.0,
+                -3.0,
+                0.0,
+                0.0,
+                -4.0 / 17.0,
+                -32.0 / 17.0,
+            ],
         );
         let c = DMatrix::from_row_slice(2, 3, &[1.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
         assert!(is_observable(&ta, &c));

@@ -39,7 +39,7 @@
 
 use nalgebra::DMatrix;
 
-use crate::dare::{finite, one_norm, sym, symmetric, Definite};
+use crate::dare::{Definite, finite, one_norm, sym, symmetric};
 use crate::error::{LtiError, Result};
 use crate::expm::expm;
 
@@ -79,7 +79,9 @@ pub fn discrete_noise_covariance(a: &Mat, w: &Mat, h: f64) -> Result<Mat> {
     finite("A", a)?;
     let w = symmetric("W", w, Definite::Semi)?;
     if !(h.is_finite() && h >= 0.0) {
-        return Err(LtiError::InvalidInput(format!("the step h = {h} is not a finite non-negative number")));
+        return Err(LtiError::InvalidInput(format!(
+            "the step h = {h} is not a finite non-negative number"
+        )));
     }
     let mut big = Mat::zeros(2 * n, 2 * n);
     big.view_mut((0, 0), (n, n)).copy_from(&(-a));
@@ -91,7 +93,11 @@ pub fn discrete_noise_covariance(a: &Mat, w: &Mat, h: f64) -> Result<Mat> {
     let mut halvings = 0;
     let mut qd = loop {
         let e = expm(&big, t);
-        let (f11, f12, f22) = (e.view((0, 0), (n, n)), e.view((0, n), (n, n)), e.view((n, n), (n, n)));
+        let (f11, f12, f22) = (
+            e.view((0, 0), (n, n)),
+            e.view((0, n), (n, n)),
+            e.view((n, n), (n, n)),
+        );
         let growth = one_norm(&f11.into_owned()) * one_norm(&f22.into_owned());
         if growth <= MAX_GROWTH || halvings == MAX_HALVINGS {
             break sym(&(f22.transpose() * f12));
@@ -128,7 +134,10 @@ mod tests {
         let m = |v: f64| Mat::from_element(1, 1, v);
         let qd = discrete_noise_covariance(&m(-3.0), &m(2.0), 0.4).unwrap()[(0, 0)];
         let want = 2.0 * (-2.4f64).exp_m1() / -6.0;
-        assert!((qd - want).abs() <= 4.0 * f64::EPSILON * want, "{qd} vs {want}");
+        assert!(
+            (qd - want).abs() <= 4.0 * f64::EPSILON * want,
+            "{qd} vs {want}"
+        );
     }
 
     #[test]
@@ -138,9 +147,16 @@ mod tests {
         let g = Mat::from_row_slice(2, 1, &[0.0, 1.0]);
         let (q, h) = (0.7, 0.25);
         let qd = process_noise_covariance(&a, &g, &Mat::from_element(1, 1, q), h).unwrap();
-        let want = Mat::from_row_slice(2, 2, &[q * h * h * h / 3.0, q * h * h / 2.0, q * h * h / 2.0, q * h]);
+        let want = Mat::from_row_slice(
+            2,
+            2,
+            &[q * h * h * h / 3.0, q * h * h / 2.0, q * h * h / 2.0, q * h],
+        );
         for (x, y) in qd.iter().zip(want.iter()) {
-            assert!((x - y).abs() <= 2.0 * f64::EPSILON * y.abs(), "{qd} vs {want}");
+            assert!(
+                (x - y).abs() <= 2.0 * f64::EPSILON * y.abs(),
+                "{qd} vs {want}"
+            );
         }
         assert_eq!(qd, qd.transpose());
     }

@@ -25,7 +25,7 @@ use nalgebra::DMatrix;
 use crate::eig::C64;
 use crate::error::{LtiError, Result};
 use crate::pinv::{pinv, rank};
-use crate::staircase::{observability_staircase, ObservabilityStaircase};
+use crate::staircase::{ObservabilityStaircase, observability_staircase};
 use crate::subspace::left_null_space;
 
 /// The decoupling structure of (A, E, C, D).
@@ -55,7 +55,12 @@ impl Decoupling {
 }
 
 /// Computes M, A₁, N and the invariant zeros. `d` may be p×0.
-pub fn decoupling(a: &DMatrix<f64>, e: &DMatrix<f64>, c: &DMatrix<f64>, d: &DMatrix<f64>) -> Result<Decoupling> {
+pub fn decoupling(
+    a: &DMatrix<f64>,
+    e: &DMatrix<f64>,
+    c: &DMatrix<f64>,
+    d: &DMatrix<f64>,
+) -> Result<Decoupling> {
     let n = a.nrows();
     let p = c.nrows();
     if e.nrows() != n || c.ncols() != n || d.nrows() != p {
@@ -71,7 +76,11 @@ pub fn decoupling(a: &DMatrix<f64>, e: &DMatrix<f64>, c: &DMatrix<f64>, d: &DMat
     e0.columns_mut(0, q).copy_from(e);
     let m = e0 * pinv(&ced);
     let a1 = (DMatrix::<f64>::identity(n, n) - &m * c) * a;
-    let nrows = if r == 0 { DMatrix::<f64>::identity(p, p) } else { left_null_space(d) };
+    let nrows = if r == 0 {
+        DMatrix::<f64>::identity(p, p)
+    } else {
+        left_null_space(d)
+    };
     let staircase = observability_staircase(&a1, &(&nrows * c));
     let zeros = staircase.unobservable_modes()?;
     Ok(Decoupling {

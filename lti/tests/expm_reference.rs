@@ -53,31 +53,61 @@ fn augmented(a: &Mat, g: &Mat, w: &Mat) -> Mat {
 
 /// (name, ours, nalgebra's) for every block the fixture tabulates.
 fn blocks(case: &Value) -> Vec<(String, Mat, Mat)> {
-    let (a, b, e) = (reader::mat(&case["A"]), reader::mat(&case["B"]), reader::mat(&case["E"]));
+    let (a, b, e) = (
+        reader::mat(&case["A"]),
+        reader::mat(&case["B"]),
+        reader::mat(&case["E"]),
+    );
     let h = case["h"].as_f64().unwrap();
     let n = a.nrows();
     let e = if e.ncols() == 0 { Mat::zeros(n, 0) } else { e };
     let old = |g: &Mat, w: &Mat| (augmented(&a, g, w) * h).exp();
     let mut out = Vec::new();
     // Φ, B_d, E_d through the path the plant and every observer design use.
-    let dm = Model { a: a.clone(), b: b.clone(), c: Mat::zeros(0, n), e: e.clone(), d: Mat::zeros(0, 0) }.discretize(h);
+    let dm = Model {
+        a: a.clone(),
+        b: b.clone(),
+        c: Mat::zeros(0, n),
+        e: e.clone(),
+        d: Mat::zeros(0, 0),
+    }
+    .discretize(h);
     let ob = old(&b, &Mat::zeros(b.ncols(), b.ncols()));
-    out.push(("Phi".into(), dm.a.clone(), ob.view((0, 0), (n, n)).into_owned()));
-    out.push(("Gamma_B".into(), dm.b.clone(), ob.view((0, n), (n, b.ncols())).into_owned()));
+    out.push((
+        "Phi".into(),
+        dm.a.clone(),
+        ob.view((0, 0), (n, n)).into_owned(),
+    ));
+    out.push((
+        "Gamma_B".into(),
+        dm.b.clone(),
+        ob.view((0, n), (n, b.ncols())).into_owned(),
+    ));
     assert_eq!(zoh(&a, &b, h).1, dm.b);
     if e.ncols() > 0 {
         let oe = old(&e, &Mat::zeros(e.ncols(), e.ncols()));
-        out.push(("Gamma_E".into(), dm.e.clone(), oe.view((0, n), (n, e.ncols())).into_owned()));
+        out.push((
+            "Gamma_E".into(),
+            dm.e.clone(),
+            oe.view((0, n), (n, e.ncols())).into_owned(),
+        ));
     }
     // The sine generator's block, built as plant::Plant::new builds it.
     for s in case["sines"].as_array().unwrap() {
         let i = s["disturbance"].as_u64().unwrap() as usize;
-        let (amp, omega) = (s["amplitude"].as_f64().unwrap(), s["omega"].as_f64().unwrap());
+        let (amp, omega) = (
+            s["amplitude"].as_f64().unwrap(),
+            s["omega"].as_f64().unwrap(),
+        );
         let mut g = Mat::zeros(n, 2);
         g.set_column(0, &(e.column(i) * amp));
         let w = Mat::from_row_slice(2, 2, &[0.0, omega, -omega, 0.0]);
         let (_, gj) = exp_upper(&a, &g, &w, h);
-        out.push((format!("Gamma_S{i}"), gj, old(&g, &w).view((0, n), (n, 2)).into_owned()));
+        out.push((
+            format!("Gamma_S{i}"),
+            gj,
+            old(&g, &w).view((0, n), (n, 2)).into_owned(),
+        ));
     }
     out
 }
@@ -86,22 +116,36 @@ fn blocks(case: &Value) -> Vec<(String, Mat, Mat)> {
 fn exponentials_are_within_an_ulp_of_40_digit_values() {
     let r = reader::load("../fixtures/expm-reference.json");
     let mut failures = Vec::new();
-    println!("{:<26} {:<9} {:>14} {:>16}", "case", "block", "ulps (expm)", "ulps (nalgebra)");
+    println!(
+        "{:<26} {:<9} {:>14} {:>16}",
+        "case", "block", "ulps (expm)", "ulps (nalgebra)"
+    );
     for case in r["cases"].as_array().unwrap() {
         let name = case["name"].as_str().unwrap();
         let mut seen = 0;
         for (key, ours, old) in blocks(case) {
-            let (hi, lo) = (reader::mat(&case[key.as_str()]), reader::mat(&case[format!("{key}_lo").as_str()]));
+            let (hi, lo) = (
+                reader::mat(&case[key.as_str()]),
+                reader::mat(&case[format!("{key}_lo").as_str()]),
+            );
             let (e, at) = max_ulps(&ours, &hi, &lo);
             let (eo, _) = max_ulps(&old, &hi, &lo);
             println!("{name:<26} {key:<9} {e:>14.2} {eo:>16.2}");
             if e > 1.0 {
-                failures.push(format!("{name} {key}{at:?}: {e:.2} ulps ({} vs {})", ours[at], hi[at]));
+                failures.push(format!(
+                    "{name} {key}{at:?}: {e:.2} ulps ({} vs {})",
+                    ours[at], hi[at]
+                ));
             }
             seen += 1;
         }
         // Every block the fixture has was checked.
-        let tabulated = case.as_object().unwrap().keys().filter(|k| (k.starts_with("Phi") || k.starts_with("Gamma")) && !k.ends_with("_lo")).count();
+        let tabulated = case
+            .as_object()
+            .unwrap()
+            .keys()
+            .filter(|k| (k.starts_with("Phi") || k.starts_with("Gamma")) && !k.ends_with("_lo"))
+            .count();
         assert_eq!(seen, tabulated, "{name}");
     }
     assert!(failures.is_empty(), "{failures:#?}");
@@ -111,8 +155,20 @@ fn exponentials_are_within_an_ulp_of_40_digit_values() {
 #[test]
 fn fixture_covers_the_stiff_seeds() {
     let r = reader::load("../fixtures/expm-reference.json");
-    let names: Vec<&str> = r["cases"].as_array().unwrap().iter().map(|c| c["name"].as_str().unwrap()).collect();
-    for want in ["seed000-missile", "seed001-missile", "seed000-missile-h0.3dt", "seed002", "seed003-charlie", "seed004"] {
+    let names: Vec<&str> = r["cases"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["name"].as_str().unwrap())
+        .collect();
+    for want in [
+        "seed000-missile",
+        "seed001-missile",
+        "seed000-missile-h0.3dt",
+        "seed002",
+        "seed003-charlie",
+        "seed004",
+    ] {
         assert!(names.contains(&want), "{want} missing from {names:?}");
     }
 }

@@ -10,7 +10,7 @@ use lti::eig::match_error;
 use lti::pinv::{pinv, rank};
 use lti::staircase::{ctrb, obsv};
 use lti::zeros::decoupling;
-use lti::{lyapunov, Mat};
+use lti::{Mat, lyapunov};
 
 fn rel(a: &Mat, b: &Mat) -> f64 {
     max_diff(a, b) / b.amax().max(f64::MIN_POSITIVE)
@@ -26,7 +26,11 @@ fn zero_order_hold_matches_scipy_expm() {
         let (ad, bd) = zoh(&a, &b, dt);
         let (_, ed) = zoh(&a, &e, dt);
         assert!(rel(&ad, &mat(&case["Ad"])) < 1e-13, "{name} Ad");
-        assert!(rel(&bd, &mat(&case["Bd"])) < 1e-12, "{name} Bd {}", rel(&bd, &mat(&case["Bd"])));
+        assert!(
+            rel(&bd, &mat(&case["Bd"])) < 1e-12,
+            "{name} Bd {}",
+            rel(&bd, &mat(&case["Bd"]))
+        );
         assert!(rel(&ed, &mat(&case["Ed"])) < 1e-12, "{name} Ed");
     }
 }
@@ -37,9 +41,16 @@ fn pinv_and_rank_follow_numpy() {
     for case in r["pinv_rank"]["cases"].as_array().unwrap() {
         let name = case["name"].as_str().unwrap();
         let m = mat(&case["M"]);
-        assert_eq!(rank(&m) as u64, case["rank"].as_u64().unwrap(), "{name} rank");
+        assert_eq!(
+            rank(&m) as u64,
+            case["rank"].as_u64().unwrap(),
+            "{name} rank"
+        );
         let want = mat(&case["pinv"]);
-        assert!(max_diff(&pinv(&m), &want) <= 1e-12 * want.amax().max(1.0), "{name} pinv");
+        assert!(
+            max_diff(&pinv(&m), &want) <= 1e-12 * want.amax().max(1.0),
+            "{name} pinv"
+        );
     }
 }
 
@@ -71,7 +82,12 @@ fn invariant_zeros_match_the_rosenbrock_pencil() {
     let r = load("tests/fixtures/reference.json");
     for case in r["invariant_zeros"].as_array().unwrap() {
         let name = case["name"].as_str().unwrap();
-        let (a, b, c, d) = (mat(&case["A"]), mat(&case["B"]), mat(&case["C"]), mat(&case["D"]));
+        let (a, b, c, d) = (
+            mat(&case["A"]),
+            mat(&case["B"]),
+            mat(&case["C"]),
+            mat(&case["D"]),
+        );
         // The fixtures write the seed-004 inputs as [B2, 0] with feedthrough [0, D]; split them.
         let (e, dv) = if name.starts_with("seed004") {
             (b.columns(0, 1).into_owned(), d.columns(1, 1).into_owned())
@@ -82,6 +98,10 @@ fn invariant_zeros_match_the_rosenbrock_pencil() {
         assert!(dec.matching(), "{name}");
         let want = complex_list(&case["zeros"]);
         assert_eq!(dec.zeros.len(), want.len(), "{name}: {:?}", dec.zeros);
-        assert!(match_error(&want, &dec.zeros) < 1e-9, "{name}: {:?}", dec.zeros);
+        assert!(
+            match_error(&want, &dec.zeros) < 1e-9,
+            "{name}: {:?}",
+            dec.zeros
+        );
     }
 }

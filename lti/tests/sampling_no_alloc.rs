@@ -4,7 +4,7 @@
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use lti::signal::{in_effect, Signal};
+use lti::signal::{Signal, in_effect};
 
 struct Counting;
 
@@ -27,12 +27,22 @@ static GLOBAL: Counting = Counting;
 #[test]
 fn sampling_next_to_a_switch_does_not_allocate() {
     let signals = [
-        Signal::Step { time: 5.0000000000001, before: 0.0, after: 1.0 },
-        Signal::Piecewise { times: vec![0.0, 3.3333, 5.0, 12.5], values: vec![0.2, -0.3, 0.5, -0.1] },
+        Signal::Step {
+            time: 5.0000000000001,
+            before: 0.0,
+            after: 1.0,
+        },
+        Signal::Piecewise {
+            times: vec![0.0, 3.3333, 5.0, 12.5],
+            values: vec![0.2, -0.3, 0.5, -0.1],
+        },
     ];
     let probe = ALLOCATIONS.load(Ordering::Relaxed);
     drop(std::hint::black_box(vec![1u8; 16]));
-    assert!(ALLOCATIONS.load(Ordering::Relaxed) > probe, "the allocator counts");
+    assert!(
+        ALLOCATIONS.load(Ordering::Relaxed) > probe,
+        "the allocator counts"
+    );
     let before = ALLOCATIONS.load(Ordering::Relaxed);
     let mut sum = 0.0;
     for k in 4990..5010u64 {

@@ -6,7 +6,7 @@
 mod common;
 
 use common::{complex_list, load, mat, max_diff};
-use lti::place::{place, Method};
+use lti::place::{Method, place};
 use lti::{C64, LtiError, Poles};
 
 /// scipy's own acceptance: each achieved pole within 1e-8 absolute or relative... we ask for
@@ -22,7 +22,10 @@ fn check(requested: &[C64], achieved: &[C64], name: &str) {
             .min_by(|x, y| x.1.total_cmp(&y.1))
             .unwrap();
         used[i] = true;
-        assert!(d <= 1e-8 || d <= 1e-6 * r.norm(), "{name}: pole {r} missed by {d:e}");
+        assert!(
+            d <= 1e-8 || d <= 1e-6 * r.norm(),
+            "{name}: pole {r} missed by {d:e}"
+        );
     }
 }
 
@@ -36,15 +39,25 @@ fn every_published_case_is_placed() {
         let b = mat(&case["B"]);
         let requested = complex_list(&case["poles"]);
         let poles = Poles::from_values(&requested).unwrap();
-        let mut methods: Vec<&str> = case["methods"].as_array().unwrap().iter().map(|m| m.as_str().unwrap()).collect();
-        methods.extend(case["extra_methods"].as_array().map_or(vec![], |v| v.iter().map(|m| m.as_str().unwrap()).collect()));
+        let mut methods: Vec<&str> = case["methods"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|m| m.as_str().unwrap())
+            .collect();
+        methods.extend(
+            case["extra_methods"]
+                .as_array()
+                .map_or(vec![], |v| v.iter().map(|m| m.as_str().unwrap()).collect()),
+        );
         for m in methods {
             let method = match m {
                 "YT" => Method::YangTits,
                 "KNV0" => Method::Knv0,
                 other => panic!("unknown method {other}"),
             };
-            let placed = place(&a, &b, &poles, method).unwrap_or_else(|e| panic!("{name} {m}: {e}"));
+            let placed =
+                place(&a, &b, &poles, method).unwrap_or_else(|e| panic!("{name} {m}: {e}"));
             check(&requested, &placed.achieved, &format!("{name} {m}"));
             runs += 1;
         }
@@ -64,16 +77,32 @@ fn every_published_case_is_placed() {
 fn real_pole_gains_match_scipy() {
     let fx = load("tests/fixtures/scipy_place_poles.json");
     let mut compared = 0;
-    for name in ["test_real/KNV_example1", "test_real/repeated_2_2_3_3", "docstring/KNV_example1"] {
-        let case = fx["cases"].as_array().unwrap().iter().find(|c| c["name"] == name).unwrap();
+    for name in [
+        "test_real/KNV_example1",
+        "test_real/repeated_2_2_3_3",
+        "docstring/KNV_example1",
+    ] {
+        let case = fx["cases"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["name"] == name)
+            .unwrap();
         let (a, b) = (mat(&case["A"]), mat(&case["B"]));
         let poles = Poles::from_values(&complex_list(&case["poles"])).unwrap();
         for (m, method) in [("YT", Method::YangTits), ("KNV0", Method::Knv0)] {
             let want = mat(&case["scipy_gain"][m]);
             let got = place(&a, &b, &poles, method).unwrap();
             let d = max_diff(&got.gain, &want);
-            assert!(d <= 1e-8 * want.norm(), "{name} {m}: gain differs from scipy's by {d:e}");
-            assert_eq!(Some(got.sweeps as u64), case["scipy_nb_iter"][m].as_u64(), "{name} {m} sweeps");
+            assert!(
+                d <= 1e-8 * want.norm(),
+                "{name} {m}: gain differs from scipy's by {d:e}"
+            );
+            assert_eq!(
+                Some(got.sweeps as u64),
+                case["scipy_nb_iter"][m].as_u64(),
+                "{name} {m} sweeps"
+            );
             compared += 1;
         }
     }
@@ -84,15 +113,26 @@ fn real_pole_gains_match_scipy() {
 fn the_cases_scipy_refuses_are_refused() {
     let fx = load("tests/fixtures/scipy_place_poles.json");
     let failing = fx["failing"].as_array().unwrap();
-    let get = |n: &str| failing.iter().find(|c| c["name"] == n).unwrap_or_else(|| panic!("no case {n}"));
+    let get = |n: &str| {
+        failing
+            .iter()
+            .find(|c| c["name"] == n)
+            .unwrap_or_else(|| panic!("no case {n}"))
+    };
 
     let c = get("multiplicity_greater_than_rank_B");
     let poles = Poles::from_values(&complex_list(&c["poles"])).unwrap();
-    assert!(matches!(place(&mat(&c["A"]), &mat(&c["B"]), &poles, Method::YangTits), Err(LtiError::InvalidPoles(_))));
+    assert!(matches!(
+        place(&mat(&c["A"]), &mat(&c["B"]), &poles, Method::YangTits),
+        Err(LtiError::InvalidPoles(_))
+    ));
 
     let c = get("uncontrollable");
     let poles = Poles::from_values(&complex_list(&c["poles"])).unwrap();
-    assert!(matches!(place(&mat(&c["A"]), &mat(&c["B"]), &poles, Method::YangTits), Err(LtiError::NotAssignable { .. })));
+    assert!(matches!(
+        place(&mat(&c["A"]), &mat(&c["B"]), &poles, Method::YangTits),
+        Err(LtiError::NotAssignable { .. })
+    ));
 
     let c = get("complex_without_conjugate");
     assert!(Poles::from_values(&complex_list(&c["poles"])).is_err());
@@ -100,6 +140,9 @@ fn the_cases_scipy_refuses_are_refused() {
     for n in ["too_many_poles", "not_enough_poles"] {
         let c = get(n);
         let poles = Poles::from_values(&complex_list(&c["poles"])).unwrap();
-        assert!(matches!(place(&mat(&c["A"]), &mat(&c["B"]), &poles, Method::YangTits), Err(LtiError::InvalidPoles(_))));
+        assert!(matches!(
+            place(&mat(&c["A"]), &mat(&c["B"]), &poles, Method::YangTits),
+            Err(LtiError::InvalidPoles(_))
+        ));
     }
 }

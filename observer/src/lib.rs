@@ -7,5 +7,5 @@ mod lmi;
 pub mod runtime;
 pub mod shell;
 
-pub use design::{design, Designed, DesignError, Report, Spec};
+pub use design::{DesignError, Designed, Report, Spec, design};
 pub use runtime::{LinearObserver, ObserverState};

@@ -9,9 +9,11 @@
 //! its matrix, column by column, off-diagonal entries scaled by √2; YD = 0 is a zero cone.
 
 use clarabel::algebra::CscMatrix;
-use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
-use lti::pinv::pinv;
+use clarabel::solver::{
+    DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
+};
 use lti::Mat;
+use lti::pinv::pinv;
 
 use crate::design::LmiSolution;
 
@@ -21,7 +23,11 @@ fn svec(m: &Mat) -> Vec<f64> {
     let mut out = Vec::with_capacity(n * (n + 1) / 2);
     for j in 0..n {
         for i in 0..=j {
-            out.push(if i == j { m[(i, j)] } else { m[(i, j)] * std::f64::consts::SQRT_2 });
+            out.push(if i == j {
+                m[(i, j)]
+            } else {
+                m[(i, j)] * std::f64::consts::SQRT_2
+            });
         }
     }
     out
@@ -54,7 +60,9 @@ pub fn solve(a1: &Mat, c: &Mat, d: &Mat, decay: f64) -> Result<LmiSolution, Stri
         }
         (pm, ym)
     };
-    let lmi = |pm: &Mat, ym: &Mat| a1.transpose() * pm + pm * a1 - c.transpose() * ym.transpose() - ym * c + pm * decay;
+    let lmi = |pm: &Mat, ym: &Mat| {
+        a1.transpose() * pm + pm * a1 - c.transpose() * ym.transpose() - ym * c + pm * decay
+    };
     let rows = 2 * np + n * r;
     let mut dense = vec![vec![0.0; nvar]; rows];
     for v in 0..nvar {
@@ -78,14 +86,24 @@ pub fn solve(a1: &Mat, c: &Mat, d: &Mat, decay: f64) -> Result<LmiSolution, Stri
     let a = CscMatrix::from(&dense);
     let q = vec![0.0; nvar];
     let pq = CscMatrix::zeros((nvar, nvar));
-    let mut cones = vec![SupportedConeT::PSDTriangleConeT(n), SupportedConeT::PSDTriangleConeT(n)];
+    let mut cones = vec![
+        SupportedConeT::PSDTriangleConeT(n),
+        SupportedConeT::PSDTriangleConeT(n),
+    ];
     if n * r > 0 {
         cones.push(SupportedConeT::ZeroConeT(n * r));
     }
-    let settings = DefaultSettingsBuilder::default().verbose(false).build().map_err(|e| e.to_string())?;
-    let mut solver = DefaultSolver::new(&pq, &q, &a, &b, &cones, settings).map_err(|e| format!("{e:?}"))?;
+    let settings = DefaultSettingsBuilder::default()
+        .verbose(false)
+        .build()
+        .map_err(|e| e.to_string())?;
+    let mut solver =
+        DefaultSolver::new(&pq, &q, &a, &b, &cones, settings).map_err(|e| format!("{e:?}"))?;
     solver.solve();
-    if !matches!(solver.solution.status, SolverStatus::Solved | SolverStatus::AlmostSolved) {
+    if !matches!(
+        solver.solution.status,
+        SolverStatus::Solved | SolverStatus::AlmostSolved
+    ) {
         return Err(format!("Clarabel: {:?}", solver.solution.status));
     }
     let x = &solver.solution.x;

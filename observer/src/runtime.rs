@@ -14,8 +14,8 @@
 //! step): it first advances z_{k−1} → z_k with the stored y_{k−1}, then forms x̂_k. All buffers are
 //! allocated at construction; `step` does not allocate.
 
-use lti::kernel::{copy, mul_acc, mul_into};
 use lti::MatData;
+use lti::kernel::{copy, mul_acc, mul_into};
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
@@ -39,8 +39,21 @@ pub struct LinearObserver {
 
 impl LinearObserver {
     /// From the five matrices.
-    pub fn new(f: &DMatrix<f64>, g: &DMatrix<f64>, k: &DMatrix<f64>, p: &DMatrix<f64>, q: &DMatrix<f64>) -> Self {
-        Self { f: f.into(), g: g.into(), k: k.into(), p: p.into(), q: q.into(), xhat0: None }
+    pub fn new(
+        f: &DMatrix<f64>,
+        g: &DMatrix<f64>,
+        k: &DMatrix<f64>,
+        p: &DMatrix<f64>,
+        q: &DMatrix<f64>,
+    ) -> Self {
+        Self {
+            f: f.into(),
+            g: g.into(),
+            k: k.into(),
+            p: p.into(),
+            q: q.into(),
+            xhat0: None,
+        }
     }
 
     /// Observer order r (size of z).
@@ -72,9 +85,18 @@ impl LinearObserver {
             && self.p.cols == r
             && self.q.rows == self.p.rows
             && self.q.cols == self.k.cols
-            && [&self.f, &self.g, &self.k, &self.p, &self.q].iter().all(|m| m.data.len() == m.rows * m.cols)
-            && self.xhat0.as_ref().is_none_or(|x| x.len() == self.p.rows && x.iter().all(|v| v.is_finite()));
-        if ok { Ok(()) } else { Err("observer matrices do not conform".into()) }
+            && [&self.f, &self.g, &self.k, &self.p, &self.q]
+                .iter()
+                .all(|m| m.data.len() == m.rows * m.cols)
+            && self
+                .xhat0
+                .as_ref()
+                .is_none_or(|x| x.len() == self.p.rows && x.iter().all(|v| v.is_finite()));
+        if ok {
+            Ok(())
+        } else {
+            Err("observer matrices do not conform".into())
+        }
     }
 
     /// A runnable instance with zero initial state.
@@ -90,7 +112,8 @@ impl LinearObserver {
         if !g_zero {
             fgk.columns_mut(r, l).copy_from(&DMatrix::from(&self.g));
         }
-        fgk.columns_mut(r + l, self.outputs()).copy_from(&DMatrix::from(&self.k));
+        fgk.columns_mut(r + l, self.outputs())
+            .copy_from(&DMatrix::from(&self.k));
         ObserverState {
             p_identity: p.is_square() && p == DMatrix::identity(p.nrows(), p.ncols()),
             q_zero: zero(&self.q),
@@ -102,7 +125,10 @@ impl LinearObserver {
             z_next: vec![0.0; r],
             xhat: vec![0.0; self.states()],
             started: false,
-            start: self.xhat0.as_ref().map(|x0| (x0.clone(), lti::pinv::pinv(&p))),
+            start: self
+                .xhat0
+                .as_ref()
+                .map(|x0| (x0.clone(), lti::pinv::pinv(&p))),
         }
     }
 }
@@ -190,7 +216,13 @@ mod tests {
         assert_eq!(s.step(&[3.0], &[0.0]), &[7.0]); // z0 = 7 − 6 = 1
         assert_eq!(s.step(&[1.0], &[10.0]), &[15.5]); // z1 = 0.5 + 10 + 3, x̂ = 13.5 + 2
         let col = |a: f64, b: f64| DMatrix::from_column_slice(2, 1, &[a, b]);
-        let mut obs = LinearObserver::new(&one(0.5), &one(0.0), &one(1.0), &col(1.0, 1.0), &col(0.0, 1.0));
+        let mut obs = LinearObserver::new(
+            &one(0.5),
+            &one(0.0),
+            &one(1.0),
+            &col(1.0, 1.0),
+            &col(0.0, 1.0),
+        );
         obs.xhat0 = Some(vec![4.0, 2.0]);
         let mut s = obs.instantiate();
         // z0 = P⁺([4, 2] − [0, 1]) = (4 + 1)/2 = 2.5: x̂_0 = [2.5, 3.5].

@@ -6,8 +6,8 @@
 //! values i·n … (i+1)·n). A bank then costs one subscriber of the plant's samples and one
 //! process, whatever its size, instead of one of each per member.
 
-use lockstep::component::{Component, ComponentConfig, Inputs, StepError};
 use lockstep::PlantLayout;
+use lockstep::component::{Component, ComponentConfig, Inputs, StepError};
 use serde::{Deserialize, Serialize};
 
 use crate::{LinearObserver, ObserverState};
@@ -39,10 +39,21 @@ impl Component for ObserverComponent {
         for o in &run.observers {
             o.check()?;
             if o.states() != run.layout.n {
-                return Err(format!("params: an observer estimates {} states, the plant has {}", o.states(), run.layout.n));
+                return Err(format!(
+                    "params: an observer estimates {} states, the plant has {}",
+                    o.states(),
+                    run.layout.n
+                ));
             }
         }
-        Ok(ObserverComponent { obs: run.observers.iter().map(LinearObserver::instantiate).collect(), layout: run.layout })
+        Ok(ObserverComponent {
+            obs: run
+                .observers
+                .iter()
+                .map(LinearObserver::instantiate)
+                .collect(),
+            layout: run.layout,
+        })
     }
 
     fn step(&mut self, _k: u64, inputs: &Inputs, out: &mut [f64]) -> Result<(), StepError> {

@@ -2,8 +2,8 @@
 //! computed independently with numpy/scipy/python-control/cvxpy).
 
 use lti::place::Method;
-use lti::{Mat, Model, PoleSpec, Poles, C64};
-use observer::design::{design, Gain, Path, Spec};
+use lti::{C64, Mat, Model, PoleSpec, Poles};
+use observer::design::{Gain, Path, Spec, design};
 use serde_json::Value;
 
 #[path = "../../fixtures/reader.rs"]
@@ -15,7 +15,11 @@ fn real(v: &[f64]) -> Poles {
 }
 
 fn matrix<'a>(r: &'a observer::Report, name: &str) -> &'a Mat {
-    &r.matrices.iter().find(|(n, _)| n == name).unwrap_or_else(|| panic!("no matrix {name}")).1
+    &r.matrices
+        .iter()
+        .find(|(n, _)| n == name)
+        .unwrap_or_else(|| panic!("no matrix {name}"))
+        .1
 }
 
 fn close(a: &Mat, b: &Mat, tol: f64) -> bool {
@@ -28,13 +32,21 @@ fn eig_close(got: &[C64], want: &[C64], tol: f64) -> bool {
 
 fn seed002() -> Model {
     let m = &seeds()["seed_002"]["model"];
-    Model { a: mat(&m["A"]), b: mat(&m["B"]), c: mat(&m["C"]), e: mat(&m["E"]), d: Mat::zeros(2, 0) }
+    Model {
+        a: mat(&m["A"]),
+        b: mat(&m["B"]),
+        c: mat(&m["C"]),
+        e: mat(&m["E"]),
+        d: Mat::zeros(2, 0),
+    }
 }
 
 #[test]
 fn seed002_chen_patton_matlab_mode() {
     let s = &seeds()["seed_002"];
-    let spec = Spec::ChenPatton { gain: Gain::place(real(&[-1.0, -2.0, -3.0]), Method::Matlab) };
+    let spec = Spec::ChenPatton {
+        gain: Gain::place(real(&[-1.0, -2.0, -3.0]), Method::Matlab),
+    };
     let d = design(&seed002(), &spec, 1e-3).unwrap();
     let r = &d.report;
     let h = Mat::from_row_slice(3, 2, &[16.0, 4.0, 0.0, 0.0, 4.0, 1.0]) / 17.0;
@@ -43,16 +55,31 @@ fn seed002_chen_patton_matlab_mode() {
     assert!(close(matrix(r, "T"), &t, 1e-12));
     for name in ["K1", "K2", "F"] {
         let want = mat(&s["design"][name]);
-        assert!(close(matrix(r, name), &want, 1e-9), "{name}:\n{}", matrix(r, name));
+        assert!(
+            close(matrix(r, name), &want, 1e-9),
+            "{name}:\n{}",
+            matrix(r, name)
+        );
         // The assignment prints each matrix truncated (not rounded) to two decimals.
         let printed = mat(&s["printed"][name]);
         let truncated = matrix(r, name).map(|x| (x * 100.0).trunc() / 100.0);
         assert!(close(&truncated, &printed, 1e-12), "{name} printed");
     }
-    assert!(eig_close(&r.poles, &[C64::new(-3.0, 0.0), C64::new(-2.0, 0.0), C64::new(-1.0, 0.0)], 1e-9));
+    assert!(eig_close(
+        &r.poles,
+        &[
+            C64::new(-3.0, 0.0),
+            C64::new(-2.0, 0.0),
+            C64::new(-1.0, 0.0)
+        ],
+        1e-9
+    ));
     assert!(r.conditions.iter().all(|c| c.ok));
     // Sampled: eig(F_d) = e^{p·dt}.
-    let want: Vec<C64> = [-1.0f64, -2.0, -3.0].iter().map(|p| C64::new((p * 1e-3).exp(), 0.0)).collect();
+    let want: Vec<C64> = [-1.0f64, -2.0, -3.0]
+        .iter()
+        .map(|p| C64::new((p * 1e-3).exp(), 0.0))
+        .collect();
     assert!(eig_close(&d.report.discrete_poles, &want, 1e-12));
 }
 
@@ -61,7 +88,9 @@ fn seed002_sampled_observer_rejects_held_disturbance_exactly() {
     // T_d E_d = 0: run the sampled plant with a held disturbance and check ‖e_k‖ = ‖F_d^k e_0‖.
     let model = seed002();
     let dt = 1e-2;
-    let spec = Spec::ChenPatton { gain: Gain::place(real(&[-1.0, -2.0, -3.0]), Method::YangTits) };
+    let spec = Spec::ChenPatton {
+        gain: Gain::place(real(&[-1.0, -2.0, -3.0]), Method::YangTits),
+    };
     let obs = design(&model, &spec, dt).unwrap().runtime;
     let dm = model.discretize(dt);
     let mut state = obs.instantiate();
@@ -73,7 +102,10 @@ fn seed002_sampled_observer_rejects_held_disturbance_exactly() {
         let xhat = state.step(y.as_slice(), &u_prev).to_vec();
         let err = (&x - nalgebra::DVector::from_vec(xhat)).amax();
         if k > 1500 {
-            assert!(err < 1e-5 && err <= last_err * 1.0001, "k = {k}: error {err}");
+            assert!(
+                err < 1e-5 && err <= last_err * 1.0001,
+                "k = {k}: error {err}"
+            );
         }
         last_err = err;
         let w = if (k / 100) % 2 == 0 { 3.0 } else { -5.0 };
@@ -89,8 +121,16 @@ fn seed002_sampled_observer_rejects_held_disturbance_exactly() {
 fn seed001_gi_full_order_matlab_gain() {
     let s = &seeds()["seed_001"];
     let m = &s["model"];
-    let model = Model { a: mat(&m["A"]), b: mat(&m["B"]), c: mat(&m["C"]), e: Mat::zeros(4, 0), d: Mat::zeros(2, 0) };
-    let spec = Spec::GiFullOrder { gain: Gain::place(real(&[-47.0, -52.0, -600.0, -700.0]), Method::Matlab) };
+    let model = Model {
+        a: mat(&m["A"]),
+        b: mat(&m["B"]),
+        c: mat(&m["C"]),
+        e: Mat::zeros(4, 0),
+        d: Mat::zeros(2, 0),
+    };
+    let spec = Spec::GiFullOrder {
+        gain: Gain::place(real(&[-47.0, -52.0, -600.0, -700.0]), Method::Matlab),
+    };
     let r = design(&model, &spec, 1e-4).unwrap().report;
     let k = matrix(&r, "K");
     let printed = [[13.0, 510.0, 445.0, 79934.0], [3.0, 23.0, 20.0, 95.0]];
@@ -99,19 +139,47 @@ fn seed001_gi_full_order_matlab_gain() {
             assert_eq!(k[(i, j)].abs().round(), p);
         }
     }
-    let want: Vec<C64> = [-700.0, -600.0, -52.0, -47.0].iter().map(|&p| C64::new(p, 0.0)).collect();
+    let want: Vec<C64> = [-700.0, -600.0, -52.0, -47.0]
+        .iter()
+        .map(|&p| C64::new(p, 0.0))
+        .collect();
     assert!(eig_close(&r.poles, &want, 1e-9), "{:?}", r.poles);
-    assert!(close(matrix(&r, "F"), &mat(&s["design"]["A - KCA"]), 1e-6 * 3e4));
+    assert!(close(
+        matrix(&r, "F"),
+        &mat(&s["design"]["A - KCA"]),
+        1e-6 * 3e4
+    ));
 }
 
 #[test]
 fn seed003_dgo_and_cumming_coincide_with_the_reference() {
     let s = &seeds()["seed_003"];
     let m = &s["model"];
-    let model = Model { a: mat(&m["A"]), b: mat(&m["B"]), c: mat(&m["C"]), e: Mat::zeros(4, 0), d: Mat::zeros(2, 0) };
+    let model = Model {
+        a: mat(&m["A"]),
+        b: mat(&m["B"]),
+        c: mat(&m["C"]),
+        e: Mat::zeros(4, 0),
+        d: Mat::zeros(2, 0),
+    };
     let poles = real(&[-8.0, -9.0]);
-    let dgo = design(&model, &Spec::DasGhosal { gain: Gain::place(poles.clone(), Method::YangTits) }, 1e-3).unwrap();
-    let cum = design(&model, &Spec::Cumming { gain: Gain::place(poles, Method::YangTits), h: None }, 1e-3).unwrap();
+    let dgo = design(
+        &model,
+        &Spec::DasGhosal {
+            gain: Gain::place(poles.clone(), Method::YangTits),
+        },
+        1e-3,
+    )
+    .unwrap();
+    let cum = design(
+        &model,
+        &Spec::Cumming {
+            gain: Gain::place(poles, Method::YangTits),
+            h: None,
+        },
+        1e-3,
+    )
+    .unwrap();
     let dg = &s["DGO"];
     assert!(close(matrix(&dgo.report, "L"), &mat(&dg["L"]), 0.0));
     assert!(close(matrix(&dgo.report, "Lg"), &mat(&dg["Lg"]), 1e-15));
@@ -126,10 +194,20 @@ fn seed003_dgo_and_cumming_coincide_with_the_reference() {
     assert!(close(matrix(&dgo.report, "F"), &f, 1e-12));
     assert!(close(matrix(&cum.report, "HAF-KCAF"), &f, 1e-12));
     assert!(close(matrix(&cum.report, "K"), k, 1e-12));
-    assert!(eig_close(&dgo.report.poles, &[C64::new(-9.0, 0.0), C64::new(-8.0, 0.0)], 1e-12));
+    assert!(eig_close(
+        &dgo.report.poles,
+        &[C64::new(-9.0, 0.0), C64::new(-8.0, 0.0)],
+        1e-12
+    ));
     // Same sampled observers, so the same estimates.
     let (a, b) = (&dgo.runtime, &cum.runtime);
-    for (x, y) in [(&a.f, &b.f), (&a.g, &b.g), (&a.k, &b.k), (&a.p, &b.p), (&a.q, &b.q)] {
+    for (x, y) in [
+        (&a.f, &b.f),
+        (&a.g, &b.g),
+        (&a.k, &b.k),
+        (&a.p, &b.p),
+        (&a.q, &b.q),
+    ] {
         assert!(close(&x.into(), &y.into(), 1e-12));
     }
 }
@@ -137,7 +215,13 @@ fn seed003_dgo_and_cumming_coincide_with_the_reference() {
 fn seed000() -> (Model, Value) {
     let s = seeds()["seed_000"].clone();
     let m = &s["model_primary_open_loop"];
-    let model = Model { a: mat(&m["A"]), b: mat(&m["B"]), c: mat(&m["C"]), e: mat(&m["Ed"]), d: Mat::zeros(2, 0) };
+    let model = Model {
+        a: mat(&m["A"]),
+        b: mat(&m["B"]),
+        c: mat(&m["C"]),
+        e: mat(&m["Ed"]),
+        d: Mat::zeros(2, 0),
+    };
     (model, s)
 }
 
@@ -145,30 +229,66 @@ fn seed000() -> (Model, Value) {
 fn seed000_das_ghosal_uio_with_printed_h() {
     let (model, s) = seed000();
     let h = Mat::from_row_slice(2, 2, &[0.8, 1.0, 1.0, 0.8]);
-    let spec = Spec::DasGhosalUio { h: Some(h), gain: None };
+    let spec = Spec::DasGhosalUio {
+        h: Some(h),
+        gain: None,
+    };
     let r = design(&model, &spec, 1e-4).unwrap().report;
-    assert!(close(matrix(&r, "K"), &Mat::from_row_slice(2, 2, &[-0.1, 0.1, 0.1, -0.1]), 1e-15));
-    assert!(close(matrix(&r, "F"), &mat(&s["design"]["F = LgAL - KCAL"]), 1e-9));
-    let eq21 = r.conditions.iter().find(|c| c.name.contains("eq. 21")).unwrap();
+    assert!(close(
+        matrix(&r, "K"),
+        &Mat::from_row_slice(2, 2, &[-0.1, 0.1, 0.1, -0.1]),
+        1e-15
+    ));
+    assert!(close(
+        matrix(&r, "F"),
+        &mat(&s["design"]["F = LgAL - KCAL"]),
+        1e-9
+    ));
+    let eq21 = r
+        .conditions
+        .iter()
+        .find(|c| c.name.contains("eq. 21"))
+        .unwrap();
     assert!(eq21.ok);
-    let want = [C64::new(-84.260701456554, 127.95943208702), C64::new(-84.260701456554, -127.95943208702)];
+    let want = [
+        C64::new(-84.260701456554, 127.95943208702),
+        C64::new(-84.260701456554, -127.95943208702),
+    ];
     assert!(eig_close(&r.poles, &want, 1e-11), "{:?}", r.poles);
 }
 
 #[test]
 fn seed000_das_ghosal_uio_h_by_placement() {
     let (model, _) = seed000();
-    let spec = Spec::DasGhosalUio { h: None, gain: Some(Gain::place(real(&[-100.0, -120.0]), Method::YangTits)) };
+    let spec = Spec::DasGhosalUio {
+        h: None,
+        gain: Some(Gain::place(real(&[-100.0, -120.0]), Method::YangTits)),
+    };
     let d = design(&model, &spec, 1e-4).unwrap();
     let want = [C64::new(-120.0, 0.0), C64::new(-100.0, 0.0)];
-    assert!(eig_close(&d.report.poles, &want, 1e-9), "{:?}", d.report.poles);
+    assert!(
+        eig_close(&d.report.poles, &want, 1e-9),
+        "{:?}",
+        d.report.poles
+    );
     // Still decoupled: LgEd − KCEd = 0.
-    assert!(d.report.conditions.iter().any(|c| c.name.contains("eq. 20") && c.ok));
+    assert!(
+        d.report
+            .conditions
+            .iter()
+            .any(|c| c.name.contains("eq. 20") && c.ok)
+    );
 }
 
 fn seed004() -> Model {
     let m = &seeds()["seed_004"]["model"];
-    Model { a: mat(&m["A"]), b: Mat::zeros(3, 1), c: mat(&m["C"]), e: mat(&m["B2"]), d: mat(&m["D"]) }
+    Model {
+        a: mat(&m["A"]),
+        b: Mat::zeros(3, 1),
+        c: mat(&m["C"]),
+        e: mat(&m["B2"]),
+        d: mat(&m["D"]),
+    }
 }
 
 #[test]
@@ -185,22 +305,44 @@ fn seed004_hui_zak_lmi_path() {
 #[cfg(not(feature = "lmi"))]
 #[test]
 fn seed004_lmi_path_needs_the_feature() {
-    let spec = Spec::HuiZak { decay: 0.05, gain: None, placement: Method::YangTits, path: Path::Lmi };
+    let spec = Spec::HuiZak {
+        decay: 0.05,
+        gain: None,
+        placement: Method::YangTits,
+        path: Path::Lmi,
+    };
     let err = design(&seed004(), &spec, 1e-3).unwrap_err();
     assert!(err.detail.contains("lmi"), "{err}");
 }
 
 fn seed004_hui_zak(path: Path) {
     let s = &seeds()["seed_004"];
-    let spec = Spec::HuiZak { decay: 0.05, gain: None, placement: Method::YangTits, path };
+    let spec = Spec::HuiZak {
+        decay: 0.05,
+        gain: None,
+        placement: Method::YangTits,
+        path,
+    };
     let r = design(&seed004(), &spec, 1e-3).unwrap().report;
     assert!(close(matrix(&r, "M"), &mat(&s["design"]["M"]), 1e-12));
-    assert!(close(matrix(&r, "A1"), &mat(&s["design"]["A1=(I-MC)A"]), 1e-12));
+    assert!(close(
+        matrix(&r, "A1"),
+        &mat(&s["design"]["A1=(I-MC)A"]),
+        1e-12
+    ));
     let l = matrix(&r, "L");
     let d = Mat::from_row_slice(2, 1, &[1.0, 2.0]);
     assert!((l * &d).amax() < 1e-12);
     let root7 = 7f64.sqrt();
-    assert!(eig_close(&r.fixed_modes, &[C64::new(-0.5, -root7), C64::new(-0.5, root7)], 1e-9), "{:?}", r.fixed_modes);
+    assert!(
+        eig_close(
+            &r.fixed_modes,
+            &[C64::new(-0.5, -root7), C64::new(-0.5, root7)],
+            1e-9
+        ),
+        "{:?}",
+        r.fixed_modes
+    );
     let free: Vec<_> = r.poles.iter().filter(|z| z.im == 0.0).collect();
     assert_eq!(free.len(), 1);
     assert!(free[0].re < -0.025);
@@ -208,7 +350,11 @@ fn seed004_hui_zak(path: Path) {
     // (A_d, B2_d, C, D), which sit within ~1e-9 of e^{(−0.5 ± j√7)·dt} (in s, within ~1e-6 of
     // −0.5 ± j√7) — and places the free pole at e^{p·dt}.
     let images: Vec<C64> = r.poles.iter().map(|z| (z * 1e-3).exp()).collect();
-    assert!(eig_close(&r.discrete_poles, &images, 1e-8), "{:?} vs {images:?}", r.discrete_poles);
+    assert!(
+        eig_close(&r.discrete_poles, &images, 1e-8),
+        "{:?} vs {images:?}",
+        r.discrete_poles
+    );
     let p = matrix(&r, "P");
     assert!(lti::lyapunov::min_eigenvalue(p) >= 0.01 - 1e-12);
     assert!(r.conditions.iter().all(|c| c.ok), "{:?}", r.conditions);
@@ -220,7 +366,14 @@ fn existence_conditions_refuse_with_the_condition_named() {
     let mut m = seed002();
     m.e = Mat::from_row_slice(3, 2, &[1.0, 0.0, 0.0, 1.0, 0.0, 0.0]);
     m.c = Mat::from_row_slice(1, 3, &[1.0, 0.0, 0.0]);
-    let err = design(&m, &Spec::ChenPatton { gain: Gain::place(real(&[-1.0, -2.0, -3.0]), Method::YangTits) }, 1e-3).unwrap_err();
+    let err = design(
+        &m,
+        &Spec::ChenPatton {
+            gain: Gain::place(real(&[-1.0, -2.0, -3.0]), Method::YangTits),
+        },
+        1e-3,
+    )
+    .unwrap_err();
     assert_eq!(err.condition, "rank(CE) = rank(E)");
     // An unstable invariant zero (+1) of (A, E, C).
     let m = Model {
@@ -230,9 +383,20 @@ fn existence_conditions_refuse_with_the_condition_named() {
         e: Mat::from_row_slice(2, 1, &[0.0, 1.0]),
         d: Mat::zeros(1, 0),
     };
-    let err = design(&m, &Spec::ChenPatton { gain: Gain::place(real(&[-1.0]), Method::YangTits) }, 1e-3).unwrap_err();
+    let err = design(
+        &m,
+        &Spec::ChenPatton {
+            gain: Gain::place(real(&[-1.0]), Method::YangTits),
+        },
+        1e-3,
+    )
+    .unwrap_err();
     assert_eq!(err.condition, "invariant zeros of (A, E, C) stable");
-    assert!(err.detail.contains('1') && err.detail.contains("(TA, C) is not detectable"), "{}", err.detail);
+    assert!(
+        err.detail.contains('1') && err.detail.contains("(TA, C) is not detectable"),
+        "{}",
+        err.detail
+    );
     // (A, CA) with an unobservable unstable mode: the generalized-inverse observer is refused.
     let m = Model {
         a: Mat::from_row_slice(2, 2, &[0.0, 1.0, 0.0, 0.0]),
@@ -241,7 +405,14 @@ fn existence_conditions_refuse_with_the_condition_named() {
         e: Mat::zeros(2, 0),
         d: Mat::zeros(1, 0),
     };
-    let err = design(&m, &Spec::GiFullOrder { gain: Gain::place(real(&[-1.0, -2.0]), Method::YangTits) }, 1e-3).unwrap_err();
+    let err = design(
+        &m,
+        &Spec::GiFullOrder {
+            gain: Gain::place(real(&[-1.0, -2.0]), Method::YangTits),
+        },
+        1e-3,
+    )
+    .unwrap_err();
     assert_eq!(err.condition, "(A, CA) detectable");
 }
 
@@ -250,7 +421,12 @@ fn seed004_sampled_observer_rejects_held_disturbances_exactly() {
     // x_{k+1} = A_d x_k + B2d w_k, y_k = C x_k + D v_k with w, v arbitrary but held.
     let model = seed004();
     let dt = 1e-3;
-    let spec = Spec::HuiZak { decay: 0.05, gain: None, placement: Method::YangTits, path: Path::Placement };
+    let spec = Spec::HuiZak {
+        decay: 0.05,
+        gain: None,
+        placement: Method::YangTits,
+        path: Path::Placement,
+    };
     let obs = design(&model, &spec, dt).unwrap().runtime;
     let dm = model.discretize(dt);
     let mut state = obs.instantiate();
@@ -267,5 +443,8 @@ fn seed004_sampled_observer_rejects_held_disturbances_exactly() {
         let w = if (k / 500) % 2 == 0 { 1.0 } else { -2.0 };
         x = &dm.a * &x + &dm.e * w;
     }
-    assert!(worst_late < 1e-9, "relative error late in the run: {worst_late:e}");
+    assert!(
+        worst_late < 1e-9,
+        "relative error late in the run: {worst_late:e}"
+    );
 }

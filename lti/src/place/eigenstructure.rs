@@ -55,7 +55,12 @@ impl Eigenstructure {
             let q = full_qr(&mj.adjoint()).q; // n×n
             s.push(q.columns(n - m, m).into_owned());
         }
-        Ok(Self { poles: poles.to_vec(), u0, z, s })
+        Ok(Self {
+            poles: poles.to_vec(),
+            u0,
+            z,
+            s,
+        })
     }
 
     /// Index of the conjugate partner of pole j, if it is complex.
@@ -92,7 +97,9 @@ impl Eigenstructure {
         let xl = x * lambda;
         // M = (XΛ) X⁻¹  ⇔  Xᵀ Mᵀ = (XΛ)ᵀ.
         let lu = x.transpose().lu();
-        let mt = lu.solve(&xl.transpose()).ok_or(LtiError::Singular("the eigenvector matrix X"))?;
+        let mt = lu
+            .solve(&xl.transpose())
+            .ok_or(LtiError::Singular("the eigenvector matrix X"))?;
         let m_real = mt.transpose().map(|v| v.re);
         if m_real.iter().any(|v| !v.is_finite()) {
             return Err(LtiError::Singular("the eigenvector matrix X"));

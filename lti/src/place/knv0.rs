@@ -14,7 +14,7 @@
 
 use nalgebra::DMatrix;
 
-use super::eigenstructure::{abs_det, Eigenstructure};
+use super::eigenstructure::{Eigenstructure, abs_det};
 use crate::eig::C64;
 use crate::householder::full_qr;
 

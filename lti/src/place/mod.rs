@@ -20,10 +20,10 @@ use nalgebra::DMatrix;
 
 pub use ackermann::{ackermann, characteristic_polynomial};
 pub use eigenstructure::Eigenstructure;
-pub use knv0::{knv0, Sweeps};
+pub use knv0::{Sweeps, knv0};
 pub use yang_tits::yang_tits;
 
-use crate::eig::{eigenvalues, format_list, match_error, C64};
+use crate::eig::{C64, eigenvalues, format_list, match_error};
 use crate::error::{LtiError, Result};
 use crate::pinv::rank;
 use crate::poles::Poles;
@@ -62,8 +62,20 @@ pub fn place(a: &DMatrix<f64>, b: &DMatrix<f64>, poles: &Poles, method: Method) 
 }
 
 /// L with eig(A − LC) = poles (placement on the dual pair (Aᵀ, Cᵀ)).
-pub fn place_observer(a: &DMatrix<f64>, c: &DMatrix<f64>, poles: &Poles, method: Method) -> Result<Placed> {
-    let mut p = place_pair(&a.transpose(), &c.transpose(), poles, method, "(A, C)", "observable")?;
+pub fn place_observer(
+    a: &DMatrix<f64>,
+    c: &DMatrix<f64>,
+    poles: &Poles,
+    method: Method,
+) -> Result<Placed> {
+    let mut p = place_pair(
+        &a.transpose(),
+        &c.transpose(),
+        poles,
+        method,
+        "(A, C)",
+        "observable",
+    )?;
     p.gain = p.gain.transpose();
     Ok(p)
 }
@@ -87,7 +99,11 @@ fn place_pair(
         )));
     }
     if poles.len() != n {
-        return Err(LtiError::InvalidPoles(format!("{} poles given for {} states", poles.len(), n)));
+        return Err(LtiError::InvalidPoles(format!(
+            "{} poles given for {} states",
+            poles.len(),
+            n
+        )));
     }
     // A B of rank n makes the pair controllable: the staircase, a large model's costliest step,
     // is only needed below that.
@@ -121,7 +137,11 @@ fn place_pair(
         )));
     }
     // The robust methods take the poles as scipy orders them (real ascending, then pairs).
-    let ordered = if matches!(method, Method::Knv0 | Method::YangTits) { scipy_order(poles.values()) } else { poles.values().to_vec() };
+    let ordered = if matches!(method, Method::Knv0 | Method::YangTits) {
+        scipy_order(poles.values())
+    } else {
+        poles.values().to_vec()
+    };
     let values = &ordered[..];
     // κ(X) of the closed loop's eigenvectors, where the method chose them: how far the
     // placed spectrum is from what rounding can hold (the achieved poles move by up to κ·ε·‖A‖).
@@ -142,7 +162,14 @@ fn place_pair(
         Method::Knv0 => {
             let es = Eigenstructure::new(a, &b_used, values)?;
             let x0 = initial_x(&es, true);
-            let (x, sweeps) = knv0(&es, x0, Sweeps::UntilConverged { rtol: 1e-3, max: 30 });
+            let (x, sweeps) = knv0(
+                &es,
+                x0,
+                Sweeps::UntilConverged {
+                    rtol: 1e-3,
+                    max: 30,
+                },
+            );
             (es.gain(a, &x)?, sweeps, Some(kappa(&x)))
         }
         Method::YangTits => {
@@ -161,11 +188,23 @@ fn place_pair(
     if error.is_nan() || error > PLACEMENT_RTOL {
         let mut how = format!("max |gain entry| {}", crate::eig::sig(gain.amax()));
         if let Some(c) = cond {
-            how.push_str(&format!(", eigenvector condition number κ(X) = {}", crate::eig::sig(c)));
+            how.push_str(&format!(
+                ", eigenvector condition number κ(X) = {}",
+                crate::eig::sig(c)
+            ));
         }
-        return Err(LtiError::PlacementMissed { requested: format_list(values), achieved: format_list(&achieved), error, how });
+        return Err(LtiError::PlacementMissed {
+            requested: format_list(values),
+            achieved: format_list(&achieved),
+            error,
+            how,
+        });
     }
-    Ok(Placed { gain, achieved, sweeps })
+    Ok(Placed {
+        gain,
+        achieved,
+        sweeps,
+    })
 }
 
 /// K = B⁻¹(A − Λ_R) for an invertible B, with Λ_R block-diagonal: a real pole on the diagonal,
@@ -185,7 +224,10 @@ fn direct(a: &DMatrix<f64>, b: &DMatrix<f64>, values: &[C64]) -> Result<DMatrix<
         }
         i += 1;
     }
-    b.clone().lu().solve(&(a - lambda)).ok_or(LtiError::Singular("B"))
+    b.clone()
+        .lu()
+        .solve(&(a - lambda))
+        .ok_or(LtiError::Singular("B"))
 }
 
 /// Initial eigenvectors: the first basis vector of each 𝒮ⱼ (MATLAB), or, for the robust
@@ -195,7 +237,11 @@ fn initial_x(es: &Eigenstructure, summed: bool) -> DMatrix<C64> {
     let n = es.poles.len();
     let mut x = DMatrix::<C64>::zeros(n, n);
     for j in 0..n {
-        let v = if summed { es.s[j].column_sum() } else { es.s[j].column(0).into_owned() };
+        let v = if summed {
+            es.s[j].column_sum()
+        } else {
+            es.s[j].column(0).into_owned()
+        };
         let norm = v.norm();
         x.set_column(j, &(v / C64::new(norm, 0.0)));
     }
@@ -208,7 +254,9 @@ fn scipy_order(values: &[C64]) -> Vec<C64> {
     real.sort_by(|a, b| a.re.total_cmp(&b.re));
     let mut upper: Vec<C64> = values.iter().copied().filter(|p| p.im > 0.0).collect();
     upper.sort_by(|a, b| a.re.total_cmp(&b.re).then(b.im.total_cmp(&a.im)));
-    real.into_iter().chain(upper.into_iter().flat_map(|p| [p, p.conj()])).collect()
+    real.into_iter()
+        .chain(upper.into_iter().flat_map(|p| [p, p.conj()]))
+        .collect()
 }
 
 #[cfg(test)]
@@ -225,10 +273,15 @@ mod tests {
         let a = DMatrix::from_row_slice(3, 3, &[0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 1.0, 2.0, 3.0]);
         let b = DMatrix::from_row_slice(3, 1, &[0.0, 0.0, 1.0]);
         let p = poles(&[-1.0, -2.0, -3.0]);
-        let gains: Vec<_> = [Method::Ackermann, Method::Matlab, Method::Knv0, Method::YangTits]
-            .iter()
-            .map(|&m| place(&a, &b, &p, m).unwrap().gain)
-            .collect();
+        let gains: Vec<_> = [
+            Method::Ackermann,
+            Method::Matlab,
+            Method::Knv0,
+            Method::YangTits,
+        ]
+        .iter()
+        .map(|&m| place(&a, &b, &p, m).unwrap().gain)
+        .collect();
         // Single input: the gain is unique, so all methods agree.
         for g in &gains[1..] {
             assert!((g - &gains[0]).norm() < 1e-9 * gains[0].norm());

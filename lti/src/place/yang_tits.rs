@@ -18,14 +18,19 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::eigenstructure::{abs_det, Eigenstructure};
+use super::eigenstructure::{Eigenstructure, abs_det};
 use super::knv0::converged;
 use crate::eig::C64;
 use crate::householder::qr_q_columns;
 
 /// Runs Tits–Yang sweeps from X until |det X| settles (scipy's rule), at most `max` sweeps.
 /// The poles in `es` must be ordered real first, then complex pairs.
-pub fn yang_tits(es: &Eigenstructure, mut x: DMatrix<C64>, rtol: f64, max: usize) -> (DMatrix<C64>, usize) {
+pub fn yang_tits(
+    es: &Eigenstructure,
+    mut x: DMatrix<C64>,
+    rtol: f64,
+    max: usize,
+) -> (DMatrix<C64>, usize) {
     let n = x.nrows();
     if n <= 1 || es.s.first().is_none_or(|s| s.ncols() <= 1) {
         return (x, 0); // single input: X is already unique
@@ -62,12 +67,19 @@ enum Update {
 /// The visiting order of one sweep (Algorithm 1 of the paper, scipy's indexing).
 fn schedule(es: &Eigenstructure) -> Vec<Update> {
     let real = es.poles.iter().take_while(|p| p.im == 0.0).count();
-    let pairs: Vec<Update> = (real..es.poles.len()).step_by(2).map(Update::ComplexPair).collect();
+    let pairs: Vec<Update> = (real..es.poles.len())
+        .step_by(2)
+        .map(Update::ComplexPair)
+        .collect();
     let (h, o) = (real / 2, real % 2);
     // 1-based (i, j) → update, wrapping j past R as the paper does.
     let pair = |i: usize, j: usize| {
         let j = if j > real { j - real } else { j };
-        if i == j { Update::Single(i - 1) } else { Update::RealPair(i - 1, j - 1) }
+        if i == j {
+            Update::Single(i - 1)
+        } else {
+            Update::RealPair(i - 1, j - 1)
+        }
     };
     let interlude = |out: &mut Vec<Update>| {
         if h == 0 && real > 0 {
@@ -129,7 +141,10 @@ fn complement(x: &DMatrix<C64>, i: usize, j: usize) -> (DVector<f64>, DVector<f6
         parts.set_column(2 * c + 1, &q2.column(c).map(|e| e.im));
     }
     let basis = crate::subspace::range(&parts);
-    (basis.column(0).into_owned(), basis.column(1.min(basis.ncols() - 1)).into_owned())
+    (
+        basis.column(0).into_owned(),
+        basis.column(1.min(basis.ncols() - 1)).into_owned(),
+    )
 }
 
 /// numpy's `allclose` for two scalars.
@@ -147,19 +162,27 @@ fn real_pair(es: &Eigenstructure, x: &mut DMatrix<C64>, i: usize, j: usize) {
     let sj = es.s[j].map(|e| e.re);
     let skew = &a * b.transpose() - &b * a.transpose();
     let svd = (si.transpose() * skew * &sj).svd(true, true);
-    let (Some(u), Some(vt)) = (svd.u, svd.v_t) else { return };
+    let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
+        return;
+    };
     let sv = &svd.singular_values;
     let tie = sv.len() > 1 && close(sv[0], sv[1]);
     let k = if tie { 2 } else { 1 };
     // G = blockdiag(𝒮ᵢ, 𝒮ⱼ)·[μ; ν] with k columns; w = [xᵢ; xⱼ]; t = G Gᵀ w.
     let mut g = DMatrix::<f64>::zeros(2 * n, k);
-    g.view_mut((0, 0), (n, k)).copy_from(&(&si * u.columns(0, k)));
-    g.view_mut((n, 0), (n, k)).copy_from(&(&sj * vt.rows(0, k).transpose()));
+    g.view_mut((0, 0), (n, k))
+        .copy_from(&(&si * u.columns(0, k)));
+    g.view_mut((n, 0), (n, k))
+        .copy_from(&(&sj * vt.rows(0, k).transpose()));
     let mut w = DVector::<f64>::zeros(2 * n);
     w.rows_mut(0, n).copy_from(&x.column(i).map(|e| e.re));
     w.rows_mut(n, n).copy_from(&x.column(j).map(|e| e.re));
     let t = &g * (g.transpose() * w);
-    let t = if t.amax() > 1e-8 { t.normalize() * 2f64.sqrt() } else { g.column(0).into_owned() };
+    let t = if t.amax() > 1e-8 {
+        t.normalize() * 2f64.sqrt()
+    } else {
+        g.column(0).into_owned()
+    };
     es.set(x, i, &t.rows(0, n).map(|e| C64::new(e, 0.0)));
     es.set(x, j, &t.rows(n, n).map(|e| C64::new(e, 0.0)));
 }
@@ -175,13 +198,25 @@ fn complex_pair(es: &Eigenstructure, x: &mut DMatrix<C64>, i: usize) {
     // M is Hermitian: real eigenvalues; order them by modulus.
     let eig = m.symmetric_eigen();
     let mut idx: Vec<usize> = (0..eig.eigenvalues.len()).collect();
-    idx.sort_by(|&p, &q| eig.eigenvalues[q].abs().total_cmp(&eig.eigenvalues[p].abs()));
+    idx.sort_by(|&p, &q| {
+        eig.eigenvalues[q]
+            .abs()
+            .total_cmp(&eig.eigenvalues[p].abs())
+    });
     let tie = idx.len() > 1 && close(eig.eigenvalues[idx[0]].abs(), eig.eigenvalues[idx[1]].abs());
-    let cols: Vec<_> = idx.iter().take(if tie { 2 } else { 1 }).map(|&c| eig.eigenvectors.column(c).into_owned()).collect();
+    let cols: Vec<_> = idx
+        .iter()
+        .take(if tie { 2 } else { 1 })
+        .map(|&c| eig.eigenvectors.column(c).into_owned())
+        .collect();
     let g = s * DMatrix::from_columns(&cols);
     let w = x.column(i).into_owned();
     let t = &g * (g.adjoint() * w);
-    let v = if t.norm() > 1e-8 { t.normalize() } else { g.column(0).into_owned() };
+    let v = if t.norm() > 1e-8 {
+        t.normalize()
+    } else {
+        g.column(0).into_owned()
+    };
     es.set(x, i, &v);
 }
 
@@ -190,12 +225,19 @@ mod tests {
     use super::*;
 
     fn order(real: usize, pairs: usize) -> Vec<(usize, usize)> {
-        let mut poles: Vec<C64> = (0..real).map(|k| C64::new(-(k as f64) - 1.0, 0.0)).collect();
+        let mut poles: Vec<C64> = (0..real)
+            .map(|k| C64::new(-(k as f64) - 1.0, 0.0))
+            .collect();
         for k in 0..pairs {
             poles.push(C64::new(-1.0, k as f64 + 1.0));
             poles.push(C64::new(-1.0, -(k as f64) - 1.0));
         }
-        let es = Eigenstructure { poles, u0: DMatrix::zeros(0, 0), z: DMatrix::zeros(0, 0), s: vec![] };
+        let es = Eigenstructure {
+            poles,
+            u0: DMatrix::zeros(0, 0),
+            z: DMatrix::zeros(0, 0),
+            s: vec![],
+        };
         schedule(&es)
             .into_iter()
             .map(|u| match u {
@@ -208,12 +250,40 @@ mod tests {
 
     #[test]
     fn visiting_order_matches_the_algorithm() {
-        assert_eq!(order(4, 0), [(4, 1), (2, 3), (1, 2), (3, 4), (1, 3), (2, 4)]);
+        assert_eq!(
+            order(4, 0),
+            [(4, 1), (2, 3), (1, 2), (3, 4), (1, 3), (2, 4)]
+        );
         assert_eq!(
             order(5, 0),
-            [(5, 1), (2, 3), (4, 5), (1, 2), (3, 4), (1, 3), (2, 4), (3, 5), (4, 1), (5, 2), (1, 3), (2, 4)]
+            [
+                (5, 1),
+                (2, 3),
+                (4, 5),
+                (1, 2),
+                (3, 4),
+                (1, 3),
+                (2, 4),
+                (3, 5),
+                (4, 1),
+                (5, 2),
+                (1, 3),
+                (2, 4)
+            ]
         );
-        assert_eq!(order(2, 1), [(2, 1), (3, 4), (1, 2), (3, 4), (3, 4), (3, 4), (1, 2), (3, 4)]);
+        assert_eq!(
+            order(2, 1),
+            [
+                (2, 1),
+                (3, 4),
+                (1, 2),
+                (3, 4),
+                (3, 4),
+                (3, 4),
+                (1, 2),
+                (3, 4)
+            ]
+        );
         assert_eq!(order(1, 2).len(), 15);
         assert_eq!(order(0, 1), vec![(1, 2); 5]);
     }

@@ -15,9 +15,12 @@
 use lti::eig::format_list;
 use lti::pinv::{pinv, rank};
 use lti::zeros::decoupling;
-use lti::{Discrete, Mat, Model, C64};
+use lti::{C64, Discrete, Mat, Model};
 
-use super::{eig, eq_detail, free_gain, require_stable, sampled_report, Checks, Designed, DesignError, Domain, Gain, Pair, Report};
+use super::{
+    Checks, DesignError, Designed, Domain, Gain, Pair, Report, eig, eq_detail, free_gain,
+    require_stable, sampled_report,
+};
 use crate::runtime::LinearObserver;
 
 const KIND: &str = "chen-patton-uio";
@@ -46,8 +49,14 @@ pub(super) fn core(
     let ce = c * e;
     let (r_ce, r_e) = (rank(&ce), rank(e));
     checks.require("rank(CE) = rank(E)", r_ce == r_e, eq_detail(r_ce, r_e))?;
-    let zeros = decoupling(a, e, c, &Mat::zeros(c.nrows(), 0)).map_err(|err| checks.error("invariant zeros", err.to_string()))?;
-    let unstable: Vec<C64> = zeros.zeros.iter().copied().filter(|&z| !domain.stable(z)).collect();
+    let zeros = decoupling(a, e, c, &Mat::zeros(c.nrows(), 0))
+        .map_err(|err| checks.error("invariant zeros", err.to_string()))?;
+    let unstable: Vec<C64> = zeros
+        .zeros
+        .iter()
+        .copied()
+        .filter(|&z| !domain.stable(z))
+        .collect();
     checks.require(
         "invariant zeros of (A, E, C) stable",
         unstable.is_empty(),
@@ -66,26 +75,73 @@ pub(super) fn core(
     let h = e * pinv(&ce);
     let t = Mat::identity(n, n) - &h * c;
     let ta = &t * a;
-    let (k1, fixed) = free_gain(checks, &Pair::full(&ta, c, "(TA, C)"), gain, carried, domain)?;
+    let (k1, fixed) = free_gain(
+        checks,
+        &Pair::full(&ta, c, "(TA, C)"),
+        gain,
+        carried,
+        domain,
+    )?;
     let f = &ta - &k1 * c;
     require_stable(checks, "F = TA − K1C stable", &eig(&f), domain)?;
     let k2 = &f * &h;
-    Ok(Core { h, t, k1, k2, f, fixed })
+    Ok(Core {
+        h,
+        t,
+        k1,
+        k2,
+        f,
+        fixed,
+    })
 }
 
-pub(super) fn design(model: Option<&Model>, dm: &Discrete, gain: &Gain) -> Result<Designed, DesignError> {
+pub(super) fn design(
+    model: Option<&Model>,
+    dm: &Discrete,
+    gain: &Gain,
+) -> Result<Designed, DesignError> {
     let dt = dm.dt;
     let mut checks = Checks::new(KIND);
     let ct = match model.filter(|_| !gain.is_lqe()) {
-        Some(model) => Some(core(&model.a, &model.c, &model.e, gain, &[], Domain::Continuous, &mut checks)?),
+        Some(model) => Some(core(
+            &model.a,
+            &model.c,
+            &model.e,
+            gain,
+            &[],
+            Domain::Continuous,
+            &mut checks,
+        )?),
         None => None,
     };
     let carried = ct.as_ref().map(|c| c.fixed.clone()).unwrap_or_default();
     let mut sampled = Checks::sampled(KIND, dt);
-    let d = core(&dm.a, &dm.c, &dm.e, gain, &carried, Domain::Discrete(dt), &mut sampled)?;
+    let d = core(
+        &dm.a,
+        &dm.c,
+        &dm.e,
+        gain,
+        &carried,
+        Domain::Discrete(dt),
+        &mut sampled,
+    )?;
     let n = dm.a.nrows();
-    let runtime = LinearObserver::new(&d.f, &(&d.t * &dm.b), &(&d.k1 + &d.k2), &Mat::identity(n, n), &d.h);
-    let matrices = |c: &Core| vec![("H".into(), c.h.clone()), ("T".into(), c.t.clone()), ("K1".into(), c.k1.clone()), ("K2".into(), c.k2.clone()), ("F".into(), c.f.clone())];
+    let runtime = LinearObserver::new(
+        &d.f,
+        &(&d.t * &dm.b),
+        &(&d.k1 + &d.k2),
+        &Mat::identity(n, n),
+        &d.h,
+    );
+    let matrices = |c: &Core| {
+        vec![
+            ("H".into(), c.h.clone()),
+            ("T".into(), c.t.clone()),
+            ("K1".into(), c.k1.clone()),
+            ("K2".into(), c.k2.clone()),
+            ("F".into(), c.f.clone()),
+        ]
+    };
     let report = match ct {
         Some(ct) => Report {
             kind: KIND,
@@ -97,7 +153,19 @@ pub(super) fn design(model: Option<&Model>, dm: &Discrete, gain: &Gain) -> Resul
             notes: vec![],
             sampled_only: false,
         },
-        None => sampled_report(KIND, sampled, &d.f, d.fixed.clone(), matrices(&d), vec![], dt),
+        None => sampled_report(
+            KIND,
+            sampled,
+            &d.f,
+            d.fixed.clone(),
+            matrices(&d),
+            vec![],
+            dt,
+        ),
     };
-    Ok(Designed { report, runtime, what: None })
+    Ok(Designed {
+        report,
+        runtime,
+        what: None,
+    })
 }

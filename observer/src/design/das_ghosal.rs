@@ -1,6 +1,6 @@
 //! Das & Ghosal's reduced-order observer (1981) and its unknown-input form (seed 000,
-//! eqs. 14–23). With Cᵍ the Moore–Penrose inverse and L the independent columns of I − CᵍC
-//! (so LLᵍ = I − CᵍC, eq. 11), every state is x = Cᵍy + Lh (eq. 14) and
+//! eqs. 14–23). With Cᵍ the Moore–Penrose inverse and L a basis of ker C with LLᵍ = I − CᵍC
+//! (eq. 11), every state is x = Cᵍy + Lh (eq. 14) and
 //!
 //! ```text
 //! q̇ = (LᵍAL − KCAL) q + [(LᵍAL − KCAL)K + LᵍACᵍ − KCACᵍ] y + (LᵍB − KCB) u     (eq. 23)
@@ -18,14 +18,24 @@
 //! order does not conform). H is free: given, or chosen here so that F has the requested poles,
 //! F = (LᵍAL − K₀CAL) − H·ΠCAL with K₀ = (LᵍE_d)(CE_d)ᵍ, Π = I − CE_d(CE_d)ᵍ.
 //!
+//! L is the orthonormal basis [`lti::subspace::kernel_basis`]: n − rank C columns for any C
+//! (the dimension from the SVD's rank rule), the coordinate vectors the paper picks where ker C
+//! is spanned by them (C = [I 0] → L = [0; I]), and Lᵍ = Lᵀ. (The paper's "independent columns of
+//! I − CᵍC", picked one at a time with a rank test, gave L too many columns on general C when
+//! two columns agreed to rounding: a rank-deficient L and a silently divergent observer.)
+//!
 //! Sampled counterpart: x_{k+1} = A_d x_k + …, y_{k+1} − CA_dCᵍy_k − CB_du_k = CA_dLh_k + CE_dw_k
 //! plays the role of ẏ, and the same equations hold with (A_d, B_d, E_d): q_{k+1} = F_d q_k + …,
 //! x̂_k = Lq_k + (Cᵍ + LK_d)y_k.
 
-use lti::pinv::{pinv, rank};
-use lti::{Discrete, Mat, Model, C64};
+use lti::pinv::pinv;
+use lti::subspace::kernel_basis;
+use lti::{C64, Discrete, Mat, Model};
 
-use super::{eig, free_gain, require_stable, sampled_report, Checks, Designed, DesignError, Domain, Gain, Pair, Report};
+use super::{
+    Checks, DesignError, Designed, Domain, Gain, Pair, Report, eig, free_gain, require_stable,
+    sampled_report,
+};
 use crate::runtime::LinearObserver;
 
 /// How K is chosen.
@@ -35,21 +45,6 @@ pub(super) enum Free {
     Gain(Gain),
     /// The UIO's free matrix H of eq. 22.
     H(Mat),
-}
-
-/// The independent columns of I − CᵍC, left to right: a basis L of ker C with LLᵍ = I − CᵍC.
-pub fn independent_columns_of_complement(c: &Mat) -> Mat {
-    let n = c.ncols();
-    let p = Mat::identity(n, n) - pinv(c) * c;
-    let mut cols: Vec<nalgebra::DVector<f64>> = Vec::new();
-    for j in 0..n {
-        let mut trial: Vec<_> = cols.clone();
-        trial.push(p.column(j).into_owned());
-        if rank(&Mat::from_columns(&trial)) == trial.len() {
-            cols = trial;
-        }
-    }
-    if cols.is_empty() { Mat::zeros(n, 0) } else { Mat::from_columns(&cols) }
 }
 
 /// The design in one domain.
@@ -80,8 +75,8 @@ pub(super) fn core(
     checks: &mut Checks,
 ) -> Result<Core, DesignError> {
     let cg = pinv(c);
-    let l = independent_columns_of_complement(c);
-    let lg = pinv(&l);
+    let l = kernel_basis(c);
+    let lg = l.transpose(); // L orthonormal: Lᵍ = Lᵀ
     let r = l.ncols();
     let lgal = &lg * a * &l;
     let cal = c * a * &l;
@@ -91,18 +86,34 @@ pub(super) fn core(
         let ced_g = pinv(&ced);
         let lge = &lg * e;
         let res21 = &lge - &lge * &ced_g * &ced;
-        let scale = lge.amax().max(1.0);
+        // Relative to the data: ‖LᵍE_d‖ ≤ ‖E_d‖ for an orthonormal L, so the scale is E_d's own
+        // (a scale from Lᵍ let a residual of 1.6e-2 pass as 1e-15 of a 1e13 Lᵍ).
+        let scale = e.amax();
+        let tol = 1e-10 * scale;
         checks.require(
             "LgEd − LgEd(CEd)g(CEd) = 0 (eq. 21)",
-            res21.amax() <= 1e-10 * scale,
-            format!("max |residual| = {:.3e}", res21.amax()),
+            res21.amax() <= tol,
+            format!(
+                "max |residual| = {:.3e} (tolerance 1e-10·max|Ed| = {:.3e})",
+                res21.amax(),
+                tol
+            ),
         )?;
         let k0 = &lge * &ced_g;
         let pi = Mat::identity(c.nrows(), c.nrows()) - &ced * &ced_g;
         let (h, fixed) = match gain {
             Free::H(h) => {
                 if h.shape() != (r, c.nrows()) {
-                    return Err(checks.error("H", format!("is {}×{}, must be {}×{}", h.nrows(), h.ncols(), r, c.nrows())));
+                    return Err(checks.error(
+                        "H",
+                        format!(
+                            "is {}×{}, must be {}×{}",
+                            h.nrows(),
+                            h.ncols(),
+                            r,
+                            c.nrows()
+                        ),
+                    ));
                 }
                 (h.clone(), Vec::new())
             }
@@ -110,29 +121,60 @@ pub(super) fn core(
                 let at = &lgal - &k0 * &cal;
                 let ct = &pi * &cal;
                 notes.push("H placed on the pair (LgAL − K0·CAL, Π·CAL)".to_string());
-                let pair = Pair { a: &at, c: &ct, name: "(LgAL − K0CAL, ΠCAL)", state_map: Some(&lg), output_map: None };
+                let pair = Pair {
+                    a: &at,
+                    c: &ct,
+                    name: "(LgAL − K0CAL, ΠCAL)",
+                    state_map: Some(&lg),
+                    output_map: None,
+                };
                 free_gain(checks, &pair, g, carried, domain)?
             }
             Free::Gain(g @ Gain::Lqe(_)) => {
                 // Π = UUᵀ (an orthogonal projector): the DARE needs independent outputs, so the
                 // pair's output is UᵀCAL, and H = H̃Uᵀ gives HΠ = H̃Uᵀ as placement's H does.
                 let at = &lgal - &k0 * &cal;
-                let ut = lti::subspace::range(&pi).transpose();
+                // U from the SVD of CE_d itself (its left null space), not from the projector's
+                // SVD: Π's eigenvalues are 0 and 1 to rounding, and a basis read off it can
+                // be off by degrees or gain a spurious column.
+                let ut = lti::subspace::left_null_space(&ced);
                 let ct = &ut * &cal;
-                notes.push("H from the DARE of the pair (LgAL − K0·CAL, Uᵀ·CAL), Π = UUᵀ".to_string());
-                let pair = Pair { a: &at, c: &ct, name: "(LgAL − K0CAL, UᵀCAL)", state_map: Some(&lg), output_map: Some(&ut) };
+                notes.push(
+                    "H from the DARE of the pair (LgAL − K0·CAL, Uᵀ·CAL), Π = UUᵀ".to_string(),
+                );
+                let pair = Pair {
+                    a: &at,
+                    c: &ct,
+                    name: "(LgAL − K0CAL, UᵀCAL)",
+                    state_map: Some(&lg),
+                    output_map: Some(&ut),
+                };
                 let (ht, fixed) = free_gain(checks, &pair, g, carried, domain)?;
                 (ht * &ut, fixed)
             }
         };
         let k = k0 + h * pi;
         let res20 = &lge - &k * &ced;
-        checks.require("LgEd − KCEd = 0 (eq. 20)", res20.amax() <= 1e-10 * scale, format!("max |residual| = {:.3e}", res20.amax()))?;
+        checks.require(
+            "LgEd − KCEd = 0 (eq. 20)",
+            res20.amax() <= tol,
+            format!(
+                "max |residual| = {:.3e} (tolerance 1e-10·max|Ed| = {:.3e})",
+                res20.amax(),
+                tol
+            ),
+        )?;
         (k, fixed)
     } else {
         match gain {
             Free::Gain(g) => {
-                let pair = Pair { a: &lgal, c: &cal, name: "(LgAL, CAL)", state_map: Some(&lg), output_map: None };
+                let pair = Pair {
+                    a: &lgal,
+                    c: &cal,
+                    name: "(LgAL, CAL)",
+                    state_map: Some(&lg),
+                    output_map: None,
+                };
                 free_gain(checks, &pair, g, carried, domain)?
             }
             Free::H(_) => return Err(checks.error("H", "only the unknown-input form takes H")),
@@ -142,24 +184,66 @@ pub(super) fn core(
     require_stable(checks, "F = LgAL − KCAL stable", &eig(&f), domain)?;
     let ky = &f * &k + &lg * a * &cg - &k * c * a * &cg;
     let ku = &lg * b - &k * c * b;
-    Ok(Core { cg, l, lg, k, f, ky, ku, fixed, notes })
+    Ok(Core {
+        cg,
+        l,
+        lg,
+        k,
+        f,
+        ky,
+        ku,
+        fixed,
+        notes,
+    })
 }
 
-pub(super) fn design(model: Option<&Model>, dm: &Discrete, gain: Free, uio: bool) -> Result<Designed, DesignError> {
+pub(super) fn design(
+    model: Option<&Model>,
+    dm: &Discrete,
+    gain: Free,
+    uio: bool,
+) -> Result<Designed, DesignError> {
     let dt = dm.dt;
     let kind = if uio { "das-ghosal-uio" } else { "das-ghosal" };
     let mut checks = Checks::new(kind);
     let lqe = matches!(&gain, Free::Gain(g) if g.is_lqe());
     let ct = match model.filter(|_| !lqe) {
-        Some(model) => Some(core(&model.a, &model.b, &model.c, &model.e, &gain, uio, &[], Domain::Continuous, &mut checks)?),
+        Some(model) => Some(core(
+            &model.a,
+            &model.b,
+            &model.c,
+            &model.e,
+            &gain,
+            uio,
+            &[],
+            Domain::Continuous,
+            &mut checks,
+        )?),
         None => None,
     };
     let carried = ct.as_ref().map(|c| c.fixed.clone()).unwrap_or_default();
     let mut sampled = Checks::sampled(kind, dt);
-    let d = core(&dm.a, &dm.b, &dm.c, &dm.e, &gain, uio, &carried, Domain::Discrete(dt), &mut sampled)?;
+    let d = core(
+        &dm.a,
+        &dm.b,
+        &dm.c,
+        &dm.e,
+        &gain,
+        uio,
+        &carried,
+        Domain::Discrete(dt),
+        &mut sampled,
+    )?;
     let q = &d.cg + &d.l * &d.k;
     let runtime = LinearObserver::new(&d.f, &d.ku, &d.ky, &d.l, &q);
-    let matrices = |c: &Core| vec![("L".into(), c.l.clone()), ("Lg".into(), c.lg.clone()), ("K".into(), c.k.clone()), ("F".into(), c.f.clone())];
+    let matrices = |c: &Core| {
+        vec![
+            ("L".into(), c.l.clone()),
+            ("Lg".into(), c.lg.clone()),
+            ("K".into(), c.k.clone()),
+            ("F".into(), c.f.clone()),
+        ]
+    };
     let report = match ct {
         Some(ct) => {
             let mut notes = ct.notes.clone();
@@ -177,7 +261,19 @@ pub(super) fn design(model: Option<&Model>, dm: &Discrete, gain: Free, uio: bool
                 sampled_only: false,
             }
         }
-        None => sampled_report(kind, sampled, &d.f, d.fixed.clone(), matrices(&d), d.notes.clone(), dt),
+        None => sampled_report(
+            kind,
+            sampled,
+            &d.f,
+            d.fixed.clone(),
+            matrices(&d),
+            d.notes.clone(),
+            dt,
+        ),
     };
-    Ok(Designed { report, runtime, what: None })
+    Ok(Designed {
+        report,
+        runtime,
+        what: None,
+    })
 }

@@ -16,16 +16,19 @@
 //! do under placement. Nothing is placed, so the design scales with the model (O(n³) per
 //! doubling step) where placing hundreds of poles with few outputs is ill-posed.
 //!
-//! Weights: Q and R default to identities of the pair's sizes. A weight given for the plant —
-//! Q n×n, R p×p, from the observer's keys or from the scenario's `[noise]` — is carried to a
-//! pair whose state is T x and whose output is M y as T Q Tᵀ and M R Mᵀ.
+//! Weights: a weight given for the plant — Q n×n, R p×p, from the observer's keys or from the
+//! scenario's `[noise]` — is carried to a pair whose state is T x and whose output is M y as
+//! T Q Tᵀ and M R Mᵀ; one given at the pair's size is used as it is. Without one, Q and R are the
+//! plant's identities carried the same way, T Tᵀ and M Mᵀ, so the default does not depend on the
+//! basis a family picks for its pair (for the orthonormal bases of Das–Ghosal's L and the
+//! DG-UIO's U they are identities; for Cumming's observer with a given H, H Hᵀ).
 
 use lti::eig::{format_list, sig};
 use lti::place::Method;
 use lti::staircase::observability_staircase;
-use lti::{steady_state_kalman, Mat, Poles, C64};
+use lti::{C64, Mat, Poles, steady_state_kalman};
 
-use super::{place_detectable, Checks, DesignError, Domain};
+use super::{Checks, DesignError, Domain, place_detectable};
 
 /// The free gain of an observer family.
 #[derive(Debug, Clone, PartialEq)]
@@ -72,7 +75,13 @@ pub(crate) struct Pair<'a> {
 impl<'a> Pair<'a> {
     /// A pair on the plant's own state and outputs.
     pub fn full(a: &'a Mat, c: &'a Mat, name: &'a str) -> Self {
-        Pair { a, c, name, state_map: None, output_map: None }
+        Pair {
+            a,
+            c,
+            name,
+            state_map: None,
+            output_map: None,
+        }
     }
 }
 
@@ -87,20 +96,41 @@ pub(crate) fn free_gain(
     domain: Domain,
 ) -> Result<(Mat, Vec<C64>), DesignError> {
     match (gain, domain) {
-        (Gain::Place { poles, method }, _) => place_detectable(checks, pair.a, pair.c, poles, carried, *method, pair.name, domain),
+        (Gain::Place { poles, method }, _) => place_detectable(
+            checks, pair.a, pair.c, poles, carried, *method, pair.name, domain,
+        ),
         (Gain::Lqe(w), Domain::Discrete(_)) => lqe(checks, pair, w),
-        (Gain::Lqe(_), Domain::Continuous) => Err(checks.error("gain", "an LQE gain is designed on the sampled pair only (a design bug)")),
+        (Gain::Lqe(_), Domain::Continuous) => Err(checks.error(
+            "gain",
+            "an LQE gain is designed on the sampled pair only (a design bug)",
+        )),
     }
 }
 
 fn lqe(checks: &mut Checks, pair: &Pair, w: &Weights) -> Result<(Mat, Vec<C64>), DesignError> {
     let (m, k) = (pair.a.nrows(), pair.c.nrows());
-    let q = weight(checks, "Q", w.q.as_ref(), m, pair.state_map, "the pair's order")?;
-    let r = weight(checks, "R", w.r.as_ref(), k, pair.output_map, "the pair's output count")?;
+    let q = weight(
+        checks,
+        "Q",
+        w.q.as_ref(),
+        m,
+        pair.state_map,
+        "the pair's order",
+    )?;
+    let r = weight(
+        checks,
+        "R",
+        w.r.as_ref(),
+        k,
+        pair.output_map,
+        "the pair's output count",
+    )?;
     let fixed = if k == 0 {
         lti::eig::eigenvalues(pair.a).unwrap_or_default()
     } else if lti::pinv::rank(pair.c) < m {
-        observability_staircase(pair.a, pair.c).unobservable_modes().map_err(|e| checks.error(pair.name, e.to_string()))?
+        observability_staircase(pair.a, pair.c)
+            .unobservable_modes()
+            .map_err(|e| checks.error(pair.name, e.to_string()))?
     } else {
         Vec::new()
     };
@@ -108,12 +138,29 @@ fn lqe(checks: &mut Checks, pair: &Pair, w: &Weights) -> Result<(Mat, Vec<C64>),
         Mat::zeros(m, 0)
     } else {
         let kf = steady_state_kalman(pair.a, pair.c, &q, &r).map_err(|e| {
-            checks.error(&format!("DARE(Φ1ᵀ, C1ᵀ, Q, R) on {} has a stabilising solution", pair.name), e.to_string())
+            checks.error(
+                &format!(
+                    "DARE(Φ1ᵀ, C1ᵀ, Q, R) on {} has a stabilising solution",
+                    pair.name
+                ),
+                e.to_string(),
+            )
         })?;
         checks.require(
-            &format!("DARE(Φ1ᵀ, C1ᵀ, Q, R) on {} has a stabilising solution", pair.name),
+            &format!(
+                "DARE(Φ1ᵀ, C1ᵀ, Q, R) on {} has a stabilising solution",
+                pair.name
+            ),
             true,
-            format!("ρ(Φ1 − KC1) = {}{}", sig(kf.radius), if fixed.is_empty() { String::new() } else { format!(", fixed modes {}", format_list(&fixed)) }),
+            format!(
+                "ρ(Φ1 − KC1) = {}{}",
+                sig(kf.radius),
+                if fixed.is_empty() {
+                    String::new()
+                } else {
+                    format!(", fixed modes {}", format_list(&fixed))
+                }
+            ),
         )?;
         kf.predictor_gain
     };
@@ -121,10 +168,25 @@ fn lqe(checks: &mut Checks, pair: &Pair, w: &Weights) -> Result<(Mat, Vec<C64>),
     Ok((gain, fixed))
 }
 
-/// A weight at the pair's size: identity when not given, as given when it has the pair's size,
+/// A weight at the pair's size: the plant's identity carried (T Tᵀ) when not given, as given when it has the pair's size,
 /// T W Tᵀ when it has the plant's size and the pair maps it by T.
-fn weight(checks: &Checks, name: &str, given: Option<&Mat>, size: usize, map: Option<&Mat>, what: &str) -> Result<Mat, DesignError> {
-    let Some(wm) = given else { return Ok(Mat::identity(size, size)) };
+fn weight(
+    checks: &Checks,
+    name: &str,
+    given: Option<&Mat>,
+    size: usize,
+    map: Option<&Mat>,
+    what: &str,
+) -> Result<Mat, DesignError> {
+    let Some(wm) = given else {
+        return Ok(match map {
+            Some(t) => {
+                let carried = t * t.transpose();
+                (&carried + carried.transpose()) * 0.5
+            }
+            None => Mat::identity(size, size),
+        });
+    };
     if wm.shape() == (size, size) {
         return Ok(wm.clone());
     }
@@ -134,8 +196,17 @@ fn weight(checks: &Checks, name: &str, given: Option<&Mat>, size: usize, map: Op
             Ok((&mapped + mapped.transpose()) * 0.5)
         }
         _ => {
-            let plant = map.map(|t| format!(" or {0}×{0}", t.ncols())).unwrap_or_default();
-            Err(checks.error(name, format!("is {}×{}, must be {size}×{size} ({what}){plant}", wm.nrows(), wm.ncols())))
+            let plant = map
+                .map(|t| format!(" or {0}×{0}", t.ncols()))
+                .unwrap_or_default();
+            Err(checks.error(
+                name,
+                format!(
+                    "is {}×{}, must be {size}×{size} ({what}){plant}",
+                    wm.nrows(),
+                    wm.ncols()
+                ),
+            ))
         }
     }
 }

@@ -15,31 +15,65 @@
 use lti::pinv::rank;
 use lti::{Discrete, Mat, Model};
 
-use super::{eig, free_gain, require_stable, sampled_report, Checks, Designed, DesignError, Domain, Gain, Pair, Report};
+use super::{
+    Checks, DesignError, Designed, Domain, Gain, Pair, Report, eig, free_gain, require_stable,
+    sampled_report,
+};
 use crate::runtime::LinearObserver;
 
 const KIND: &str = "gi-full-order";
 
-fn core(a: &Mat, c: &Mat, gain: &Gain, carried: &[lti::C64], domain: Domain, checks: &mut Checks) -> Result<(Mat, Mat, Vec<lti::C64>), DesignError> {
+fn core(
+    a: &Mat,
+    c: &Mat,
+    gain: &Gain,
+    carried: &[lti::C64],
+    domain: Domain,
+    checks: &mut Checks,
+) -> Result<(Mat, Mat, Vec<lti::C64>), DesignError> {
     let ca = c * a;
     // The pair's output is CA·x = ẏ − CBu (or y_{k+1} − CB_du_k): an R given for y weights it.
-    let (k, fixed) = free_gain(checks, &Pair::full(a, &ca, "(A, CA)"), gain, carried, domain)?;
+    let (k, fixed) = free_gain(
+        checks,
+        &Pair::full(a, &ca, "(A, CA)"),
+        gain,
+        carried,
+        domain,
+    )?;
     let f = a - &k * &ca;
     require_stable(checks, "F = A − KCA stable", &eig(&f), domain)?;
     Ok((k, f, fixed))
 }
 
-pub(super) fn design(model: Option<&Model>, dm: &Discrete, gain: &Gain) -> Result<Designed, DesignError> {
+pub(super) fn design(
+    model: Option<&Model>,
+    dm: &Discrete,
+    gain: &Gain,
+) -> Result<Designed, DesignError> {
     let dt = dm.dt;
     let mut checks = Checks::new(KIND);
     let n = dm.a.nrows();
     let continuous = match model.filter(|_| !gain.is_lqe()) {
-        Some(model) => Some(core(&model.a, &model.c, gain, &[], Domain::Continuous, &mut checks)?),
+        Some(model) => Some(core(
+            &model.a,
+            &model.c,
+            gain,
+            &[],
+            Domain::Continuous,
+            &mut checks,
+        )?),
         None => None,
     };
     let carried = continuous.as_ref().map(|c| c.2.clone()).unwrap_or_default();
     let mut sampled = Checks::sampled(KIND, dt);
-    let (kd, fd, fixed_d) = core(&dm.a, &dm.c, gain, &carried, Domain::Discrete(dt), &mut sampled)?;
+    let (kd, fd, fixed_d) = core(
+        &dm.a,
+        &dm.c,
+        gain,
+        &carried,
+        Domain::Discrete(dt),
+        &mut sampled,
+    )?;
     let g = &dm.b - &kd * &dm.c * &dm.b;
     let ky = &fd * &kd;
     let runtime = LinearObserver::new(&fd, &g, &ky, &Mat::identity(n, n), &kd);
@@ -47,7 +81,14 @@ pub(super) fn design(model: Option<&Model>, dm: &Discrete, gain: &Gain) -> Resul
     let notes = model
         .map(|m| {
             let ra = rank(&m.a);
-            format!("rank(A) = {ra} of {n}{}", if ra == n { " (A non-singular)" } else { " (A singular: (A, CA) checked directly)" })
+            format!(
+                "rank(A) = {ra} of {n}{}",
+                if ra == n {
+                    " (A non-singular)"
+                } else {
+                    " (A singular: (A, CA) checked directly)"
+                }
+            )
         })
         .into_iter()
         .collect();
@@ -62,7 +103,19 @@ pub(super) fn design(model: Option<&Model>, dm: &Discrete, gain: &Gain) -> Resul
             notes,
             sampled_only: false,
         },
-        None => sampled_report(KIND, sampled, &fd, fixed_d, vec![("K".into(), kd.clone()), ("F".into(), fd.clone())], notes, dt),
+        None => sampled_report(
+            KIND,
+            sampled,
+            &fd,
+            fixed_d,
+            vec![("K".into(), kd.clone()), ("F".into(), fd.clone())],
+            notes,
+            dt,
+        ),
     };
-    Ok(Designed { report, runtime, what: None })
+    Ok(Designed {
+        report,
+        runtime,
+        what: None,
+    })
 }

@@ -27,9 +27,12 @@ use lti::eig::{format_list, sig};
 use lti::lyapunov;
 use lti::place::Method;
 use lti::zeros::decoupling;
-use lti::{Discrete, Mat, Model, PoleSpec, Poles, C64};
+use lti::{C64, Discrete, Mat, Model, PoleSpec, Poles};
 
-use super::{eig, eq_detail, free_gain, require_stable, sampled_report, Checks, Designed, DesignError, Domain, Gain, Pair, Report};
+use super::{
+    Checks, DesignError, Designed, Domain, Gain, Pair, Report, eig, eq_detail, free_gain,
+    require_stable, sampled_report,
+};
 use crate::runtime::LinearObserver;
 
 const KIND: &str = "hui-zak-uio";
@@ -87,14 +90,26 @@ fn core(
 ) -> Result<Core, DesignError> {
     let n = a.nrows();
     let dec = decoupling(a, b2, c, d).map_err(|e| checks.error("decoupling", e.to_string()))?;
-    checks.require("rank[CB2 D] = rank(B2) + rank(D)", dec.matching(), eq_detail(dec.rank_ced, dec.rank_e_plus_d))?;
+    checks.require(
+        "rank[CB2 D] = rank(B2) + rank(D)",
+        dec.matching(),
+        eq_detail(dec.rank_ced, dec.rank_e_plus_d),
+    )?;
     let m = dec.m.clone();
     let proj = Mat::identity(n, n) - &m * c;
     let res_b2 = (&proj * b2).amax();
     let res_md = (&m * d).amax();
-    checks.require("(I − MC)B2 = 0, MD = 0", res_b2 <= 1e-10 && res_md <= 1e-10, format!("max |(I − MC)B2| = {res_b2:.1e}, max |MD| = {res_md:.1e}"))?;
+    checks.require(
+        "(I − MC)B2 = 0, MD = 0",
+        res_b2 <= 1e-10 && res_md <= 1e-10,
+        format!("max |(I − MC)B2| = {res_b2:.1e}, max |MD| = {res_md:.1e}"),
+    )?;
     let fixed = dec.zeros.clone();
-    let unstable: Vec<C64> = fixed.iter().copied().filter(|&z| !domain.stable(z)).collect();
+    let unstable: Vec<C64> = fixed
+        .iter()
+        .copied()
+        .filter(|&z| !domain.stable(z))
+        .collect();
     checks.require(
         "invariant zeros of (A, B2, C, D) stable",
         unstable.is_empty(),
@@ -115,17 +130,38 @@ fn core(
         (Some(l), _) => l.clone(),
         (None, Some(g)) => {
             // The pair's output is N·y (N spans the left null space of D): R given for y is NRNᵀ.
-            let pair = Pair { a: &dec.a1, c: &nc, name: "(A1, NC)", state_map: None, output_map: Some(&dec.n) };
+            let pair = Pair {
+                a: &dec.a1,
+                c: &nc,
+                name: "(A1, NC)",
+                state_map: None,
+                output_map: Some(&dec.n),
+            };
             let (lt, _) = free_gain(checks, &pair, g, carried, domain)?;
             lt * &dec.n
         }
-        (None, None) => return Err(checks.error("poles", "no free poles given (a design bug: the caller supplies the default)")),
+        (None, None) => {
+            return Err(checks.error(
+                "poles",
+                "no free poles given (a design bug: the caller supplies the default)",
+            ));
+        }
     };
     let res_ld = (&l * d).amax();
-    checks.require("LD = 0", res_ld <= 1e-9 * l.amax().max(1.0), format!("max |LD| = {res_ld:.1e}"))?;
+    checks.require(
+        "LD = 0",
+        res_ld <= 1e-9 * l.amax().max(1.0),
+        format!("max |LD| = {res_ld:.1e}"),
+    )?;
     let acl = &dec.a1 - &l * c;
     require_stable(checks, "A1 − LC stable", &eig(&acl), domain)?;
-    Ok(Core { m, a1: dec.a1, l, acl, fixed })
+    Ok(Core {
+        m,
+        a1: dec.a1,
+        l,
+        acl,
+        fixed,
+    })
 }
 
 /// The decay-rate certificate of the continuous design: P ⪰ 0.01I with
@@ -156,7 +192,14 @@ fn discrete_certificate(acl_d: &Mat, decay: f64, dt: f64) -> Result<(f64, f64), 
     Ok((rho, lhs.symmetric_eigen().eigenvalues.max()))
 }
 
-pub(super) fn design(model: Option<&Model>, dm: &Discrete, decay: f64, gain: Option<&Gain>, method: Method, path: Path) -> Result<Designed, DesignError> {
+pub(super) fn design(
+    model: Option<&Model>,
+    dm: &Discrete,
+    decay: f64,
+    gain: Option<&Gain>,
+    method: Method,
+    path: Path,
+) -> Result<Designed, DesignError> {
     let dt = dm.dt;
     let mut checks = Checks::new(KIND);
     if !(decay >= 0.0 && decay.is_finite()) {
@@ -164,7 +207,10 @@ pub(super) fn design(model: Option<&Model>, dm: &Discrete, decay: f64, gain: Opt
     }
     if let Some(g @ Gain::Lqe(_)) = gain {
         if path == Path::Lmi {
-            return Err(checks.error("path", "gain = lqe computes L from a DARE: it takes no LMI path"));
+            return Err(checks.error(
+                "path",
+                "gain = lqe computes L from a DARE: it takes no LMI path",
+            ));
         }
         return design_sampled(dm, decay, g);
     }
@@ -188,22 +234,38 @@ pub(super) fn design(model: Option<&Model>, dm: &Discrete, decay: f64, gain: Opt
         Path::Placement => None,
         Path::Lmi => Some(solve_lmi(model, decay, &mut checks)?),
     };
-    let lmi_l = lmi.as_ref().map(|s| s.p.clone().lu().solve(&s.y).expect("P ≻ 0 is invertible"));
+    let lmi_l = lmi
+        .as_ref()
+        .map(|s| s.p.clone().lu().solve(&s.y).expect("P ≻ 0 is invertible"));
     // Without given poles the free ones default from the continuous fixed modes, once, and the
     // sampled design then places their images e^{p·dt}.
     let free_default;
     let poles = match poles {
         Some(p) => Some(p),
         None if lmi.is_none() => {
-            let dec = decoupling(&model.a, b2, &model.c, d).map_err(|e| checks.error("decoupling", e.to_string()))?;
+            let dec = decoupling(&model.a, b2, &model.c, d)
+                .map_err(|e| checks.error("decoupling", e.to_string()))?;
             free_default = default_poles(dec.staircase.no, &dec.zeros, decay);
             Some(&free_default)
         }
         None => None,
     };
-    let ct = core(&model.a, &model.c, b2, d, poles.map(|p| Gain::place(p.clone(), method)).as_ref(), &[], lmi_l.as_ref(), Domain::Continuous, &mut checks)?;
+    let ct = core(
+        &model.a,
+        &model.c,
+        b2,
+        d,
+        poles.map(|p| Gain::place(p.clone(), method)).as_ref(),
+        &[],
+        lmi_l.as_ref(),
+        Domain::Continuous,
+        &mut checks,
+    )?;
     let poles_c = eig(&ct.acl);
-    let slowest = poles_c.iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
+    let slowest = poles_c
+        .iter()
+        .map(|z| z.re)
+        .fold(f64::NEG_INFINITY, f64::max);
     checks.require(
         &format!("decay rate {decay}: every Re λ(A1 − LC) < −{}", decay / 2.0),
         slowest < -decay / 2.0,
@@ -215,11 +277,16 @@ pub(super) fn design(model: Option<&Model>, dm: &Discrete, decay: f64, gain: Opt
             s.p.clone()
         }
         None => {
-            let (p, worst) = certificate(&ct.acl, decay).map_err(|e| checks.error("Lyapunov certificate", e))?;
+            let (p, worst) =
+                certificate(&ct.acl, decay).map_err(|e| checks.error("Lyapunov certificate", e))?;
             checks.require(
                 "A1ᵀP + PA1 − CᵀYᵀ − YC + αP ⪯ 0, P ⪰ 0.01I (Y = PL)",
                 worst <= 1e-9 * p.amax(),
-                format!("λmax = {}, λmin(P) = {}", sig(worst), sig(lyapunov::min_eigenvalue(&p))),
+                format!(
+                    "λmax = {}, λmin(P) = {}",
+                    sig(worst),
+                    sig(lyapunov::min_eigenvalue(&p))
+                ),
             )?;
             p
         }
@@ -229,15 +296,38 @@ pub(super) fn design(model: Option<&Model>, dm: &Discrete, decay: f64, gain: Opt
     let mut sampled = Checks::sampled(KIND, dt);
     let free_poles = match (&lmi, poles) {
         (Some(_), _) => {
-            let free: Vec<C64> = poles_c.iter().copied().filter(|z| !ct.fixed.iter().any(|f| (f - z).norm() < 1e-6 * f.norm().max(1.0))).collect();
+            let free: Vec<C64> = poles_c
+                .iter()
+                .copied()
+                .filter(|z| {
+                    !ct.fixed
+                        .iter()
+                        .any(|f| (f - z).norm() < 1e-6 * f.norm().max(1.0))
+                })
+                .collect();
             Some(Poles::from_values(&free).map_err(|e| sampled.error("poles", e.to_string()))?)
         }
         (None, p) => p.cloned(),
     };
     let free = free_poles.map(|p| Gain::place(p, method));
-    let d_core = core(&dm.a, &dm.c, &dm.e, d, free.as_ref(), &ct.fixed, None, Domain::Discrete(dt), &mut sampled)?;
-    let (rho, worst_d) = discrete_certificate(&d_core.acl, decay, dt).map_err(|e| sampled.error("Lyapunov certificate", e))?;
-    notes.push(format!("sampled decay certificate: ρ = e^(−α·dt/2) = {}, λmax(AᵀPA − ρ²P) = {}", sig(rho), sig(worst_d)));
+    let d_core = core(
+        &dm.a,
+        &dm.c,
+        &dm.e,
+        d,
+        free.as_ref(),
+        &ct.fixed,
+        None,
+        Domain::Discrete(dt),
+        &mut sampled,
+    )?;
+    let (rho, worst_d) = discrete_certificate(&d_core.acl, decay, dt)
+        .map_err(|e| sampled.error("Lyapunov certificate", e))?;
+    notes.push(format!(
+        "sampled decay certificate: ρ = e^(−α·dt/2) = {}, λmax(AᵀPA − ρ²P) = {}",
+        sig(rho),
+        sig(worst_d)
+    ));
     let runtime = runtime(&d_core, dm);
     Ok(Designed {
         report: Report {
@@ -246,7 +336,12 @@ pub(super) fn design(model: Option<&Model>, dm: &Discrete, decay: f64, gain: Opt
             poles: poles_c,
             discrete_poles: eig(&d_core.acl),
             fixed_modes: ct.fixed,
-            matrices: vec![("M".into(), ct.m), ("A1".into(), ct.a1), ("L".into(), ct.l), ("P".into(), p)],
+            matrices: vec![
+                ("M".into(), ct.m),
+                ("A1".into(), ct.a1),
+                ("L".into(), ct.l),
+                ("P".into(), p),
+            ],
             notes,
             sampled_only: false,
         },
@@ -270,29 +365,65 @@ fn runtime(d: &Core, dm: &Discrete) -> LinearObserver {
 fn design_sampled(dm: &Discrete, decay: f64, gain: &Gain) -> Result<Designed, DesignError> {
     let dt = dm.dt;
     let mut sampled = Checks::sampled(KIND, dt);
-    let d_core = core(&dm.a, &dm.c, &dm.e, &dm.d, Some(gain), &[], None, Domain::Discrete(dt), &mut sampled)?;
-    let (rho, worst_d) = discrete_certificate(&d_core.acl, decay, dt).map_err(|e| sampled.error("Lyapunov certificate", e))?;
+    let d_core = core(
+        &dm.a,
+        &dm.c,
+        &dm.e,
+        &dm.d,
+        Some(gain),
+        &[],
+        None,
+        Domain::Discrete(dt),
+        &mut sampled,
+    )?;
+    let (rho, worst_d) = discrete_certificate(&d_core.acl, decay, dt)
+        .map_err(|e| sampled.error("Lyapunov certificate", e))?;
     sampled.require(
         &format!("decay rate {decay}: AᵀPA − ρ²P ⪯ 0 with ρ = e^(−α·dt/2)"),
         worst_d <= 1e-9,
         format!("ρ = {}, λmax = {}", sig(rho), sig(worst_d)),
     )?;
     let runtime = runtime(&d_core, dm);
-    let matrices = vec![("M".into(), d_core.m.clone()), ("A1".into(), d_core.a1.clone()), ("L".into(), d_core.l.clone())];
-    let report = sampled_report(KIND, sampled, &d_core.acl, d_core.fixed.clone(), matrices, vec![], dt);
-    Ok(Designed { report, runtime, what: None })
+    let matrices = vec![
+        ("M".into(), d_core.m.clone()),
+        ("A1".into(), d_core.a1.clone()),
+        ("L".into(), d_core.l.clone()),
+    ];
+    let report = sampled_report(
+        KIND,
+        sampled,
+        &d_core.acl,
+        d_core.fixed.clone(),
+        matrices,
+        vec![],
+        dt,
+    );
+    Ok(Designed {
+        report,
+        runtime,
+        what: None,
+    })
 }
 
 #[cfg(feature = "lmi")]
 fn solve_lmi(model: &Model, decay: f64, checks: &mut Checks) -> Result<LmiSolution, DesignError> {
-    let dec = decoupling(&model.a, &model.e, &model.c, &model.d).map_err(|e| checks.error("decoupling", e.to_string()))?;
-    let sol = crate::lmi::solve(&dec.a1, &model.c, &model.d, decay).map_err(|e| checks.error("LMI", e))?;
-    let lhs = dec.a1.transpose() * &sol.p + &sol.p * &dec.a1 - model.c.transpose() * sol.y.transpose() - &sol.y * &model.c + &sol.p * decay;
+    let dec = decoupling(&model.a, &model.e, &model.c, &model.d)
+        .map_err(|e| checks.error("decoupling", e.to_string()))?;
+    let sol = crate::lmi::solve(&dec.a1, &model.c, &model.d, decay)
+        .map_err(|e| checks.error("LMI", e))?;
+    let lhs = dec.a1.transpose() * &sol.p + &sol.p * &dec.a1
+        - model.c.transpose() * sol.y.transpose()
+        - &sol.y * &model.c
+        + &sol.p * decay;
     let worst = lhs.symmetric_eigen().eigenvalues.max();
     checks.require(
         "A1ᵀP + PA1 − CᵀYᵀ − YC + αP ⪯ 0, P ⪰ 0.01I, YD = 0 (LMI)",
         worst <= 1e-7 * sol.p.amax() && lyapunov::min_eigenvalue(&sol.p) >= 0.01 * (1.0 - 1e-6),
-        format!("λmax = {}, λmin(P) = {}", sig(worst), sig(lyapunov::min_eigenvalue(&sol.p))),
+        format!(
+            "λmax = {}, λmin(P) = {}",
+            sig(worst),
+            sig(lyapunov::min_eigenvalue(&sol.p))
+        ),
     )?;
     Ok(sol)
 }

@@ -12,9 +12,9 @@
 //! not modelled (they are what the unknown-input observers reject and the filter does not).
 //! There is no continuous design: the report's poles are ln(z)/dt of the filter's.
 
-use lti::{steady_state_kalman, Discrete, Mat};
+use lti::{Discrete, Mat, steady_state_kalman};
 
-use super::{eig, require_stable, Checks, Designed, DesignError, Domain, Report};
+use super::{Checks, DesignError, Designed, Domain, Report, eig, require_stable};
 use crate::runtime::LinearObserver;
 
 const KIND: &str = "kalman";
@@ -22,19 +22,33 @@ const KIND: &str = "kalman";
 pub(super) fn design(dm: &Discrete, qd: &Mat, r: &Mat) -> Result<Designed, DesignError> {
     let dt = dm.dt;
     let mut checks = Checks::sampled(KIND, dt);
-    let kf = steady_state_kalman(&dm.a, &dm.c, qd, r).map_err(|e| checks.error("DARE(Φᵀ, Cᵀ, Q_d, R) has a stabilising solution", e.to_string()))?;
+    let kf = steady_state_kalman(&dm.a, &dm.c, qd, r).map_err(|e| {
+        checks.error(
+            "DARE(Φᵀ, Cᵀ, Q_d, R) has a stabilising solution",
+            e.to_string(),
+        )
+    })?;
     let n = dm.a.nrows();
     let p_upd = Mat::identity(n, n) - &kf.gain * &dm.c;
     let f = &dm.a * &p_upd;
     let discrete = eig(&f);
-    require_stable(&mut checks, "Φ(I − MC) stable", &discrete, Domain::Discrete(dt))?;
+    require_stable(
+        &mut checks,
+        "Φ(I − MC) stable",
+        &discrete,
+        Domain::Discrete(dt),
+    )?;
     let (continuous, _) = lti::eig::continuous_image(&discrete, dt);
     let runtime = LinearObserver::new(&f, &dm.b, &kf.predictor_gain, &p_upd, &kf.gain);
     Ok(Designed {
         report: Report {
             kind: KIND,
             conditions: checks.into_list(),
-            matrices: vec![("M".into(), kf.gain.clone()), ("P".into(), kf.p.clone()), ("S".into(), kf.innovation.clone())],
+            matrices: vec![
+                ("M".into(), kf.gain.clone()),
+                ("P".into(), kf.p.clone()),
+                ("S".into(), kf.innovation.clone()),
+            ],
             poles: continuous,
             discrete_poles: discrete,
             fixed_modes: vec![],

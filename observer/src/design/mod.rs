@@ -22,16 +22,16 @@ mod luenberger;
 mod unknown_input;
 
 use lti::eig::{continuous_image, eigenvalues, format_list, format_one};
-use lti::place::{place_observer, Method};
+use lti::place::{Method, place_observer};
 use lti::staircase::observability_staircase;
-use lti::{Discrete, Mat, Model, Poles, C64};
+use lti::{C64, Discrete, Mat, Model, Poles};
 
 use crate::runtime::LinearObserver;
 
 pub use gain::{Gain, Weights};
-pub use hui_zak::{lmi_available, LmiSolution, Path};
+pub(crate) use gain::{Pair, free_gain};
+pub use hui_zak::{LmiSolution, Path, lmi_available};
 pub use unknown_input::InputEstimator;
-pub(crate) use gain::{free_gain, Pair};
 
 /// Which observer, with its free parameters.
 #[derive(Debug, Clone, PartialEq)]
@@ -51,7 +51,12 @@ pub enum Spec {
     Cumming { gain: Gain, h: Option<Mat> },
     /// Hui & Żak's projection unknown-input observer (seed 004). Without a gain the free poles
     /// default from the fixed modes and are placed with `placement`.
-    HuiZak { decay: f64, gain: Option<Gain>, placement: Method, path: Path },
+    HuiZak {
+        decay: f64,
+        gain: Option<Gain>,
+        placement: Method,
+        path: Path,
+    },
     /// The steady-state Kalman filter of the sampled plant for process-noise covariance Q_d
     /// (per step, n×n) and measurement-noise covariance R (p×p).
     Kalman { qd: Mat, r: Mat },
@@ -74,7 +79,10 @@ impl Spec {
 
     /// True for designs that reject the unknown inputs.
     pub fn decouples(&self) -> bool {
-        matches!(self, Spec::ChenPatton { .. } | Spec::DasGhosalUio { .. } | Spec::HuiZak { .. })
+        matches!(
+            self,
+            Spec::ChenPatton { .. } | Spec::DasGhosalUio { .. } | Spec::HuiZak { .. }
+        )
     }
 }
 
@@ -168,26 +176,59 @@ pub(crate) struct Checks {
 
 impl Checks {
     pub(crate) fn new(kind: &'static str) -> Self {
-        Self { kind, prefix: String::new(), list: Vec::new(), weights: None }
+        Self {
+            kind,
+            prefix: String::new(),
+            list: Vec::new(),
+            weights: None,
+        }
     }
 
     /// Checks of the sampled design: names are prefixed so an error says which design failed.
     pub(crate) fn sampled(kind: &'static str, dt: f64) -> Self {
-        Self { kind, prefix: format!("sampled design (dt = {dt}): "), list: Vec::new(), weights: None }
+        Self {
+            kind,
+            prefix: format!("sampled design (dt = {dt}): "),
+            list: Vec::new(),
+            weights: None,
+        }
     }
 
     /// Records a condition that must hold.
-    pub(crate) fn require(&mut self, name: &str, ok: bool, detail: impl Into<String>) -> Result<(), DesignError> {
+    pub(crate) fn require(
+        &mut self,
+        name: &str,
+        ok: bool,
+        detail: impl Into<String>,
+    ) -> Result<(), DesignError> {
         let detail = detail.into();
         let name = format!("{}{name}", self.prefix);
-        self.list.push(Condition { name: name.clone(), ok, detail: detail.clone() });
-        if ok { Ok(()) } else { Err(DesignError { kind: self.kind, condition: name, detail, conditions: self.list.clone() }) }
+        self.list.push(Condition {
+            name: name.clone(),
+            ok,
+            detail: detail.clone(),
+        });
+        if ok {
+            Ok(())
+        } else {
+            Err(DesignError {
+                kind: self.kind,
+                condition: name,
+                detail,
+                conditions: self.list.clone(),
+            })
+        }
     }
 
     /// An error for `name`, carrying the conditions so far.
     pub(crate) fn error(&self, name: &str, detail: impl Into<String>) -> DesignError {
         let condition = format!("{}{name}", self.prefix);
-        DesignError { kind: self.kind, condition, detail: detail.into(), conditions: self.list.clone() }
+        DesignError {
+            kind: self.kind,
+            condition,
+            detail: detail.into(),
+            conditions: self.list.clone(),
+        }
     }
 
     pub(crate) fn into_list(self) -> Vec<Condition> {
@@ -196,7 +237,15 @@ impl Checks {
 
     /// The LQE weights as report matrices (none for a placed gain).
     pub(crate) fn weight_matrices(&self) -> Vec<(String, Mat)> {
-        self.weights.iter().flat_map(|(q, r)| [("Q (LQE)".to_string(), q.clone()), ("R (LQE)".to_string(), r.clone())]).collect()
+        self.weights
+            .iter()
+            .flat_map(|(q, r)| {
+                [
+                    ("Q (LQE)".to_string(), q.clone()),
+                    ("R (LQE)".to_string(), r.clone()),
+                ]
+            })
+            .collect()
     }
 }
 
@@ -216,7 +265,9 @@ pub(crate) fn sampled_report(
     notes.insert(0, "the sampled design only (gain = lqe, or a discrete-time plant): matrices are the sampled observer's, poles are ln(z)/dt".into());
     let (poles, deadbeat) = continuous_image(&discrete, dt);
     if deadbeat > 0 {
-        notes.push(format!("{deadbeat} deadbeat mode(s) z = 0 (no continuous image, left out of the poles)"));
+        notes.push(format!(
+            "{deadbeat} deadbeat mode(s) z = 0 (no continuous image, left out of the poles)"
+        ));
     }
     Report {
         kind,
@@ -259,12 +310,24 @@ pub(crate) fn place_detectable(
     // are a large model's costliest step.
     let stairs = (lti::pinv::rank(c) < n).then(|| observability_staircase(a, c));
     let (no, fixed) = match &stairs {
-        Some(s) => (s.no, s.unobservable_modes().map_err(|e| checks.error(pair, e.to_string()))?),
+        Some(s) => (
+            s.no,
+            s.unobservable_modes()
+                .map_err(|e| checks.error(pair, e.to_string()))?,
+        ),
         None => (n, Vec::new()),
     };
     if no < n {
-        let what = if domain == Domain::Continuous { "Re < 0" } else { "|z| < 1" };
-        let unstable: Vec<C64> = fixed.iter().copied().filter(|&z| !domain.stable(z)).collect();
+        let what = if domain == Domain::Continuous {
+            "Re < 0"
+        } else {
+            "|z| < 1"
+        };
+        let unstable: Vec<C64> = fixed
+            .iter()
+            .copied()
+            .filter(|&z| !domain.stable(z))
+            .collect();
         checks.require(
             &format!("{pair} detectable"),
             unstable.is_empty(),
@@ -277,19 +340,28 @@ pub(crate) fn place_detectable(
     }
     let target = match domain {
         Domain::Continuous => free.clone(),
-        Domain::Discrete(dt) => sampled_target(free, carried, &fixed, dt).map_err(|e| checks.error("poles", e))?,
+        Domain::Discrete(dt) => {
+            sampled_target(free, carried, &fixed, dt).map_err(|e| checks.error("poles", e))?
+        }
     };
     if target.len() != no {
         let detail = match domain {
             Domain::Continuous if no == n => {
-                format!("{pair} is observable: give {n} pole(s) (poles = [...]), {} given", free.len())
+                format!(
+                    "{pair} is observable: give {n} pole(s) (poles = [...]), {} given",
+                    free.len()
+                )
             }
             Domain::Continuous => format!(
                 "{pair} has {} fixed mode(s) {} that no gain moves; give {} pole(s) for the observable part{}, {} given",
                 n - no,
                 format_list(&fixed),
                 no,
-                if no == 0 { " (poles = [] or no poles key)" } else { "" },
+                if no == 0 {
+                    " (poles = [] or no poles key)"
+                } else {
+                    ""
+                },
                 free.len()
             ),
             Domain::Discrete(_) => format!(
@@ -306,7 +378,8 @@ pub(crate) fn place_detectable(
         return Err(checks.error("poles", detail));
     }
     if no == n {
-        let placed = place_observer(a, c, &target, method).map_err(|e| placement_refused(checks, e))?;
+        let placed =
+            place_observer(a, c, &target, method).map_err(|e| placement_refused(checks, e))?;
         return Ok((placed.gain, Vec::new()));
     }
     if no == 0 {
@@ -314,7 +387,8 @@ pub(crate) fn place_detectable(
     }
     let stairs = stairs.expect("a staircase whenever no < n");
     let (ao, co) = stairs.observable_part();
-    let placed = place_observer(&ao, &co, &target, method).map_err(|e| placement_refused(checks, e))?;
+    let placed =
+        place_observer(&ao, &co, &target, method).map_err(|e| placement_refused(checks, e))?;
     let l = stairs.q.columns(0, no) * placed.gain;
     Ok((l, fixed))
 }
@@ -335,9 +409,20 @@ fn placement_refused(checks: &Checks, e: lti::LtiError) -> DesignError {
 /// away the image of a continuous one it sits on — up to sampling, within 1e−4·max(1, |z|) in
 /// the s-plane (seed 004's sit within ~1e−6) — and stays; one that sits on none (a zero that
 /// sampling made) takes nothing, and the count then says the design cannot be had.
-fn sampled_target(free: &Poles, carried: &[C64], sampled_fixed: &[C64], dt: f64) -> Result<Poles, String> {
+fn sampled_target(
+    free: &Poles,
+    carried: &[C64],
+    sampled_fixed: &[C64],
+    dt: f64,
+) -> Result<Poles, String> {
     // Conjugates mapped as conjugates, so the list stays exactly closed under conjugation.
-    let image = |z: C64| if z.im < 0.0 { (z.conj() * dt).exp().conj() } else { (z * dt).exp() };
+    let image = |z: C64| {
+        if z.im < 0.0 {
+            (z.conj() * dt).exp().conj()
+        } else {
+            (z * dt).exp()
+        }
+    };
     // |Δs| between a continuous mode z and a sampled one f: |e^{z·dt} − f| / (dt·|e^{z·dt}|).
     let ds = |z: C64, f: C64| (image(z) - f).norm() / (dt * image(z).norm());
     let mut left: Vec<C64> = carried.to_vec();
@@ -363,12 +448,25 @@ pub(crate) fn eq_detail(a: usize, b: usize) -> String {
 }
 
 /// Checks that every eigenvalue is stable in `domain`.
-pub(crate) fn require_stable(checks: &mut Checks, name: &str, ev: &[C64], domain: Domain) -> Result<(), DesignError> {
-    let bad: Vec<String> = ev.iter().filter(|&&z| !domain.stable(z)).map(|&z| format_one(z, true)).collect();
+pub(crate) fn require_stable(
+    checks: &mut Checks,
+    name: &str,
+    ev: &[C64],
+    domain: Domain,
+) -> Result<(), DesignError> {
+    let bad: Vec<String> = ev
+        .iter()
+        .filter(|&&z| !domain.stable(z))
+        .map(|&z| format_one(z, true))
+        .collect();
     if bad.is_empty() {
         checks.require(name, true, format_list(ev))
     } else {
-        checks.require(name, false, format!("unstable eigenvalue(s) {}", bad.join(", ")))
+        checks.require(
+            name,
+            false,
+            format!("unstable eigenvalue(s) {}", bad.join(", ")),
+        )
     }
 }
 
@@ -389,20 +487,30 @@ fn design_on(model: Option<&Model>, dm: &Discrete, spec: &Spec) -> Result<Design
     let mut d = match spec {
         Spec::Luenberger { gain } => luenberger::design(model, dm, gain),
         Spec::ChenPatton { gain } => chen_patton::design(model, dm, gain),
-        Spec::DasGhosal { gain } => das_ghosal::design(model, dm, das_ghosal::Free::Gain(gain.clone()), false),
+        Spec::DasGhosal { gain } => {
+            das_ghosal::design(model, dm, das_ghosal::Free::Gain(gain.clone()), false)
+        }
         Spec::DasGhosalUio { h, gain } => {
             let free = match (h, gain) {
                 (Some(h), _) => das_ghosal::Free::H(h.clone()),
                 (None, Some(g)) => das_ghosal::Free::Gain(g.clone()),
                 (None, None) => {
-                    return Err(Checks::new("das-ghosal-uio").error("H or poles", "give H = [[…]], poles = […] or gain = \"lqe\""));
+                    return Err(Checks::new("das-ghosal-uio").error(
+                        "H or poles",
+                        "give H = [[…]], poles = […] or gain = \"lqe\"",
+                    ));
                 }
             };
             das_ghosal::design(model, dm, free, true)
         }
         Spec::GiFullOrder { gain } => gi_full_order::design(model, dm, gain),
         Spec::Cumming { gain, h } => cumming::design(model, dm, gain, h.as_ref()),
-        Spec::HuiZak { decay, gain, placement, path } => hui_zak::design(model, dm, *decay, gain.as_ref(), *placement, *path),
+        Spec::HuiZak {
+            decay,
+            gain,
+            placement,
+            path,
+        } => hui_zak::design(model, dm, *decay, gain.as_ref(), *placement, *path),
         Spec::Kalman { qd, r } => kalman::design(dm, qd, r),
     }?;
     if spec.decouples() {

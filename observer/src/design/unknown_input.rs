@@ -58,5 +58,9 @@ pub(crate) fn estimator(m: &Discrete, with_d: bool) -> Option<InputEstimator> {
         pinv(&ce)
     };
     let w_c = &w * &m.c;
-    Some(InputEstimator { w_c_phi: &w_c * &m.a, w_c_gamma_b: &w_c * &m.b, w })
+    Some(InputEstimator {
+        w_c_phi: &w_c * &m.a,
+        w_c_gamma_b: &w_c * &m.b,
+        w,
+    })
 }
