@@ -36,6 +36,17 @@ pub fn pinv(a: &DMatrix<f64>) -> DMatrix<f64> {
     out
 }
 
+/// X = B M⁺, refined once: X ← X + (B − XM)M⁺. Where XM = B is solvable (B's rows in M's row
+/// space: the decoupling conditions H·CE = E, M·[CE D] = [E 0]) the correction takes the
+/// residual from the pseudo-inverse's κ(M)·ε to ~ε — a held disturbance is then rejected over
+/// 20 000 steps of a slow observer (seed 004, ρ = 1 − 5e-5), not amplified 2·10⁴-fold.
+pub fn right_solve(b: &DMatrix<f64>, m: &DMatrix<f64>) -> DMatrix<f64> {
+    let mp = pinv(m);
+    let x = b * &mp;
+    let residual = b - &x * m;
+    x + residual * mp
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

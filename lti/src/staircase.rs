@@ -82,13 +82,24 @@ impl ObservabilityStaircase {
 
 /// Staircase reduction of (A, B).
 pub fn controllability_staircase(a: &DMatrix<f64>, b: &DMatrix<f64>) -> ControllabilityStaircase {
+    controllability_staircase_at(a, b, 0.0)
+}
+
+/// Staircase reduction of (A, B), rank decisions at n²·ε·max(‖A‖₁, ‖B‖₁, `norm`): `norm` is the
+/// size of the data (A, B) were formed from, when they are products — a reduced-order pair
+/// such as (LᵀAL, CAL), whose output block is rounding of ‖C‖‖A‖ where the exact one is zero.
+pub fn controllability_staircase_at(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    norm: f64,
+) -> ControllabilityStaircase {
     let n = a.nrows();
     let norm1 = |m: &DMatrix<f64>| {
         (0..m.ncols())
             .map(|j| m.column(j).iter().map(|x| x.abs()).sum::<f64>())
             .fold(0.0, f64::max)
     };
-    let tol = tolerance(n, norm1(a).max(norm1(b)));
+    let tol = tolerance(n, norm1(a).max(norm1(b)).max(norm));
     let mut q = DMatrix::<f64>::identity(n, n);
     let mut at = a.clone();
     let mut bt = b.clone();
@@ -135,7 +146,16 @@ pub fn controllability_staircase(a: &DMatrix<f64>, b: &DMatrix<f64>) -> Controll
 
 /// Staircase reduction of (A, C), by duality with (Aᵀ, Cᵀ).
 pub fn observability_staircase(a: &DMatrix<f64>, c: &DMatrix<f64>) -> ObservabilityStaircase {
-    let dual = controllability_staircase(&a.transpose(), &c.transpose());
+    observability_staircase_at(a, c, 0.0)
+}
+
+/// [`observability_staircase`] with the data's size `norm` (see [`controllability_staircase_at`]).
+pub fn observability_staircase_at(
+    a: &DMatrix<f64>,
+    c: &DMatrix<f64>,
+    norm: f64,
+) -> ObservabilityStaircase {
+    let dual = controllability_staircase_at(&a.transpose(), &c.transpose(), norm);
     ObservabilityStaircase {
         q: dual.q,
         a: dual.a.transpose(),
@@ -152,22 +172,42 @@ fn tolerance(n: usize, norm: f64) -> f64 {
     (n * n) as f64 * f64::EPSILON * norm.max(f64::MIN_POSITIVE)
 }
 
-/// Orthonormal basis of the range of `m`, counting singular values above an absolute `tol`.
+/// Orthonormal basis of the range of `m`, counting singular values above an absolute `tol`
+/// (faer's SVD, [`crate::linalg::svd`]).
 fn range_with_tol(m: &DMatrix<f64>, tol: f64) -> DMatrix<f64> {
     if m.is_empty() {
         return DMatrix::zeros(m.nrows(), 0);
     }
-    let svd = m.clone().svd(true, false);
-    let u = svd.u.expect("requested U");
-    let cols: Vec<_> = (0..svd.singular_values.len())
-        .filter(|&i| svd.singular_values[i] > tol)
-        .map(|i| u.column(i).into_owned())
-        .collect();
-    if cols.is_empty() {
-        DMatrix::zeros(m.nrows(), 0)
-    } else {
-        DMatrix::from_columns(&cols)
+    let Some(svd) = crate::linalg::svd::Svd::new(m) else {
+        return DMatrix::zeros(m.nrows(), 0);
+    };
+    let r = svd.s.iter().filter(|&&s| s > tol).count();
+    svd.u.columns(0, r).into_owned()
+}
+
+/// Whether C alone already makes (A, C) observable: C has full column rank at the staircase's
+/// absolute tolerance n²·ε·max(‖A‖₁, ‖C‖₁). A C that is rounding noise beside A (the reduced
+/// pair CΦL of a mode no sensor sees: ~1e-16) is not — numpy's rank rule, relative to C's own
+/// largest singular value, would call it full and hand a Riccati equation an output of noise.
+pub fn observable_by_rank(a: &DMatrix<f64>, c: &DMatrix<f64>) -> bool {
+    observable_by_rank_at(a, c, 0.0)
+}
+
+/// [`observable_by_rank`] with the data's size `norm` (see [`controllability_staircase_at`]).
+pub fn observable_by_rank_at(a: &DMatrix<f64>, c: &DMatrix<f64>, norm: f64) -> bool {
+    let n = a.nrows();
+    if c.ncols() != n || c.nrows() < n {
+        return n == 0;
     }
+    let norm1 = |m: &DMatrix<f64>| {
+        (0..m.ncols())
+            .map(|j| m.column(j).iter().map(|x| x.abs()).sum::<f64>())
+            .fold(0.0, f64::max)
+    };
+    let tol = tolerance(n, norm1(a).max(norm1(c)).max(norm));
+    crate::linalg::svd::singular_values(c)
+        .get(n - 1)
+        .is_some_and(|&s| s > tol)
 }
 
 /// Controllability matrix [B, AB, …, Aⁿ⁻¹B].

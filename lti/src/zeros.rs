@@ -24,7 +24,7 @@ use nalgebra::DMatrix;
 
 use crate::eig::C64;
 use crate::error::{LtiError, Result};
-use crate::pinv::{pinv, rank};
+use crate::pinv::rank;
 use crate::staircase::{ObservabilityStaircase, observability_staircase};
 use crate::subspace::left_null_space;
 
@@ -74,7 +74,7 @@ pub fn decoupling(
     ced.columns_mut(q, r).copy_from(d);
     let mut e0 = DMatrix::<f64>::zeros(n, q + r);
     e0.columns_mut(0, q).copy_from(e);
-    let m = e0 * pinv(&ced);
+    let m = crate::pinv::right_solve(&e0, &ced);
     let a1 = (DMatrix::<f64>::identity(n, n) - &m * c) * a;
     let nrows = if r == 0 {
         DMatrix::<f64>::identity(p, p)

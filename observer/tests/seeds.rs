@@ -443,8 +443,12 @@ fn seed004_sampled_observer_rejects_held_disturbances_exactly() {
         let w = if (k / 500) % 2 == 0 { 1.0 } else { -2.0 };
         x = &dm.a * &x + &dm.e * w;
     }
+    // The floor is rounding, accumulated by the slow error dynamics: each step leaves ~ε·|K||y|,
+    // summed over 1/(1 − ρ) = 1/(0.05·dt) = 2·10⁴ steps. Measured 5.9e-10 with nalgebra's SVD
+    // and 1.25e-9 with faer's (a different but equally exact N and M): the bound is at that
+    // floor, not at a decoupling error (which would leave O(1): w switches between 1 and −2).
     assert!(
-        worst_late < 1e-9,
+        worst_late < 3e-9,
         "relative error late in the run: {worst_late:e}"
     );
 }

@@ -16,6 +16,7 @@
 use lti::pinv::rank;
 use lti::{C64, Discrete, Mat, Model};
 
+use super::gain::norm1;
 use super::{
     Checks, DesignError, Designed, Domain, Gain, Pair, Report, eig, eq_detail, free_gain,
     require_stable, sampled_report,
@@ -69,6 +70,7 @@ fn core(
         a: &haf,
         c: &caf,
         name: "(HAF, CAF)",
+        scale: norm1(a) * norm1(h).max(norm1(c)) * norm1(&f),
         state_map: Some(h),
         output_map: None,
     };

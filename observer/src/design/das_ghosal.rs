@@ -32,6 +32,7 @@ use lti::pinv::pinv;
 use lti::subspace::kernel_basis;
 use lti::{C64, Discrete, Mat, Model};
 
+use super::gain::norm1;
 use super::{
     Checks, DesignError, Designed, Domain, Gain, Pair, Report, eig, free_gain, require_stable,
     sampled_report,
@@ -79,6 +80,9 @@ pub(super) fn core(
     let lg = l.transpose(); // L orthonormal: Lᵍ = Lᵀ
     let r = l.ncols();
     let lgal = &lg * a * &l;
+    // The size of the data the reduced pairs are products of: their rank decisions are made
+    // against it (CAL is rounding of ‖C‖‖A‖ along a mode no sensor sees).
+    let data_scale = norm1(a) * norm1(&l) * norm1(c).max(1.0);
     let cal = c * a * &l;
     let mut notes = Vec::new();
     let (k, fixed) = if uio {
@@ -125,6 +129,7 @@ pub(super) fn core(
                     a: &at,
                     c: &ct,
                     name: "(LgAL − K0CAL, ΠCAL)",
+                    scale: data_scale * (1.0 + norm1(&k0)),
                     state_map: Some(&lg),
                     output_map: None,
                 };
@@ -146,6 +151,7 @@ pub(super) fn core(
                     a: &at,
                     c: &ct,
                     name: "(LgAL − K0CAL, UᵀCAL)",
+                    scale: data_scale * (1.0 + norm1(&k0)),
                     state_map: Some(&lg),
                     output_map: Some(&ut),
                 };
@@ -172,6 +178,7 @@ pub(super) fn core(
                     a: &lgal,
                     c: &cal,
                     name: "(LgAL, CAL)",
+                    scale: data_scale,
                     state_map: Some(&lg),
                     output_map: None,
                 };

@@ -23,9 +23,10 @@
 //! basis a family picks for its pair (for the orthonormal bases of Das–Ghosal's L and the
 //! DG-UIO's U they are identities; for Cumming's observer with a given H, H Hᵀ).
 
+use lti::eig::continuous_image;
 use lti::eig::{format_list, sig};
 use lti::place::Method;
-use lti::staircase::observability_staircase;
+use lti::staircase::{observability_staircase_at, observable_by_rank_at};
 use lti::{C64, Mat, Poles, steady_state_kalman};
 
 use super::{Checks, DesignError, Domain, place_detectable};
@@ -68,6 +69,10 @@ pub(crate) struct Pair<'a> {
     pub name: &'a str,
     /// T with pair state = T x; `None` when the pair's state is x itself.
     pub state_map: Option<&'a Mat>,
+    /// The size (1-norm) of the data the pair was formed from, 0 when it is the plant's own:
+    /// rank decisions on the pair are made against it (a reduced pair's output CΦL is rounding
+    /// of ‖C‖‖Φ‖ where a mode no sensor sees makes it exactly zero).
+    pub scale: f64,
     /// M with pair output = M y; `None` when it is y itself.
     pub output_map: Option<&'a Mat>,
 }
@@ -79,6 +84,7 @@ impl<'a> Pair<'a> {
             a,
             c,
             name,
+            scale: 0.0,
             state_map: None,
             output_map: None,
         }
@@ -97,9 +103,9 @@ pub(crate) fn free_gain(
 ) -> Result<(Mat, Vec<C64>), DesignError> {
     match (gain, domain) {
         (Gain::Place { poles, method }, _) => place_detectable(
-            checks, pair.a, pair.c, poles, carried, *method, pair.name, domain,
+            checks, pair.a, pair.c, pair.scale, poles, carried, *method, pair.name, domain,
         ),
-        (Gain::Lqe(w), Domain::Discrete(_)) => lqe(checks, pair, w),
+        (Gain::Lqe(w), Domain::Discrete(dt)) => lqe(checks, pair, w, dt),
         (Gain::Lqe(_), Domain::Continuous) => Err(checks.error(
             "gain",
             "an LQE gain is designed on the sampled pair only (a design bug)",
@@ -107,7 +113,12 @@ pub(crate) fn free_gain(
     }
 }
 
-fn lqe(checks: &mut Checks, pair: &Pair, w: &Weights) -> Result<(Mat, Vec<C64>), DesignError> {
+fn lqe(
+    checks: &mut Checks,
+    pair: &Pair,
+    w: &Weights,
+    dt: f64,
+) -> Result<(Mat, Vec<C64>), DesignError> {
     let (m, k) = (pair.a.nrows(), pair.c.nrows());
     let q = weight(
         checks,
@@ -127,13 +138,35 @@ fn lqe(checks: &mut Checks, pair: &Pair, w: &Weights) -> Result<(Mat, Vec<C64>),
     )?;
     let fixed = if k == 0 {
         lti::eig::eigenvalues(pair.a).unwrap_or_default()
-    } else if lti::pinv::rank(pair.c) < m {
-        observability_staircase(pair.a, pair.c)
+    } else if !observable_by_rank_at(pair.a, pair.c, pair.scale) {
+        observability_staircase_at(pair.a, pair.c, pair.scale)
             .unobservable_modes()
             .map_err(|e| checks.error(pair.name, e.to_string()))?
     } else {
         Vec::new()
     };
+    // The modes no gain moves must be stable before a Riccati equation is asked: it has no
+    // stabilising solution otherwise, and the cause is structural, not a convergence failure.
+    if m > 0 && (k == 0 || !fixed.is_empty()) {
+        let unstable: Vec<C64> = fixed
+            .iter()
+            .copied()
+            .filter(|&z| !Domain::Discrete(dt).stable(z))
+            .collect();
+        checks.require(
+            &format!("{} detectable", pair.name),
+            unstable.is_empty(),
+            if unstable.is_empty() {
+                format!("unobservable modes z = {} (s = {}) inside the unit circle", format_list(&fixed), format_list(&continuous_image(&fixed, dt).0))
+            } else {
+                format!(
+                    "unobservable mode(s) z = {} (s = {}) not inside the unit circle: no sensor sees them, no observer gain can move them",
+                    format_list(&unstable),
+                    format_list(&continuous_image(&unstable, dt).0)
+                )
+            },
+        )?;
+    }
     let gain = if k == 0 {
         Mat::zeros(m, 0)
     } else {
@@ -209,4 +242,11 @@ fn weight(
             ))
         }
     }
+}
+
+/// The 1-norm (largest column sum), the staircase's measure of size.
+pub(crate) fn norm1(m: &Mat) -> f64 {
+    (0..m.ncols())
+        .map(|j| m.column(j).iter().map(|x| x.abs()).sum::<f64>())
+        .fold(0.0, f64::max)
 }

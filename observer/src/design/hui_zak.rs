@@ -134,6 +134,7 @@ fn core(
                 a: &dec.a1,
                 c: &nc,
                 name: "(A1, NC)",
+                scale: 0.0,
                 state_map: None,
                 output_map: Some(&dec.n),
             };
