@@ -27,7 +27,8 @@ The signals
              base), added to the torque the governor delivers to the shaft: tm_i = pout_i + w.
   u (l = 4)  known inputs: the voltage references vref of the four exciters (pu).
 
-How B and E are obtained (from ANDES's own equations, no model data copied):
+How B and E are obtained (from ANDES's own equations, no model data copied; the code is the
+general one of scripts/models/andes_case.py, which exports the other ANDES cases the same way):
   An input enters one residual equation of the DAE. The residual sensitivities f_u, g_u are
   measured by a forward difference through ANDES's residual evaluation (``TDS.fg_update``) at
   the operating point, perturbing
@@ -60,17 +61,18 @@ call them observable; either way an LQE gain leaves them where they are.
 
 Run (ANDES 2.0.0, numpy 2.4.6, scipy 1.17.1 from PyPI; any working directory):
 
-    python3 -m venv /tmp/andes-venv && /tmp/andes-venv/bin/pip install andes==2.0.0
-    /tmp/andes-venv/bin/python scripts/models/kundur_andes.py            # writes scenarios/models/kundur/
-    /tmp/andes-venv/bin/python scripts/models/kundur_andes.py --check    # prints the checks, writes nothing
+    python3 -m venv /work/andes-venv && /work/andes-venv/bin/pip install andes==2.0.0
+    /work/andes-venv/bin/python scripts/models/kundur_andes.py            # writes scenarios/models/kundur/
+    /work/andes-venv/bin/python scripts/models/kundur_andes.py --check    # prints the checks, writes nothing
 """
 
 import argparse
 import os
-import sys
 
 import numpy as np
 import scipy.linalg as sla
+
+from andes_case import linearise, load_operating_point   # the same folder: the general ANDES export
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DEFAULT_OUT = os.path.normpath(os.path.join(HERE, "..", "..", "scenarios", "models", "kundur"))
@@ -79,82 +81,6 @@ CASE = "kundur/kundur_full.xlsx"
 DISTURBED = (2, 3)          # generators whose shaft torque carries the unknown inputs (1-based)
 SIGMA_Q = 1e-9              # process noise per step and state, std (the scenario's [noise])
 LQE_R = 0.01                # R = LQE_R I for the UIO's and the reference Kalman filter's design
-
-
-def load_operating_point():
-    """ANDES system after power flow and small-signal analysis (which also initialises TDS)."""
-    import andes
-
-    andes.config_logger(stream_level=40)  # errors only: ANDES logs every step by default
-    ss = andes.load(andes.get_case(CASE), no_output=True, default_config=True)
-    if not ss.PFlow.run():
-        sys.exit("power flow did not converge")
-    ss.EIG.run()
-    return ss, andes.__version__
-
-
-def dense(m):
-    import kvxopt  # ANDES's sparse matrices; a dependency of andes
-
-    return np.array(kvxopt.matrix(m), dtype=float)
-
-
-def residual_sensitivity(ss, service, index, step):
-    """(f_u, g_u) of an input that shifts `service.v[index]` by `step`, by a forward difference
-    through ANDES's residual evaluation at the operating point (then restored)."""
-    dae = ss.dae
-    ss.TDS.fg_update(ss.exist.tds)
-    f0, g0 = dae.f.copy(), dae.g.copy()
-    eps = 1e-6
-    service.v[index] += step * eps
-    ss.TDS.fg_update(ss.exist.tds)
-    fu, gu = (dae.f - f0) / eps, (dae.g - g0) / eps
-    service.v[index] -= step * eps
-    ss.TDS.fg_update(ss.exist.tds)
-    return fu, gu
-
-
-def linearise(ss):
-    dae = ss.dae
-    eig = ss.EIG
-    # The B and E below reuse the plain Schur complement; that is ANDES's A only when EIG folded
-    # no zero-time-constant states and removed no dead algebraic variables: check it.
-    assert len(eig.zstate_idx) == 0 and len(eig.dead_algeb_idx) == 0, "EIG reduced the DAE further"
-    fx, fy, gx, gy = (dense(m) for m in (dae.fx, dae.fy, dae.gx, dae.gy))
-    tf = np.asarray(dae.Tf, dtype=float).ravel()
-    a = np.array(eig.As, dtype=float)
-    a_own = (fx - fy @ np.linalg.solve(gy, gx)) / tf[:, None]
-    assert np.abs(a - a_own).max() <= 1e-9 * np.abs(a).max(), "ANDES's As is not Tf^-1 (fx - fy gy^-1 gx)"
-    assert list(eig.x_name) == list(dae.x_name)
-
-    def reduce(fu, gu):
-        return (fu - fy @ np.linalg.solve(gy, gu)) / tf
-
-    cols_b = []
-    for i in range(ss.EXDC2.n):
-        fu, gu = residual_sensitivity(ss, ss.EXDC2.vref0, i, +1.0)
-        # exactly one algebraic residual moves, by 1: the exciter's vref equation
-        assert np.abs(fu).max() < 1e-9 and np.isclose(gu[ss.EXDC2.vref.a[i]], 1.0) and np.sum(np.abs(gu) > 1e-9) == 1
-        cols_b.append(reduce(fu, gu))
-    cols_e = []
-    for g in DISTURBED:
-        i = g - 1
-        assert ss.TGOV1.syn.v[i] == ss.GENROU.idx.v[i], "governor i must drive generator i"
-        fu, gu = residual_sensitivity(ss, ss.TGOV1.tm0, i, -1.0)
-        assert np.abs(fu).max() < 1e-9 and np.isclose(gu[ss.GENROU.tm.a[i]], 1.0) and np.sum(np.abs(gu) > 1e-9) == 1
-        cols_e.append(reduce(fu, gu))
-    b, e = np.column_stack(cols_b), np.column_stack(cols_e)
-
-    # Cross-check E with the swing equation: 1/M in the row of omega_i, nothing elsewhere.
-    e_swing = np.zeros_like(e)
-    for k, g in enumerate(DISTURBED):
-        e_swing[ss.GENROU.omega.a[g - 1], k] = 1.0 / ss.GENROU.M.v[g - 1]
-    assert np.allclose(e, e_swing, rtol=1e-9, atol=1e-12), "E differs from 1/M in the omega rows"
-
-    names = [s.replace(" ", "_") for s in dae.x_name]
-    rows = list(ss.GENROU.delta.a) + list(ss.GENROU.omega.a)
-    c = np.eye(a.shape[0])[rows]
-    return a, b, c, e, names
 
 
 # ---------------------------------------------------------------------------------------------
@@ -266,8 +192,8 @@ def main():
     ap.add_argument("--check", action="store_true", help="print the checks only, write nothing")
     args = ap.parse_args()
 
-    ss, version = load_operating_point()
-    a, b, c, e, names = linearise(ss)
+    ss, version = load_operating_point(CASE)
+    a, b, c, e, names, _ = linearise(ss, DISTURBED)
     print(f"ANDES {version}, case {CASE}: {len(names)} states")
     report(a, b, c, e, args.dt)
     if args.check:

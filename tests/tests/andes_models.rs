@@ -1,0 +1,129 @@
+//! Real power-system models (ANDES's Kundur, IEEE 14, IEEE 39, NPCC and WECC cases, linearised by
+//! `scripts/models/andes_case.py`; 52 … 569 states): at dt = 1 ms and 10 ms a Chen–Patton UIO
+//! with `gain = "lqe"` designs exactly where scipy/numpy (`scripts/models/andes_reference.py`,
+//! `fixtures/andes/<case>/reference.json`) say it exists, decouples the unknown torques, and is
+//! refused where it does not (IEEE 39 and WECC: stabiliser filter states with zero rows in A,
+//! modes at s = 0 no sensor sees — z = 1 after sampling; the refusal does not yet name them).
+
+use std::path::Path;
+
+use lti::{Mat, Model};
+use observer::design::{Gain, Spec, Weights, design};
+use serde_json::Value;
+
+fn matrix(dir: &Path, name: &str) -> Mat {
+    let rows = scenario::matrix_file::read(dir, name).unwrap();
+    let (m, n) = (rows.len(), rows.first().map_or(0, |r| r.len()));
+    Mat::from_fn(m, n, |i, j| rows[i][j])
+}
+
+fn case(name: &str) -> (Model, Value) {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../fixtures/andes")
+        .join(name);
+    let (a, b, c, e) = (
+        matrix(&dir, "A.npy"),
+        matrix(&dir, "B.npy"),
+        matrix(&dir, "C.npy"),
+        matrix(&dir, "E.npy"),
+    );
+    let p = c.nrows();
+    let reference: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("reference.json")).unwrap())
+            .unwrap();
+    (
+        Model {
+            a,
+            b,
+            c,
+            e,
+            d: Mat::zeros(p, 0),
+        },
+        reference,
+    )
+}
+
+/// The largest |e_k| of the w → e response (an impulse in each unknown input, 200 steps, from a
+/// consistent start) relative to the largest |x_k|: 0 for an observer that decouples w.
+fn decoupling_error(d: &observer::Designed, model: &Model, dt: f64) -> f64 {
+    let dm = model.discretize(dt);
+    let rt = &d.runtime;
+    let [f, k, pm, qm] = [&rt.f, &rt.k, &rt.p, &rt.q].map(Mat::from);
+    // u = 0: G drops out; a w impulse at k = 0 is x₁ = Γ_E, z₁ = K·Cx₀ = 0.
+    let mut worst: f64 = 0.0;
+    for col in 0..dm.e.ncols() {
+        let mut x = Mat::from_column_slice(dm.e.nrows(), 1, dm.e.column(col).as_slice());
+        let mut z = Mat::zeros(f.nrows(), 1);
+        let (mut emax, mut xmax): (f64, f64) = (0.0, 0.0);
+        for _ in 0..200 {
+            let y = &dm.c * &x;
+            emax = emax.max((&x - &pm * &z - &qm * &y).amax());
+            xmax = xmax.max(x.amax());
+            z = &f * &z + &k * &y;
+            x = &dm.a * &x;
+        }
+        worst = worst.max(emax / xmax);
+    }
+    worst
+}
+
+fn check(name: &str) {
+    let (model, reference) = case(name);
+    let p = model.c.nrows();
+    for dt in [0.001, 0.01] {
+        let key = if dt == 0.001 { "0.001" } else { "0.01" };
+        let exists = reference["dt"][key]["uio"]["exists"].as_bool().unwrap();
+        let spec = Spec::ChenPatton {
+            gain: Gain::Lqe(Weights {
+                q: None,
+                r: Some(Mat::identity(p, p) * 0.01),
+            }),
+        };
+        let got = design(&model, &spec, dt);
+        match (exists, got) {
+            (true, Ok(d)) => {
+                let rho = lti::eig::spectral_radius(&d.report.discrete_poles);
+                assert!(rho < 1.0, "{name} dt = {dt}: ρ(F) = {rho}");
+                let err = decoupling_error(&d, &model, dt);
+                assert!(
+                    err < 1e-9,
+                    "{name} dt = {dt}: w → e {err:e} of the response"
+                );
+            }
+            (true, Err(e)) => panic!("{name} dt = {dt}: exists (scipy), refused: {e}"),
+            (false, Ok(_)) => panic!(
+                "{name} dt = {dt}: designed though scipy finds an unseen mode outside the unit circle"
+            ),
+            // Refused, as it must be. The refusal does not yet name the cause: the staircase does
+            // not see the defective mode at z = 1 (multiplicity 4–5, computed ~ε^(1/4) off), and
+            // the Riccati iteration then fails ("doubling did not converge" on IEEE 39, "Stein
+            // operator singular" on WECC) — issue 30 item 4, open.
+            (false, Err(e)) => eprintln!("{name} dt = {dt}: refused: {e}"),
+        }
+    }
+}
+
+#[test]
+fn kundur_designs_at_1_and_10_ms() {
+    check("kundur");
+}
+
+#[test]
+fn ieee14_designs_at_1_and_10_ms() {
+    check("ieee14");
+}
+
+#[test]
+fn ieee39_is_refused_for_its_unseen_modes_at_z_1() {
+    check("ieee39");
+}
+
+#[test]
+fn npcc_designs_at_1_and_10_ms() {
+    check("npcc");
+}
+
+#[test]
+fn wecc_is_refused_for_its_unseen_modes_at_z_1() {
+    check("wecc");
+}
