@@ -69,3 +69,28 @@ fn seed003_prefilter_makes_the_angle_of_attack_follow_the_reference() {
     let e = design_c(&model, &FeedbackSpec::Poles { poles: Poles::new([-4.0, -5.0, -6.0, -7.0].map(PoleSpec::Real)).unwrap(), placement: Method::Ackermann, domain: Domain::Continuous }, Some(&Mat::zeros(1, 4)), dt).unwrap_err();
     assert!(e.contains("singular"), "{e}");
 }
+
+/// Issue 30: Ackermann's formula for the sampled loop at dt = 1 ms, where the poles e^{p·dt}
+/// crowd at z = 1 (0.993 … 0.996): refused before ("placement missed … 1.306e-5" in z), placed
+/// now through the δ-domain. A single-input gain is unique, so it must equal Tits–Yang's for the
+/// same sampled poles (an eigenvector method, no characteristic polynomial), and the achieved
+/// poles sit on p in the s-plane relative to each pole.
+#[test]
+fn seed003_ackermann_places_the_sampled_loop_at_1_ms() {
+    let m = &seeds()["seed_003"]["model"];
+    let model = Model { a: mat(&m["A"]), b: mat(&m["B"]), c: mat(&m["C"]), e: Mat::zeros(4, 0), d: Mat::zeros(2, 0) };
+    let p = [-4.0, -5.0, -6.0, -7.0];
+    let dt = 1e-3;
+    let spec = |placement| FeedbackSpec::Poles { poles: Poles::new(p.map(PoleSpec::Real)).unwrap(), placement, domain: Domain::Sampled };
+    let ack = design_c(&model, &spec(Method::Ackermann), None, dt).unwrap();
+    let yt = design_c(&model, &spec(Method::YangTits), None, dt).unwrap();
+    let rel = (&ack.g - &yt.g).amax() / yt.g.amax();
+    assert!(rel < 1e-6, "Ackermann (δ) and Tits–Yang gains differ by {rel:e}\n{}\n{}", ack.g, yt.g);
+    let dm = model.discretize(dt);
+    let closed = lti::eig::eigenvalues(&(&dm.a - &dm.b * &ack.g)).unwrap();
+    let (s, _) = lti::eig::continuous_image(&closed, dt);
+    for want in p {
+        let off = s.iter().map(|z| (z - C64::new(want, 0.0)).norm()).fold(f64::INFINITY, f64::min);
+        assert!(off <= 1e-6 * want.abs(), "s = {want}: nearest achieved pole off by {off:e}");
+    }
+}

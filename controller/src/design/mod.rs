@@ -22,7 +22,7 @@ pub mod integral;
 
 use lti::dare::solve_dare;
 use lti::eig::{continuous_image, eigenvalues, format_list};
-use lti::place::{place, Method};
+use lti::place::{place, place_sampled, Method};
 use lti::{Discrete, Mat, Model, Poles, C64};
 
 /// Where the poles asked for are placed.
@@ -155,6 +155,13 @@ pub fn design(model: Option<&Model>, dm: &Discrete, spec: &FeedbackSpec, opts: &
                 return Err(format!("{} poles given, the loop has {states}", poles.len()));
             }
             match domain {
+                // Ackermann's formula works on the characteristic polynomial, whose coefficients
+                // in z cancel when the poles crowd at 1 (seed 003 at dt = 1 ms): it is placed in
+                // the δ-domain, δ = (z − 1)/dt, where they spread as in s (`lti::place::delta`).
+                Domain::Sampled if *placement == Method::Ackermann => (
+                    place_sampled(&phi, &gamma, poles, dm.dt, *placement).map_err(|e| e.to_string())?.gain,
+                    "placed for the sampled loop in the δ-domain: eig(Φ − Γ_BG) = e^{p·dt}".to_string(),
+                ),
                 Domain::Sampled => (
                     place(&phi, &gamma, &poles.to_discrete(dm.dt), *placement).map_err(|e| e.to_string())?.gain,
                     "placed for the sampled loop: eig(Φ − Γ_BG) = e^{p·dt}".to_string(),

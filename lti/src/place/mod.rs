@@ -9,9 +9,11 @@
 //!   It returns the gain MATLAB returns (seeds 001 and 002 print such gains).
 //! * [`Method::Ackermann`] — Ackermann's formula, single input only.
 //!
-//! Every placement checks the eigenvalues it achieved and fails if they are off.
+//! Every placement checks the eigenvalues it achieved and fails if they are off. A sampled loop's
+//! poles crowded at z = 1 are placed in the δ-domain ([`place_sampled`]).
 
 mod ackermann;
+mod delta;
 mod eigenstructure;
 mod knv0;
 mod yang_tits;
@@ -19,6 +21,7 @@ mod yang_tits;
 use nalgebra::DMatrix;
 
 pub use ackermann::{ackermann, characteristic_polynomial};
+pub use delta::{delta_pole, place_sampled};
 pub use eigenstructure::Eigenstructure;
 pub use knv0::{Sweeps, knv0};
 pub use yang_tits::yang_tits;

@@ -13,7 +13,7 @@
 //! T_d E_d = 0 exactly, so a disturbance held over each step is rejected at every sample.
 
 use lti::eig::format_list;
-use lti::pinv::{pinv, rank};
+use lti::pinv::rank;
 use lti::zeros::decoupling;
 use lti::{C64, Discrete, Mat, Model};
 
@@ -63,16 +63,18 @@ pub(super) fn core(
         if zeros.zeros.is_empty() {
             "none".to_string()
         } else if unstable.is_empty() {
-            format_list(&zeros.zeros)
+            format!("{var} = {}", format_list(&zeros.zeros), var = if domain == Domain::Continuous { "s" } else { "z" })
         } else {
             format!(
-                "unstable zero(s) {z}: (TA, C) is not detectable — its unobservable mode(s) {var} = {z} stay in F = TA − K1C whatever K1 is",
+                "unstable zero(s) {var} = {z}: (TA, C) is not detectable — its unobservable mode(s) {var} = {z} stay in F = TA − K1C whatever K1 is{no_sensor}",
                 z = format_list(&unstable),
-                var = if domain == Domain::Continuous { "s" } else { "z" }
+                var = if domain == Domain::Continuous { "s" } else { "z" },
+                no_sensor = " (no sensor sees them: no observer can estimate them)"
             )
         },
     )?;
-    let h = e * pinv(&ce);
+    // H = E(CE)⁺, refined once so that HCE = E holds to ~ε (`lti::pinv::right_solve`).
+    let h = lti::pinv::right_solve(e, &ce);
     let t = Mat::identity(n, n) - &h * c;
     let ta = &t * a;
     let (k1, fixed) = free_gain(

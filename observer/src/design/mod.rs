@@ -201,8 +201,8 @@ impl Checks {
         ok: bool,
         detail: impl Into<String>,
     ) -> Result<(), DesignError> {
-        let detail = detail.into();
-        let name = format!("{}{name}", self.prefix);
+        let detail = self.in_domain(&detail.into());
+        let name = format!("{}{}", self.prefix, self.in_domain(name));
         self.list.push(Condition {
             name: name.clone(),
             ok,
@@ -222,13 +222,23 @@ impl Checks {
 
     /// An error for `name`, carrying the conditions so far.
     pub(crate) fn error(&self, name: &str, detail: impl Into<String>) -> DesignError {
-        let condition = format!("{}{name}", self.prefix);
+        let condition = format!("{}{}", self.prefix, self.in_domain(name));
         DesignError {
             kind: self.kind,
             condition,
-            detail: detail.into(),
+            detail: self.in_domain(&detail.into()),
             conditions: self.list.clone(),
         }
+    }
+
+    /// A condition's words in this design's domain: the sampled design works on (Φ, Γ_B, Γ_E),
+    /// and says so — "(TΦ, C)", "invariant zeros of (Φ, Γ_E, C)" — where the families, which
+    /// run one function for both domains, write the papers' continuous names.
+    fn in_domain(&self, text: &str) -> String {
+        if self.prefix.is_empty() {
+            return text.to_string();
+        }
+        SAMPLED_NAMES.iter().fold(text.to_string(), |t, (from, to)| t.replace(from, to))
     }
 
     pub(crate) fn into_list(self) -> Vec<Condition> {
@@ -248,6 +258,25 @@ impl Checks {
             .collect()
     }
 }
+
+/// The papers' continuous names and their sampled counterparts, longest first where one
+/// contains another (Φ = e^{A·dt}, Γ_E = ∫e^{Aτ}dτ·E, the same C).
+const SAMPLED_NAMES: [(&str, &str); 14] = [
+    ("(A, E, C)", "(Φ, Γ_E, C)"),
+    ("rank(CE) = rank(E)", "rank(CΓ_E) = rank(Γ_E)"),
+    ("TA − K1C", "TΦ − K1C"),
+    ("(TA, C)", "(TΦ, C)"),
+    ("LgEd(CEd)g(CEd)", "LᵍΓ_E(CΓ_E)ᵍ(CΓ_E)"),
+    ("LgEd", "LᵍΓ_E"),
+    ("KCEd", "KCΓ_E"),
+    ("max|Ed|", "max|Γ_E|"),
+    ("LgAL", "LᵍΦL"),
+    ("K0CAL", "K0CΦL"),
+    ("KCAL", "KCΦL"),
+    ("CAL", "CΦL"),
+    ("HAF", "HΦF"),
+    ("CAF", "CΦF"),
+];
 
 /// The report of a design that has only its sampled part (an LQE gain, a discrete-time plant): the sampled checks as
 /// conditions, ln(z)/dt as continuous poles and fixed modes, the sampled matrices and the weights.
