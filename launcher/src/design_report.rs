@@ -104,11 +104,12 @@ pub fn report(s: &Scenario) -> DesignReport {
                 if !e.conditions.iter().any(|c| !c.ok) {
                     text += &format!("    FAIL {:<52} {}\n", e.condition, e.detail);
                 }
-                text += &format!("  no observer: {} does not hold: {}\n", e.condition, e.detail);
+                let carried = crate::plan::carried_by(s, &e);
+                text += &format!("  no observer: {} does not hold: {}{carried}\n", e.condition, e.detail);
                 observers.push(json!({
                     "name": o.name, "kind": o.kind(),
                     "conditions": conditions_json(&e.conditions),
-                    "error": format!("{} does not hold: {}", e.condition, e.detail),
+                    "error": format!("{} does not hold: {}{carried}", e.condition, e.detail),
                 }));
             }
         }

@@ -42,13 +42,24 @@ pub fn design_observer(s: &Scenario, o: &ObserverEntry, spec: &observer::Spec) -
     Ok(d)
 }
 
+/// " (x41 = WO_x_IEEEST_1, …)": the scenario's names of the states a refusal says carry a mode
+/// no sensor sees (the design names them x1, x2, … only).
+pub fn carried_by(s: &Scenario, e: &observer::DesignError) -> String {
+    let names: Vec<String> = e
+        .unseen_states
+        .iter()
+        .filter_map(|&i| s.names.state.get(i).filter(|n| n.name != format!("x{}", i + 1)).map(|n| format!("x{} = {}", i + 1, n.name)))
+        .collect();
+    if names.is_empty() { String::new() } else { format!(" ({})", names.join(", ")) }
+}
+
 /// Observer `i`'s refusal, located at its field.
 fn observer_error(s: &Scenario, i: usize, o: &ObserverEntry, e: &observer::DesignError) -> PlanError {
     let placement = e.condition.ends_with("poles") || e.condition.ends_with("pole placement");
     let (sub, reason) = if placement {
         (".poles", format!("{} observer '{}': {}", e.kind, o.name, e.detail))
     } else {
-        ("", format!("{} observer '{}': {} does not hold: {}", e.kind, o.name, e.condition, e.detail))
+        ("", format!("{} observer '{}': {} does not hold: {}{}", e.kind, o.name, e.condition, e.detail, carried_by(s, e)))
     };
     PlanError { error: scenario::locate_error(s, &format!("observer[{}]{sub}", i + 1), reason), conditions: e.conditions.clone(), observer: Some(i) }
 }

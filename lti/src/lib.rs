@@ -4,6 +4,8 @@
 //! * [`pinv`], [`subspace`], [`householder`], [`eig`] — the numerical core;
 //! * [`staircase`] — controllable / observable splits, controllability and observability matrices;
 //! * [`zeros`] — invariant zeros that decide whether an unknown-input observer exists;
+//! * [`unseen`] — the modes no sensor sees (PBH at the eigenvalues that matter), and the states
+//!   that carry them;
 //! * [`lyapunov`] — continuous and discrete Lyapunov equations (decay-rate certificates);
 //! * [`dare`] — the discrete algebraic Riccati equation (structure-preserving doubling) and the
 //!   steady-state Kalman filter;
@@ -33,6 +35,7 @@ pub mod sampled;
 pub mod signal;
 pub mod staircase;
 pub mod subspace;
+pub mod unseen;
 pub mod van_loan;
 pub mod zeros;
 

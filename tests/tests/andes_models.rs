@@ -2,8 +2,9 @@
 //! `scripts/models/andes_case.py`; 52 … 569 states): at dt = 1 ms and 10 ms a Chen–Patton UIO
 //! with `gain = "lqe"` designs exactly where scipy/numpy (`scripts/models/andes_reference.py`,
 //! `fixtures/andes/<case>/reference.json`) say it exists, decouples the unknown torques, and is
-//! refused where it does not (IEEE 39 and WECC: stabiliser filter states with zero rows in A,
-//! modes at s = 0 no sensor sees — z = 1 after sampling; the refusal does not yet name them).
+//! refused where it does not, naming the mode and the states that carry it (IEEE 39 and WECC:
+//! stabiliser filter states of the IEEEST models with zero rows in A, modes at s = 0 — z = 1
+//! after sampling — that no sensor sees).
 
 use std::path::Path;
 
@@ -69,6 +70,14 @@ fn decoupling_error(d: &observer::Designed, model: &Model, dt: f64) -> f64 {
 
 fn check(name: &str) {
     let (model, reference) = case(name);
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../fixtures/andes")
+        .join(name);
+    let states: Vec<String> = std::fs::read_to_string(dir.join("states.txt"))
+        .unwrap()
+        .lines()
+        .map(str::to_string)
+        .collect();
     let p = model.c.nrows();
     for dt in [0.001, 0.01] {
         let key = if dt == 0.001 { "0.001" } else { "0.01" };
@@ -94,11 +103,24 @@ fn check(name: &str) {
             (false, Ok(_)) => panic!(
                 "{name} dt = {dt}: designed though scipy finds an unseen mode outside the unit circle"
             ),
-            // Refused, as it must be. The refusal does not yet name the cause: the staircase does
-            // not see the defective mode at z = 1 (multiplicity 4–5, computed ~ε^(1/4) off), and
-            // the Riccati iteration then fails ("doubling did not converge" on IEEE 39, "Stein
-            // operator singular" on WECC) — issue 30 item 4, open.
-            (false, Err(e)) => eprintln!("{name} dt = {dt}: refused: {e}"),
+            // Refused naming the mode and the states that carry it: the PBH test at the
+            // eigenvalues on the circle (`lti::unseen`), before the Riccati iteration.
+            (false, Err(e)) => {
+                let text = e.to_string();
+                assert!(
+                    text.contains("z = 1 (s = 0)") && text.contains("no sensor sees it"),
+                    "{name} dt = {dt}: {text}"
+                );
+                let carried = e
+                    .unseen_states
+                    .iter()
+                    .map(|&i| states[i].as_str())
+                    .collect::<Vec<_>>();
+                assert!(
+                    !carried.is_empty() && carried.iter().all(|s| s.contains("IEEEST")),
+                    "{name} dt = {dt}: carried by {carried:?}: {text}"
+                );
+            }
         }
     }
 }
@@ -114,7 +136,7 @@ fn ieee14_designs_at_1_and_10_ms() {
 }
 
 #[test]
-fn ieee39_is_refused_for_its_unseen_modes_at_z_1() {
+fn ieee39_is_refused_naming_the_stabiliser_states_no_sensor_sees() {
     check("ieee39");
 }
 
@@ -124,6 +146,6 @@ fn npcc_designs_at_1_and_10_ms() {
 }
 
 #[test]
-fn wecc_is_refused_for_its_unseen_modes_at_z_1() {
+fn wecc_is_refused_naming_the_stabiliser_states_no_sensor_sees() {
     check("wecc");
 }

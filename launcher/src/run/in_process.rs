@@ -65,6 +65,9 @@ pub fn run(cfg: &Configs, session: &mut Session) -> Result<Stop, LaunchError> {
         if let Err(d) = diverged {
             return Ok(Stop::Diverged(d.to_string()));
         }
+        if let Some(w) = session.diverged.take() {
+            return Ok(Stop::Diverged(w));
+        }
     }
     Ok(Stop::Completed)
 }

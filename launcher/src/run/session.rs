@@ -86,6 +86,29 @@ pub struct Session {
     pace: Option<Pace>,
     /// `/latency/overrun`'s group and series (paced runs).
     overrun: Option<(usize, SeriesId)>,
+    /// Each observer's name, and the plant's state bound that its estimate is held to.
+    observer_names: Vec<String>,
+    state_bound: f64,
+    /// The first observer estimate that left the state bound or became non-finite, in words:
+    /// the run stops there as it does when the plant's state diverges (exit 4).
+    pub diverged: Option<String>,
+}
+
+/// An observer whose error left the plant's state bound (or is not finite) at this row, in
+/// words. An observer designed wrongly diverges while every condition it printed read "ok"
+/// (issue 30: a rank-deficient reduced basis reached an error of 1.8e12 and the run exited 0):
+/// its error x̂ᵢ − xᵢ is held to the rule the plant's state is, |·| ≤ `state_bound` (default
+/// 1e9). The error, not the estimate: an observer that follows a diverging plant is not the one
+/// to name, the plant's own check stops that run.
+fn estimate_divergence(row: &StepRow, x: &[f64], names: &[String], bound: f64) -> Option<String> {
+    for (xhat, name) in row.xhat.iter().zip(names) {
+        let bad = xhat.iter().zip(x).enumerate().find(|(_, (e, x))| !e.is_finite() || (*e - *x).abs() > bound);
+        if let Some((i, (&e, &xi))) = bad {
+            let value = if e.is_finite() { format!("x̂{n} − x{n} = {:.6e} left the bound ±{bound:.3e}", e - xi, n = i + 1) } else { format!("x̂{} = {e}", i + 1) };
+            return Some(format!("observer '{name}': its error grows without bound: {value} at step {}", row.k));
+        }
+    }
+    None
 }
 
 /// How a paced run kept its schedule: step k is due to end at t₀ + (k + 1)·period.
@@ -305,6 +328,9 @@ impl Session {
             judge,
             pace,
             overrun,
+            observer_names: s.observers.iter().map(|o| o.name.clone()).collect(),
+            state_bound: s.state_bound,
+            diverged: None,
         })
     }
 
@@ -413,6 +439,9 @@ impl Session {
 
     fn push(&mut self, row: &StepRow, step_ns: Option<(u64, u64)>, hops: &[(usize, u64)]) -> Result<(), LaunchError> {
         self.metrics.push(row);
+        if self.diverged.is_none() {
+            self.diverged = estimate_divergence(row, &row.plant[self.layout.x()], &self.observer_names, self.state_bound);
+        }
         let lay = self.layout;
         for m in &mut self.monitors {
             m.step(row.k, &self.metrics.residual);

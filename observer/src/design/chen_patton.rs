@@ -19,7 +19,7 @@ use lti::{C64, Discrete, Mat, Model};
 
 use super::{
     Checks, DesignError, Designed, Domain, Gain, Pair, Report, eig, eq_detail, free_gain,
-    require_stable, sampled_report,
+    refuse_unseen, require_stable, sampled_report,
 };
 use crate::runtime::LinearObserver;
 
@@ -77,6 +77,10 @@ pub(super) fn core(
     let h = lti::pinv::right_solve(e, &ce);
     let t = Mat::identity(n, n) - &h * c;
     let ta = &t * a;
+    // The staircase behind the zeros decides rank over up to n stages; on the real models
+    // (IEEE 39, WECC) it passed modes at z = 1 no sensor sees. The PBH test at the eigenvalues
+    // on or outside the boundary is decisive, and names the states that carry them.
+    refuse_unseen(checks, &ta, c, "(TA, C)", domain, true)?;
     let (k1, fixed) = free_gain(
         checks,
         &Pair::full(&ta, c, "(TA, C)"),

@@ -145,6 +145,19 @@ fn lqe(
     } else {
         Vec::new()
     };
+    // Modes no output sees on or outside the circle, by the PBH test (which the staircase's
+    // accumulated rank decisions can miss on large models), named — before a Riccati iteration
+    // fails on them with "did not converge".
+    if k > 0 {
+        super::refuse_unseen(
+            checks,
+            pair.a,
+            pair.c,
+            pair.name,
+            Domain::Discrete(dt),
+            pair.state_map.is_none(),
+        )?;
+    }
     // The modes no gain moves must be stable before a Riccati equation is asked: it has no
     // stabilising solution otherwise, and the cause is structural, not a convergence failure.
     if m > 0 && (k == 0 || !fixed.is_empty()) {

@@ -22,6 +22,16 @@ const KIND: &str = "kalman";
 pub(super) fn design(dm: &Discrete, qd: &Mat, r: &Mat) -> Result<Designed, DesignError> {
     let dt = dm.dt;
     let mut checks = Checks::sampled(KIND, dt);
+    // A mode no sensor sees on or outside the unit circle: named, before the Riccati iteration
+    // fails on it (WECC: "the Stein operator is singular").
+    super::refuse_unseen(
+        &mut checks,
+        &dm.a,
+        &dm.c,
+        "(Φ, C)",
+        Domain::Discrete(dt),
+        true,
+    )?;
     let kf = steady_state_kalman(&dm.a, &dm.c, qd, r).map_err(|e| {
         checks.error(
             "DARE(Φᵀ, Cᵀ, Q_d, R) has a stabilising solution",

@@ -143,6 +143,10 @@ pub struct DesignError {
     pub detail: String,
     /// All conditions evaluated, the failing one last.
     pub conditions: Vec<Condition>,
+    /// The plant states (0-based) that carry a mode no sensor sees, when that is the cause and
+    /// the pair's state is the plant's: the largest entries of its eigenvector, largest first.
+    /// The detail names them x1, x2, …; the launcher adds the scenario's `state_names`.
+    pub unseen_states: Vec<usize>,
 }
 
 /// Continuous or sampled: decides what "stable" means and how poles map.
@@ -212,6 +216,7 @@ impl Checks {
             Ok(())
         } else {
             Err(DesignError {
+                unseen_states: Vec::new(),
                 kind: self.kind,
                 condition: name,
                 detail,
@@ -224,6 +229,7 @@ impl Checks {
     pub(crate) fn error(&self, name: &str, detail: impl Into<String>) -> DesignError {
         let condition = format!("{}{}", self.prefix, self.in_domain(name));
         DesignError {
+            unseen_states: Vec::new(),
             kind: self.kind,
             condition,
             detail: self.in_domain(&detail.into()),
@@ -238,7 +244,9 @@ impl Checks {
         if self.prefix.is_empty() {
             return text.to_string();
         }
-        SAMPLED_NAMES.iter().fold(text.to_string(), |t, (from, to)| t.replace(from, to))
+        SAMPLED_NAMES
+            .iter()
+            .fold(text.to_string(), |t, (from, to)| t.replace(from, to))
     }
 
     pub(crate) fn into_list(self) -> Vec<Condition> {
@@ -487,9 +495,88 @@ fn sampled_target(
     Poles::from_values(&values).map_err(|e| e.to_string())
 }
 
-/// Sorted eigenvalues (design matrices are small and finite; failure is a bug upstream).
+/// Refuses the pair (A₁, C₁) if a mode on or outside the stability boundary is one no output
+/// sees ([`lti::unseen`], the PBH test at those eigenvalues), naming it in s and z and, when the
+/// pair's state is the plant's (`plant_coordinates`), the states that carry it. Passes silently
+/// otherwise: the condition it adds is the family's own detectability one, already listed.
+pub(crate) fn refuse_unseen(
+    checks: &mut Checks,
+    a1: &Mat,
+    c1: &Mat,
+    pair: &str,
+    domain: Domain,
+    plant_coordinates: bool,
+) -> Result<(), DesignError> {
+    let found = match domain {
+        Domain::Continuous => lti::unseen::unseen_modes(
+            a1,
+            c1,
+            |s| s.re >= -1e-3 * s.norm().max(1.0),
+            |s| !domain.stable(s),
+        ),
+        Domain::Discrete(_) => {
+            lti::unseen::unseen_modes(a1, c1, |z| z.norm() >= 1.0 - 1e-3, |z| !domain.stable(z))
+        }
+    }
+    .map_err(|e| checks.error(pair, e.to_string()))?;
+    let Some(first) = found.first() else {
+        return Ok(());
+    };
+    let both = |m: &lti::unseen::Unseen| {
+        let times = if m.multiplicity > 1 {
+            format!(" (×{})", m.multiplicity)
+        } else {
+            String::new()
+        };
+        match domain {
+            Domain::Continuous => format!("s = {}{times}", format_one(m.value, true)),
+            Domain::Discrete(dt) => {
+                // z carries rounding of ~1e-12 at best, ln(z)/dt that over dt: below 1e-9/dt, s is 0.
+                let snap = |s: C64| {
+                    if s.norm() * dt < 1e-9 {
+                        C64::new(0.0, 0.0)
+                    } else {
+                        s
+                    }
+                };
+                let s = continuous_image(&[m.value], dt)
+                    .0
+                    .first()
+                    .map(|s| format_one(snap(*s), true))
+                    .unwrap_or_else(|| "none".into());
+                format!("z = {} (s = {s}){times}", format_one(m.value, true))
+            }
+        }
+    };
+    let modes: Vec<String> = found.iter().map(both).collect();
+    let carried = if plant_coordinates {
+        let names: Vec<String> = first
+            .states
+            .iter()
+            .map(|(i, _)| format!("x{}", i + 1))
+            .collect();
+        format!(", carried by {}", names.join(", "))
+    } else {
+        String::new()
+    };
+    let detail = format!(
+        "mode {}{carried}: no sensor sees it, no observer can estimate it",
+        modes.join("; ")
+    );
+    let mut err = match checks.require(&format!("{pair} detectable"), false, detail) {
+        Err(e) => e,
+        Ok(()) => unreachable!("a failed condition is an error"),
+    };
+    if plant_coordinates {
+        err.unseen_states = first.states.iter().map(|(i, _)| *i).collect();
+    }
+    Err(err)
+}
+
+/// Sorted eigenvalues; NaNs where the Schur iteration failed (see below).
 pub(crate) fn eig(m: &Mat) -> Vec<C64> {
-    eigenvalues(m).unwrap_or_default()
+    // A failure gives NaNs, which no stability check passes: never an "ok" over an empty list.
+    eigenvalues(m).unwrap_or_else(|_| vec![C64::new(f64::NAN, f64::NAN); m.nrows()])
 }
 
 /// "rank X = r" style details.

@@ -189,6 +189,10 @@ fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: 
             if made > 0 {
                 last_progress = Instant::now();
             }
+            if let Some(w) = session.diverged.take() {
+                stop_all(procs);
+                return Ok(Stop::Diverged(w));
+            }
             if chunk == 0 && made == 0 {
                 break;
             }
