@@ -507,18 +507,8 @@ pub(crate) fn refuse_unseen(
     domain: Domain,
     plant_coordinates: bool,
 ) -> Result<(), DesignError> {
-    let found = match domain {
-        Domain::Continuous => lti::unseen::unseen_modes(
-            a1,
-            c1,
-            |s| s.re >= -1e-3 * s.norm().max(1.0),
-            |s| !domain.stable(s),
-        ),
-        Domain::Discrete(_) => {
-            lti::unseen::unseen_modes(a1, c1, |z| z.norm() >= 1.0 - 1e-3, |z| !domain.stable(z))
-        }
-    }
-    .map_err(|e| checks.error(pair, e.to_string()))?;
+    let found = lti::unseen::unseen_modes(a1, c1, |z| !domain.stable(z))
+        .map_err(|e| checks.error(pair, e.to_string()))?;
     let Some(first) = found.first() else {
         return Ok(());
     };
