@@ -18,6 +18,10 @@ E = [[2.0], [0.0], [0.5]]
 x0 = [1.0, -1.0, 2.0]
 state_bound = 10.0
 
+[[disturbance]]
+kind = "constant"
+value = 0.0
+
 [[input]]
 kind = "constant"
 value = 0.0
