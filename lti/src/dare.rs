@@ -551,7 +551,8 @@ pub(crate) fn sym(m: &Mat) -> Mat {
     (m + m.transpose()) * 0.5
 }
 
-pub(crate) fn one_norm(m: &Mat) -> f64 {
+/// ‖M‖₁, the largest column sum of |mᵢⱼ|.
+pub fn one_norm(m: &Mat) -> f64 {
     m.column_iter()
         .map(|c| c.iter().map(|x| x.abs()).sum::<f64>())
         .fold(0.0, f64::max)

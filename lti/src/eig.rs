@@ -8,7 +8,7 @@
 
 use nalgebra::{Complex, DMatrix};
 
-use crate::error::{LtiError, Result};
+use crate::error::Result;
 
 /// A complex number in double precision.
 pub type C64 = Complex<f64>;
@@ -58,22 +58,7 @@ pub fn balance(a: &DMatrix<f64>) -> DMatrix<f64> {
 
 /// Eigenvalues of a real square matrix, sorted by (real part, imaginary part).
 pub fn eigenvalues(a: &DMatrix<f64>) -> Result<Vec<C64>> {
-    let n = a.nrows();
-    if n != a.ncols() {
-        return Err(LtiError::Dimension(format!(
-            "eigenvalues of a {}×{} matrix",
-            n,
-            a.ncols()
-        )));
-    }
-    if n == 0 {
-        return Ok(Vec::new());
-    }
-    if a.iter().any(|x| !x.is_finite()) {
-        return Err(LtiError::NoConvergence(
-            "eigenvalues of a non-finite matrix",
-        ));
-    }
+    // Shape, emptiness and finiteness are checked there.
     let mut ev = crate::linalg::evd::eigenvalues(a)?;
     // A real matrix has exactly conjugate pairs; make them so bit for bit.
     for e in ev.iter_mut() {

@@ -15,6 +15,7 @@
 
 use nalgebra::DMatrix;
 
+use crate::dare::one_norm;
 use crate::eig::{C64, eigenvalues};
 use crate::error::Result;
 use crate::subspace::orthogonal_complement;
@@ -94,12 +95,7 @@ pub fn controllability_staircase_at(
     norm: f64,
 ) -> ControllabilityStaircase {
     let n = a.nrows();
-    let norm1 = |m: &DMatrix<f64>| {
-        (0..m.ncols())
-            .map(|j| m.column(j).iter().map(|x| x.abs()).sum::<f64>())
-            .fold(0.0, f64::max)
-    };
-    let tol = tolerance(n, norm1(a).max(norm1(b)).max(norm));
+    let tol = tolerance(n, one_norm(a).max(one_norm(b)).max(norm));
     let mut q = DMatrix::<f64>::identity(n, n);
     let mut at = a.clone();
     let mut bt = b.clone();
@@ -199,12 +195,7 @@ pub fn observable_by_rank_at(a: &DMatrix<f64>, c: &DMatrix<f64>, norm: f64) -> b
     if c.ncols() != n || c.nrows() < n {
         return n == 0;
     }
-    let norm1 = |m: &DMatrix<f64>| {
-        (0..m.ncols())
-            .map(|j| m.column(j).iter().map(|x| x.abs()).sum::<f64>())
-            .fold(0.0, f64::max)
-    };
-    let tol = tolerance(n, norm1(a).max(norm1(c)).max(norm));
+    let tol = tolerance(n, one_norm(a).max(one_norm(c)).max(norm));
     crate::linalg::svd::singular_values(c)
         .get(n - 1)
         .is_some_and(|&s| s > tol)

@@ -8,11 +8,6 @@ use crate::householder::full_qr;
 use crate::linalg::qr::pivot_order;
 use crate::linalg::svd::Svd;
 
-/// The SVD of a finite matrix; a non-finite one gets NaN bases of the sizes asked for.
-fn svd_or_nan(a: &DMatrix<f64>) -> Option<Svd> {
-    Svd::new(a)
-}
-
 /// Orthonormal basis (as columns) of the right null space {v : A v = 0}: the right singular
 /// vectors of the singular values under [the rank rule](crate::linalg::svd).
 pub fn null_space(a: &DMatrix<f64>) -> DMatrix<f64> {
@@ -23,7 +18,7 @@ pub fn null_space(a: &DMatrix<f64>) -> DMatrix<f64> {
     if m == 0 {
         return DMatrix::identity(n, n);
     }
-    match svd_or_nan(a) {
+    match Svd::new(a) {
         Some(svd) => svd.null(),
         None => DMatrix::from_element(n, n, f64::NAN),
     }
@@ -35,7 +30,7 @@ pub fn range(a: &DMatrix<f64>) -> DMatrix<f64> {
     if m == 0 || n == 0 {
         return DMatrix::zeros(m, 0);
     }
-    match svd_or_nan(a) {
+    match Svd::new(a) {
         Some(svd) => svd.range(),
         None => DMatrix::from_element(m, m, f64::NAN),
     }
@@ -55,7 +50,7 @@ pub fn kernel_basis(c: &DMatrix<f64>) -> DMatrix<f64> {
     if c.nrows() == 0 {
         return DMatrix::identity(n, n);
     }
-    let Some(svd) = svd_or_nan(c) else {
+    let Some(svd) = Svd::new(c) else {
         return DMatrix::from_element(n, n, f64::NAN);
     };
     let null = svd.null();
@@ -107,7 +102,7 @@ pub fn left_null_space(a: &DMatrix<f64>) -> DMatrix<f64> {
     if n == 0 {
         return DMatrix::identity(m, m);
     }
-    match svd_or_nan(a) {
+    match Svd::new(a) {
         Some(svd) => svd.left_null().transpose(),
         None => DMatrix::from_element(m, m, f64::NAN),
     }

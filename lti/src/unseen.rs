@@ -16,6 +16,7 @@
 
 use nalgebra::DMatrix;
 
+use crate::dare::one_norm;
 use crate::eig::{C64, eigenvalues};
 use crate::error::Result;
 use crate::linalg::svd::Svd;
@@ -50,12 +51,7 @@ pub fn unseen_modes(
 ) -> Result<Vec<Unseen>> {
     let n = a.nrows();
     let ev = eigenvalues(a)?;
-    let norm1 = |m: &DMatrix<f64>| {
-        (0..m.ncols())
-            .map(|j| m.column(j).iter().map(|x| x.abs()).sum::<f64>())
-            .fold(0.0, f64::max)
-    };
-    let scale = norm1(a).max(norm1(c)).max(1.0);
+    let scale = one_norm(a).max(one_norm(c)).max(1.0);
     let p = c.nrows();
     let mut out: Vec<Unseen> = Vec::new();
     for &z in ev.iter().filter(|&&z| concerns(z) && z.im >= 0.0) {

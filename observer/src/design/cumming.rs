@@ -16,12 +16,12 @@
 use lti::pinv::rank;
 use lti::{C64, Discrete, Mat, Model};
 
-use super::gain::norm1;
 use super::{
     Checks, DesignError, Designed, Domain, Gain, Pair, Report, eig, eq_detail, free_gain,
     require_stable, sampled_report,
 };
 use crate::runtime::LinearObserver;
+use lti::dare::one_norm as norm1;
 use lti::subspace::kernel_basis;
 
 const KIND: &str = "cumming";

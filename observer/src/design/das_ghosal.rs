@@ -32,12 +32,12 @@ use lti::pinv::pinv;
 use lti::subspace::kernel_basis;
 use lti::{C64, Discrete, Mat, Model};
 
-use super::gain::norm1;
 use super::{
     Checks, DesignError, Designed, Domain, Gain, Pair, Report, eig, free_gain, require_stable,
     sampled_report,
 };
 use crate::runtime::LinearObserver;
+use lti::dare::one_norm as norm1;
 
 /// How K is chosen.
 #[derive(Debug, Clone)]

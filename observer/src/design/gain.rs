@@ -256,10 +256,3 @@ fn weight(
         }
     }
 }
-
-/// The 1-norm (largest column sum), the staircase's measure of size.
-pub(crate) fn norm1(m: &Mat) -> f64 {
-    (0..m.ncols())
-        .map(|j| m.column(j).iter().map(|x| x.abs()).sum::<f64>())
-        .fold(0.0, f64::max)
-}
