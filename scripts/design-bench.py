@@ -11,6 +11,11 @@ I, I)` with the gain, or `place_poles((TΦ)ᵀ, Cᵀ, e^{p·dt})` (Tits–Yang).
 child process with a time limit; one that runs out is reported as "> limit".
 
     .venv/bin/python scripts/design-bench.py [--sizes 50,200,500,1000] [--limit 300] [--runs 3] [--gains lqe,place]
+    .venv/bin/python scripts/design-bench.py --andes kundur,ieee14,ieee39,npcc,wecc [--dt 0.001] --gains lqe
+
+With `--andes`, the models are the real power-system ones in `fixtures/andes/<case>/` (issue 30:
+design times beside scipy's) instead of random ones; IEEE 39 and WECC are refused by both (an
+unseen mode at s = 0), so their rows time the refusal against scipy's DARE failing.
 
 The launcher is the release build in $CARGO_TARGET_DIR (default target/).
 """
@@ -52,31 +57,21 @@ def poles(n):
     return [-1.0 - 0.2 * i for i in range(n)]
 
 
-def scenarios(d, n, a, b, c, e):
+def scenarios(d, n, a, b, c, e, dt=DT):
     for k, v in dict(A=a, B=b, C=c, E=e).items():
         np.save(d / f"{k}.npy", v)
+    disturbances = "".join(f'[[disturbance]]\nkind = "constant"\nvalue = {0.3 if i % 2 == 0 else -0.2}\n' for i in range(e.shape[1]))
+    inputs = "".join('[[input]]\nkind = "constant"\nvalue = 0.0\n' for _ in range(b.shape[1]))
     head = f"""name = "stiff{n}"
-dt = {DT}
-duration = 0.01
+dt = {dt}
+duration = {10 * dt}
 [plant]
 A = "A.npy"
 B = "B.npy"
 C = "C.npy"
 E = "E.npy"
 x0 = [{", ".join("0.0" for _ in range(n))}]
-[[disturbance]]
-kind = "constant"
-value = 0.3
-[[disturbance]]
-kind = "constant"
-value = -0.2
-[[input]]
-kind = "constant"
-value = 0.0
-[[input]]
-kind = "constant"
-value = 0.0
-[[observer]]
+{disturbances}{inputs}[[observer]]
 name = "uio"
 kind = "chen-patton-uio"
 """
@@ -121,15 +116,23 @@ def main():
     ap.add_argument("--limit", type=float, default=300.0)
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--gains", default="lqe,place", help="which designs to time: lqe, place or both")
+    ap.add_argument("--andes", default="", help="real models from fixtures/andes instead of random ones")
+    ap.add_argument("--dt", type=float, default=DT)
     args = ap.parse_args()
     target = os.environ.get("CARGO_TARGET_DIR") or str(REPO / "target")
     launcher = os.path.join(target, "release", "launcher")
     rows = []
-    for n in (int(s) for s in args.sizes.split(",")):
+    cases = args.andes.split(",") if args.andes else [int(s) for s in args.sizes.split(",")]
+    for case in cases:
         with tempfile.TemporaryDirectory() as tmp:
             d = Path(tmp)
-            scenarios(d, n, *model(n, np.random.default_rng(n)))
-            row = {"n": n, "p": max(n // 10, 2)}
+            if args.andes:
+                a, b, c, e = (np.load(REPO / "fixtures" / "andes" / case / f"{k}.npy") for k in "ABCE")
+            else:
+                a, b, c, e = model(case, np.random.default_rng(case))
+            n = a.shape[0]
+            scenarios(d, n, a, b, c, e, args.dt)
+            row = {"n": n, "p": c.shape[0], "case": case}
             for what in args.gains.split(","):
                 best, verdict = None, ""
                 for _ in range(args.runs):
@@ -142,7 +145,7 @@ def main():
                 row[f"ours_{what}"] = (best, verdict)
                 best, verdict = None, ""
                 for _ in range(args.runs):
-                    _, done = timed([sys.executable, "-c", SCIPY, str(d), what, str(DT)], args.limit)
+                    _, done = timed([sys.executable, "-c", SCIPY, str(d), what, str(args.dt)], args.limit)
                     if isinstance(done, str):
                         verdict = done
                         break
@@ -155,12 +158,12 @@ def main():
                 row[f"scipy_{what}"] = (best, verdict)
             rows.append(row)
             print(json.dumps(row), flush=True)
-    print("\n| n | p | ours, lqe | scipy, DARE | ours, placement | scipy, place_poles (YT) |")
-    print("|---|---|---|---|---|---|")
+    print("\n| case | n | p | ours, lqe | scipy, DARE | ours, placement | scipy, place_poles (YT) |")
+    print("|---|---|---|---|---|---|---|")
     fmt = lambda v: (f"{v[0]:.2f} s " if v[0] is not None else "") + v[1] if v else "—"
     for r in rows:
         cells = [fmt(r.get(k)) for k in ("ours_lqe", "scipy_lqe", "ours_place", "scipy_place")]
-        print(f"| {r['n']} | {r['p']} | " + " | ".join(cells) + " |")
+        print(f"| {r['case']} | {r['n']} | {r['p']} | " + " | ".join(cells) + " |")
 
 
 if __name__ == "__main__":

@@ -20,7 +20,16 @@ fn a_paced_run_keeps_wall_time_and_its_processes_idle() {
     // with seconds to spare.
     let seconds = 8.0;
     let path = variant(&s, "seed002-sine", seconds, false);
-    let child = launcher(&s).arg("run").arg(&path).arg("--out").arg(s.join("out")).arg("--realtime").stdout(std::process::Stdio::piped()).stderr(std::process::Stdio::piped()).spawn().unwrap();
+    let child = launcher(&s)
+        .arg("run")
+        .arg(&path)
+        .arg("--out")
+        .arg(s.join("out"))
+        .arg("--realtime")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
     let pid = child.id();
     let names = ["plant", "uio", "luenberger", "controller"];
     wait_running(pid, &names);
@@ -29,7 +38,10 @@ fn a_paced_run_keeps_wall_time_and_its_processes_idle() {
     // uio at 18 % of a core where its steady state is 5–6 % here).
     wait_stepping(&s.join("out").join("seed002-sine.rrd.partial"));
     // CPU use of every component over one second in the middle of the run.
-    let pids: Vec<i32> = names.iter().map(|n| component_pid(pid, n).unwrap()).collect();
+    let pids: Vec<i32> = names
+        .iter()
+        .map(|n| component_pid(pid, n).unwrap())
+        .collect();
     let before: Vec<u64> = pids.iter().map(|&p| cpu_ticks(p).unwrap()).collect();
     let t = Instant::now();
     std::thread::sleep(Duration::from_secs(1));
@@ -39,22 +51,35 @@ fn a_paced_run_keeps_wall_time_and_its_processes_idle() {
     let hz = unsafe { libc::sysconf(libc::_SC_CLK_TCK) } as f64;
     for ((name, b), a) in names.iter().zip(&before).zip(&after) {
         let share = (a.expect("still running") - b) as f64 / hz / secs;
-        assert!(share < 0.10, "{name} used {:.0} % of a core in a paced run", 100.0 * share);
+        assert!(
+            share < 0.10,
+            "{name} used {:.0} % of a core in a paced run",
+            100.0 * share
+        );
     }
     let out = child.wait_with_output().unwrap();
     assert!(out.status.success(), "{:?}", text(&out));
     assert_clean(&s, pid);
     let sum = summary(&s, "seed002-sine");
     let rt = &sum["realtime"];
-    let (paced, scheduled) = (rt["paced_wall_s"].as_f64().unwrap(), rt["scheduled_s"].as_f64().unwrap());
+    let (paced, scheduled) = (
+        rt["paced_wall_s"].as_f64().unwrap(),
+        rt["scheduled_s"].as_f64().unwrap(),
+    );
     assert!((scheduled - seconds).abs() < 1e-9, "{rt}");
-    assert!((paced / scheduled - 1.0).abs() < 0.01, "paced {paced} s for {scheduled} s");
+    assert!(
+        (paced / scheduled - 1.0).abs() < 0.01,
+        "paced {paced} s for {scheduled} s"
+    );
     assert_eq!(rt["steps"], 8000);
     let rec = read(&s.join("out").join("seed002-sine.rrd")).unwrap();
     let overrun = &rec.series["/latency/overrun"];
     assert_eq!(overrun.values.len(), 8000);
     let late = overrun.values.iter().filter(|&&v| v > 0.0).count() as u64;
-    assert_eq!(rt["overruns"], late, "the summary counts what the recording shows");
+    assert_eq!(
+        rt["overruns"], late,
+        "the summary counts what the recording shows"
+    );
 }
 
 #[test]
@@ -62,7 +87,11 @@ fn speed_scales_the_pace_and_an_impossible_pace_is_reported() {
     // Four times real time, in-process: 2 s of simulated time in 0.5 s.
     let s = Scratch::new("realtime-speed");
     let path = variant(&s, "seed002-sine", 2.0, false);
-    let out = run(&s, &path, &["--mode", "in-process", "--realtime", "--speed", "4"]);
+    let out = run(
+        &s,
+        &path,
+        &["--mode", "in-process", "--realtime", "--speed", "4"],
+    );
     assert!(out.status.success(), "{:?}", text(&out));
     let rt = &summary(&s, "seed002-sine")["realtime"];
     let paced = rt["paced_wall_s"].as_f64().unwrap();
@@ -70,15 +99,42 @@ fn speed_scales_the_pace_and_an_impossible_pace_is_reported() {
     // A million times real time at dt = 1 ms is a step per ns: no step can keep up, and the
     // summary says so.
     let t = Scratch::new("realtime-too-fast");
-    let out = run(&t, &path, &["--mode", "in-process", "--realtime", "--speed", "1e6", "--force"]);
+    let out = run(
+        &t,
+        &path,
+        &[
+            "--mode",
+            "in-process",
+            "--realtime",
+            "--speed",
+            "1e6",
+            "--force",
+        ],
+    );
     assert!(out.status.success(), "{:?}", text(&out));
     let (stdout, _) = text(&out);
     assert!(stdout.contains("cannot keep up"), "{stdout}");
     let rt = &summary(&t, "seed002-sine")["realtime"];
     assert!(rt["overruns"].as_u64().unwrap() > 1000, "{rt}");
     for bad in ["0", "-1", "nan", "inf"] {
-        let out = run(&t, &path, &["--mode", "in-process", "--realtime", "--speed", bad, "--force"]);
-        assert_eq!(out.status.code(), Some(2), "--speed {bad}: {:?}", text(&out));
+        let out = run(
+            &t,
+            &path,
+            &[
+                "--mode",
+                "in-process",
+                "--realtime",
+                "--speed",
+                bad,
+                "--force",
+            ],
+        );
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "--speed {bad}: {:?}",
+            text(&out)
+        );
     }
 }
 
@@ -90,20 +146,34 @@ fn a_python_plant_is_paced_too() {
     // 2.6 s seen in a slow phase of the machine).
     let out = run(&s, &scenario("cartpole-python-plant"), &[]);
     assert!(out.status.success(), "{:?}", text(&out));
-    let unpaced = summary(&s, "cartpole-python-plant")["wall_s"].as_f64().unwrap();
+    let unpaced = summary(&s, "cartpole-python-plant")["wall_s"]
+        .as_f64()
+        .unwrap();
     // 10 s of simulated time in real time: a 1 ms period. At five times (0.2 ms) the
     // Python plant's step (~0.12 ms) and its sleep's wake-up latency (~0.1–0.2 ms here) no longer
     // fit in a period: on 2026-11-28 every one of 10 000 steps overran and the paced run took
     // 2.8–4.2 s for the 2 s scheduled, with this change and without it (the same binaries of the
     // commit before, rebuilt and run); at twice (0.5 ms) 70 % of the steps still overran once.
-    let out = run(&s, &scenario("cartpole-python-plant"), &["--realtime", "--speed", "1", "--force"]);
+    let out = run(
+        &s,
+        &scenario("cartpole-python-plant"),
+        &["--realtime", "--speed", "1", "--force"],
+    );
     assert!(out.status.success(), "{:?}", text(&out));
     let rt = &summary(&s, "cartpole-python-plant")["realtime"];
-    let (paced, scheduled) = (rt["paced_wall_s"].as_f64().unwrap(), rt["scheduled_s"].as_f64().unwrap());
+    let (paced, scheduled) = (
+        rt["paced_wall_s"].as_f64().unwrap(),
+        rt["scheduled_s"].as_f64().unwrap(),
+    );
     // Paced means never ahead of the schedule; a late finish is the machine's, not the
     // pacing's: at 0.2 ms a step the Python plant needs long to catch up after one stall (the
     // page cache's writeback stalled it 50–120 ms in CI after the tests before it wrote their
     // recordings), so the upper bound is loose, and relative to the unpaced run where the
     // machine is slower than the schedule.
-    assert!((scheduled - 10.0).abs() < 1e-9 && paced >= scheduled * 0.999 && paced <= scheduled.max(unpaced) * 1.25, "{rt}, unpaced {unpaced} s");
+    assert!(
+        (scheduled - 10.0).abs() < 1e-9
+            && paced >= scheduled * 0.999
+            && paced <= scheduled.max(unpaced) * 1.25,
+        "{rt}, unpaced {unpaced} s"
+    );
 }
