@@ -154,7 +154,7 @@ def main():
                         break
                     secs, ok = done.stdout.split()
                     best = float(secs) if best is None else min(best, float(secs))
-                    verdict = "stable" if what == "lqe" and ok == "True" else ("placed" if ok == "True" else "missed")
+                    verdict = ("stable" if ok == "True" else "not stable") if what == "lqe" else ("placed" if ok == "True" else "missed")
                 row[f"scipy_{what}"] = (best, verdict)
             rows.append(row)
             print(json.dumps(row), flush=True)
