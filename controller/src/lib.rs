@@ -4,7 +4,8 @@
 //! u_k = N r_k − G x̂_k − G_ξ ξ_k − M ŵ_{k−1},      ξ_{k+1} = ξ_k + dt (r_k − z_k)
 //! ```
 //!
-//! (seed 000 eq. 24, with the reference prefilter N of [`design`]; the integrators ξ of
+//! (seed 000 eq. 24, with the reference prefilter N of [`design`]; at an operating point the
+//! design is in deviations and u_op − N r_op + G x_op is added, [`ControllerConfig::offset`]; the integrators ξ of
 //! [`design::integral`] and the cancellation M ŵ of [`design::feedforward`] when asked), its
 //! design, and the process shell that runs it in lockstep.
 
@@ -38,6 +39,11 @@ pub struct ControllerConfig {
     /// Cancellation of the unknown input, if asked.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub feedforward: Option<FeedforwardConfig>,
+    /// At an operating point, c_u = u_op − N r_op + G x_op (l values), added to u: the design
+    /// is in deviations, δu = N(r − r_op) − G(x̂ − x_op) (− G_ξξ − Mδŵ), and the plant takes
+    /// u = u_op + δu. `None` at the origin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub offset: Option<Vec<f64>>,
 }
 
 impl ControllerConfig {
@@ -76,6 +82,10 @@ pub struct FeedforwardConfig {
     pub y: [usize; 2],
     /// [start, end) of u_{k−1} in the plant's sample.
     pub u_prev: [usize; 2],
+    /// At an operating point, M(c − w_op) = −M W(y_op − CΦx_op − CΓ_Bu_op) (l values), so that
+    /// what is cancelled is Mδŵ = M(ŵ − w_op). `None` at the origin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub offset: Option<Vec<f64>>,
 }
 
 /// State feedback as a step function.
@@ -91,6 +101,8 @@ pub struct Controller {
     integral: Option<Integral>,
     feedforward: Option<Feedforward>,
     reads_plant: bool,
+    /// c_u at an operating point.
+    offset: Option<Vec<f64>>,
 }
 
 #[derive(Debug, Clone)]
@@ -144,10 +156,22 @@ impl Controller {
                 if mw.shape() != (l, y.len()) || a.shape() != (l, nx) || b.shape() != (l, l) || u_prev.len() != l {
                     return Err("feedforward: MW, MWCΦ, MWCΓ_B and the sample's ranges do not conform".to_string());
                 }
-                Ok(Feedforward { m_what: InputEstimateStep::new(mw, &a, &b), y, u_prev })
+                let mut m_what = InputEstimateStep::new(mw, &a, &b);
+                if let Some(c) = &f.offset {
+                    if c.len() != l || c.iter().any(|v| !v.is_finite()) {
+                        return Err(format!("feedforward: offset must hold {l} finite values"));
+                    }
+                    m_what = m_what.with_offset(c.clone());
+                }
+                Ok(Feedforward { m_what, y, u_prev })
             })
             .transpose()?;
-        Ok(Self { gx: DVector::zeros(l), u: DVector::zeros(l), r: DVector::zeros(l), g, n, references: SampledSignal::all(&cfg.references, cfg.dt), dt: cfg.dt, integral, feedforward, reads_plant: cfg.reads_plant() })
+        if let Some(c) = &cfg.offset
+            && (c.len() != l || c.iter().any(|v| !v.is_finite()))
+        {
+            return Err(format!("offset must hold {l} finite values (one per input)"));
+        }
+        Ok(Self { gx: DVector::zeros(l), u: DVector::zeros(l), r: DVector::zeros(l), g, n, references: SampledSignal::all(&cfg.references, cfg.dt), dt: cfg.dt, integral, feedforward, reads_plant: cfg.reads_plant(), offset: cfg.offset.clone() })
     }
 
     /// Whether it reads the plant's sample (for ŵ, or measured tracked outputs).
@@ -186,6 +210,11 @@ impl Controller {
         }
         for (u, gx) in u.iter_mut().zip(gx.iter()) {
             *u -= gx;
+        }
+        if let Some(c) = &self.offset {
+            for (u, c) in u.iter_mut().zip(c) {
+                *u += c;
+            }
         }
         u
     }

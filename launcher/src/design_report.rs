@@ -77,10 +77,12 @@ pub fn report(s: &Scenario) -> DesignReport {
                 for (n, m) in &r.matrices {
                     text += &matrix_text(n, m);
                 }
-                text += &format!("  poles:            {}\n", format_list(&r.poles));
-                text += &format!("  sampled (dt = {}): {}\n", s.dt, format_list(&r.discrete_poles));
+                // Every list says its domain (issue 30, item 7): s for the continuous poles and
+                // fixed modes (ln(z)/dt for a sampled-only design), z for the sampled ones.
+                text += &format!("  poles (s):        {}\n", format_list(&r.poles));
+                text += &format!("  poles (z, dt = {}): {}\n", s.dt, format_list(&r.discrete_poles));
                 if !r.fixed_modes.is_empty() {
-                    text += &format!("  fixed modes:      {}\n", format_list(&r.fixed_modes));
+                    text += &format!("  fixed modes (s):  {}\n", format_list(&r.fixed_modes));
                 }
                 for n in &r.notes {
                     text += &format!("  note: {n}\n");

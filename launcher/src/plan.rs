@@ -35,10 +35,15 @@ pub struct PlanError {
 }
 
 /// One observer's design, on the continuous plant and its exact sampling or on a discrete-time
-/// plant's own (Φ, Γ_B, Γ_E), starting at the observer's `xhat0`.
+/// plant's own (Φ, Γ_B, Γ_E), starting at the observer's `xhat0`, run at the scenario's operating
+/// point (its offsets; without `xhat0` it starts there).
 pub fn design_observer(s: &Scenario, o: &ObserverEntry, spec: &observer::Spec) -> Result<Designed, observer::DesignError> {
     let mut d = if s.discrete { observer::design::design_discrete(&s.sampled_model(), spec) } else { design(&s.model, spec, s.dt) }?;
     d.runtime.xhat0 = o.xhat0.clone();
+    // The model is in deviations from the operating point; the plant's signals are absolute.
+    if let Some(op) = &s.operating_point {
+        d.at_operating_point(op);
+    }
     Ok(d)
 }
 

@@ -117,6 +117,10 @@ pub struct Summary {
     /// The design's warnings (the ones `launcher design` prints), so the figures carry them.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
+    /// `[plant.operating_point]`: the point the design model is linearised at; every figure
+    /// above is in the plant's own (absolute) units.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub operating_point: Option<lti::OperatingPoint>,
 }
 
 impl Summary {
@@ -172,6 +176,7 @@ impl Summary {
             recording_digest: None,
             replay: None,
             warnings: plan.warnings.clone(),
+            operating_point: s.operating_point.clone(),
         };
         summary.expectations = summary.check(s, matches!(stop, Stop::Completed));
         summary

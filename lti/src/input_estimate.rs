@@ -5,6 +5,8 @@
 //! ŵ_{k−1} = W y_k − (WCΦ) x̂_{k−1} − (WCΓ_B) u_{k−1}
 //! ```
 //!
+//! At an operating point ([`crate::OperatingPoint`]) the recursion runs in deviations and a
+//! constant c = w_op − W(y_op − CΦx_op − CΓ_Bu_op) is added ([`InputEstimateStep::with_offset`]).
 //! It needs y_k, so ŵ_{k−1} completes with sample k. A left factor M may be folded into all three
 //! matrices (MW, MWCΦ, MWCΓ_B) to get Mŵ directly — the controller's cancellation of w. One pass
 //! of products and sums, in a fixed order, so the recorder and the controller form the same bits.
@@ -24,6 +26,8 @@ pub struct InputEstimateStep {
     p: usize,
     n: usize,
     started: bool,
+    /// The constant of an estimate made in deviations from an operating point, if any.
+    offset: Option<Vec<f64>>,
     /// ŵ_{k−1}, completed by the last sample (valid once [`Self::push`] returned true).
     pub value: Vec<f64>,
 }
@@ -42,8 +46,17 @@ impl InputEstimateStep {
             p,
             n,
             started: false,
+            offset: None,
             value: vec![0.0; q],
         }
+    }
+
+    /// The same recursion with a constant added to every estimate (q values): at an operating
+    /// point, c = w_op − W(y_op − CΦx_op − CΓ_Bu_op) (M c when M is folded in).
+    pub fn with_offset(mut self, c: Vec<f64>) -> Self {
+        debug_assert_eq!(c.len(), self.value.len(), "one offset per estimate");
+        self.offset = Some(c);
+        self
     }
 
     /// Sample k: y_k, the u_{k−1} the plant held over step k − 1, and x̂_k. Returns whether
@@ -55,6 +68,11 @@ impl InputEstimateStep {
             copy(yy, y);
             copy(&mut rest[self.n..], u_prev);
             mul_into(&mut self.value, &self.m, &self.stacked);
+            if let Some(c) = &self.offset {
+                for (v, c) in self.value.iter_mut().zip(c) {
+                    *v += c;
+                }
+            }
         }
         copy(&mut self.stacked[self.p..self.p + self.n], xhat);
         self.started = true;

@@ -28,6 +28,7 @@ pub mod kernel;
 pub mod linalg;
 pub mod lyapunov;
 pub mod model;
+pub mod operating_point;
 pub mod pinv;
 pub mod place;
 pub mod poles;
@@ -44,6 +45,7 @@ pub use eig::C64;
 pub use error::{LtiError, Result};
 pub use model::{Discrete, MatData, Model};
 pub use nalgebra::DMatrix;
+pub use operating_point::OperatingPoint;
 pub use poles::{PoleSpec, Poles, re_im};
 pub use van_loan::{discrete_noise_covariance, process_noise_covariance};
 

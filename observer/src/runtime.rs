@@ -10,6 +10,17 @@
 //! state the outputs give is taken from y_0). Without it z_0 = 0, so x̂_0 = Q y_0: for a UIO
 //! x̂_0 = H y_0, for a Luenberger observer 0.
 //!
+//! A design made in deviations from an operating point (x_op, u_op, y_op; [`lti::OperatingPoint`])
+//! runs on the plant's absolute signals with two constant offsets,
+//!
+//! ```text
+//! z_{k+1} = F z_k + G u_k + K y_k + c_z,   c_z = −(G u_op + K y_op),
+//! x̂_k     = P z_k + Q y_k + c_x,           c_x = x_op − Q y_op,
+//! ```
+//!
+//! i.e. z⁺ = Fz + Gδu + Kδy and x̂ = x_op + Pz + Qδy: without an initial estimate z_0 = 0 starts
+//! the observer at the operating point, x̂_0 = x_op + Qδy_0.
+//!
 //! At step k the observer is given y_k and u_{k−1} (the input the plant held over the last
 //! step): it first advances z_{k−1} → z_k with the stored y_{k−1}, then forms x̂_k. All buffers are
 //! allocated at construction; `step` does not allocate.
@@ -35,6 +46,18 @@ pub struct LinearObserver {
     /// The initial estimate x̂₀ (n values); `None`: z_0 = 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub xhat0: Option<Vec<f64>>,
+    /// The offsets of a design in deviations from an operating point; `None` at the origin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub offset: Option<Offset>,
+}
+
+/// c_z (r values) and c_x (n values) of an observer run at an operating point (module docs).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Offset {
+    /// c_z = −(G u_op + K y_op).
+    pub z: Vec<f64>,
+    /// c_x = x_op − Q y_op.
+    pub x: Vec<f64>,
 }
 
 impl LinearObserver {
@@ -53,7 +76,30 @@ impl LinearObserver {
             p: p.into(),
             q: q.into(),
             xhat0: None,
+            offset: None,
         }
+    }
+
+    /// The same observer run on absolute signals at the operating point (x_op, u_op, y_op): sets
+    /// c_z = −(G u_op + K y_op) and c_x = x_op − Q y_op (module docs); none at the origin.
+    ///
+    /// Preconditions: n, l and p values.
+    pub fn at_operating_point(&mut self, x_op: &[f64], u_op: &[f64], y_op: &[f64]) {
+        if x_op.iter().chain(u_op).chain(y_op).all(|&v| v == 0.0) {
+            self.offset = None;
+            return;
+        }
+        let m = |d: &MatData| DMatrix::<f64>::from(d);
+        let (u, y) = (
+            DMatrix::from_column_slice(u_op.len(), 1, u_op),
+            DMatrix::from_column_slice(y_op.len(), 1, y_op),
+        );
+        let cz = -(m(&self.g) * &u + m(&self.k) * &y);
+        let cx = DMatrix::from_column_slice(x_op.len(), 1, x_op) - m(&self.q) * &y;
+        self.offset = Some(Offset {
+            z: cz.as_slice().to_vec(),
+            x: cx.as_slice().to_vec(),
+        });
     }
 
     /// Observer order r (size of z).
@@ -91,7 +137,12 @@ impl LinearObserver {
             && self
                 .xhat0
                 .as_ref()
-                .is_none_or(|x| x.len() == self.p.rows && x.iter().all(|v| v.is_finite()));
+                .is_none_or(|x| x.len() == self.p.rows && x.iter().all(|v| v.is_finite()))
+            && self.offset.as_ref().is_none_or(|o| {
+                o.z.len() == r
+                    && o.x.len() == self.p.rows
+                    && o.z.iter().chain(&o.x).all(|v| v.is_finite())
+            });
         if ok {
             Ok(())
         } else {
@@ -129,6 +180,7 @@ impl LinearObserver {
                 .xhat0
                 .as_ref()
                 .map(|x0| (x0.clone(), lti::pinv::pinv(&p))),
+            offset: self.offset.clone(),
         }
     }
 }
@@ -154,6 +206,8 @@ pub struct ObserverState {
     p_identity: bool,
     /// Q = 0 (predictor-form Luenberger): skip Q y.
     q_zero: bool,
+    /// (c_z, c_x) at an operating point.
+    offset: Option<Offset>,
 }
 
 impl ObserverState {
@@ -166,12 +220,22 @@ impl ObserverState {
                 copy(&mut self.stacked[r..r + self.l], u_prev);
             }
             mul_into(&mut self.z_next, &self.fgk, &self.stacked);
+            if let Some(o) = &self.offset {
+                for (z, c) in self.z_next.iter_mut().zip(&o.z) {
+                    *z += c;
+                }
+            }
             copy(&mut self.stacked[..r], &self.z_next);
         } else if let Some((x0, p_pinv)) = &self.start {
-            // z_0 = P⁺(x̂₀ − Q y_0), with x̂ as the scratch vector.
+            // z_0 = P⁺(x̂₀ − Q y_0 − c_x), with x̂ as the scratch vector.
             mul_into(&mut self.xhat, &self.q, y);
             for (v, x) in self.xhat.iter_mut().zip(x0) {
                 *v = x - *v;
+            }
+            if let Some(o) = &self.offset {
+                for (v, c) in self.xhat.iter_mut().zip(&o.x) {
+                    *v -= c;
+                }
             }
             mul_into(&mut self.stacked[..r], p_pinv, &self.xhat);
         }
@@ -187,6 +251,11 @@ impl ObserverState {
         }
         if !self.q_zero {
             mul_acc(&mut self.xhat, &self.q, y);
+        }
+        if let Some(o) = &self.offset {
+            for (v, c) in self.xhat.iter_mut().zip(&o.x) {
+                *v += c;
+            }
         }
         &self.xhat
     }

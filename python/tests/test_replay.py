@@ -507,3 +507,23 @@ def test_mcap_missing_hold(motor, tmp_path):
     p = launch(tmp_path, "run", mcap_scenario(tmp_path, name="holes.mcap", extra='missing = "hold"'), "--out", out)
     assert p.returncode == 0, p.stderr
     assert json.loads((out / "motor-log.summary.json").read_text())["replay"]["held_cells"] == 3
+
+
+def test_a_log_without_input_columns_replays_as_u_zero(motor, tmp_path):
+    """`inputs` is optional (issue 31, item 4): a log of a plant whose known inputs held still
+    replays with u = 0 (u_op at an operating point), the same bit for bit as the log with columns
+    of zeros mapped to u."""
+    folder, (t, u, w, x, y) = motor
+    write_csv(folder / "still.csv", t, np.zeros_like(u), w, x, y)
+    text = motor_scenario(folder, csv="still.csv", duration=2.0).read_text()
+    assert 'inputs = ["volts1", "volts2"]\n' in text
+    with_u = folder / "with-u.toml"
+    with_u.write_text(text.replace('name = "motor-log"', 'name = "with-u"'))
+    without = folder / "without-u.toml"
+    without.write_text(text.replace('name = "motor-log"', 'name = "without-u"').replace('inputs = ["volts1", "volts2"]\n', ""))
+    out = tmp_path / "out"
+    for scen in (with_u, without):
+        p = launch(tmp_path, "run", scen, "--out", out)
+        assert p.returncode == 0, p.stderr
+    values, signals = compared(launch(tmp_path, "compare", out / "with-u.rrd", out / "without-u.rrd"))
+    assert values > 2000 * 6 and signals > 20, (values, signals)

@@ -23,6 +23,10 @@ pub struct Params {
     pub outputs: Vec<String>,
     pub disturbances: Option<Vec<String>>,
     pub states: Option<Vec<String>>,
+    /// Without `inputs` (a log of a plant whose known inputs held still): the constant u
+    /// (l values: the operating point's u_op, or 0).
+    #[serde(default)]
+    pub input_values: Option<Vec<f64>>,
     /// "none" or "zoh".
     pub resample: String,
     /// "error" or "hold".

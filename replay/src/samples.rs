@@ -80,6 +80,8 @@ pub fn table(p: &Params, file: String, m: Mapped, states: bool, name: &Naming<'_
     let nw = p.disturbances.as_ref().map_or(0, Vec::len);
     let (n, pp, q, r, l) = (p.n, p.p, p.q, p.r, p.l);
     let out_w = n + pp + q + r + 2 * l;
+    let zeros = vec![0.0; l];
+    let held_u: Option<&[f64]> = (p.inputs.is_empty() && l > 0).then(|| p.input_values.as_deref().filter(|u| u.len() == l).unwrap_or(&zeros));
     let mut data = Vec::with_capacity(pick.len() * out_w);
     for (k, &i) in pick.iter().enumerate() {
         let c = &cells[i * width + off..(i + 1) * width];
@@ -90,12 +92,21 @@ pub fn table(p: &Params, file: String, m: Mapped, states: bool, name: &Naming<'_
         data.extend_from_slice(cy);
         if nw == 0 { data.extend(std::iter::repeat_n(0.0, q)) } else { data.extend_from_slice(cw) }
         data.extend(std::iter::repeat_n(0.0, r));
-        data.extend_from_slice(cu);
-        if k == 0 {
-            data.extend(std::iter::repeat_n(0.0, l));
-        } else {
-            let prev = pick[k - 1];
-            data.extend_from_slice(&cells[prev * width + width - l..(prev + 1) * width]);
+        match held_u {
+            // No input columns: u is the constant the scenario gives (u_op, or 0).
+            Some(u) => {
+                data.extend_from_slice(u);
+                if k == 0 { data.extend(std::iter::repeat_n(0.0, l)) } else { data.extend_from_slice(u) }
+            }
+            None => {
+                data.extend_from_slice(cu);
+                if k == 0 {
+                    data.extend(std::iter::repeat_n(0.0, l));
+                } else {
+                    let prev = pick[k - 1];
+                    data.extend_from_slice(&cells[prev * width + width - l..(prev + 1) * width]);
+                }
+            }
         }
     }
     let facts = Facts { file, rows: rows as u64, samples: pick.len() as u64, held_rows, held_cells: m.held_cells, states };

@@ -11,6 +11,7 @@ pub mod limits;
 pub use observer_processes::{observer_processes, ObserverProcess};
 mod locate;
 mod observer_processes;
+mod operating_point;
 pub mod matrix_file;
 mod raw;
 mod replay_plant;
@@ -54,8 +55,11 @@ pub struct Scenario {
     pub model: Model,
     /// `[plant] time = "discrete"`: `model`'s A, B and E are Φ, Γ_B and Γ_E of one step of dt.
     pub discrete: bool,
-    /// Initial state.
+    /// Initial state (absolute, like every signal of the plant).
     pub x0: Vec<f64>,
+    /// `[plant.operating_point]`: the model is the linearisation there, in deviations; the
+    /// observers and the controller add its offsets and exchange absolute signals.
+    pub operating_point: Option<lti::OperatingPoint>,
     /// |x_i| beyond this stops the run.
     pub state_bound: f64,
     /// Names and units of every signal, for labels, titles and CSV headers.

@@ -195,6 +195,18 @@ pub struct RawPlant {
     pub ff: Option<Rows>,
     /// The host it runs on (a name in `[hosts]`).
     pub host: Option<String>,
+    /// `[plant.operating_point]`: where the model is linearised (it is in deviations there).
+    pub operating_point: Option<RawOperatingPoint>,
+}
+
+/// `[plant.operating_point]`: x, u, w (default 0) and y (default C x).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawOperatingPoint {
+    pub x: Option<Vec<f64>>,
+    pub u: Option<Vec<f64>>,
+    pub w: Option<Vec<f64>>,
+    pub y: Option<Vec<f64>>,
 }
 
 /// An external component: its command and parameters (PROTOCOL.md §7).

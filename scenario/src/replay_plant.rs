@@ -20,7 +20,8 @@ pub const REPLAY_PLANT_PROGRAM: &str = "replay_plant";
 
 /// The replayed plant as the process that runs it, and the data file's absolute path.
 /// `r` is the number of columns of D (the replayed v is zero: D v is in the recorded y).
-pub(crate) fn plant_replay(raw: &Option<RawReplay>, dir: Option<&Path>, z: &Sizes, r: usize, dt: f64, steps: u64) -> Result<Option<(std::path::PathBuf, ProcessSpec)>, Bad> {
+/// `u_op`: the operating point's known inputs, the u of a log without input columns (else 0).
+pub(crate) fn plant_replay(raw: &Option<RawReplay>, dir: Option<&Path>, z: &Sizes, r: usize, dt: f64, steps: u64, u_op: Option<&[f64]>) -> Result<Option<(std::path::PathBuf, ProcessSpec)>, Bad> {
     let Some(f) = raw else { return Ok(None) };
     let path = plant_file::path("plant.replay.path", dir, &f.path)?;
     let format = match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
@@ -73,7 +74,9 @@ pub(crate) fn plant_replay(raw: &Option<RawReplay>, dir: Option<&Path>, z: &Size
         }
         Ok(Some(names.clone()))
     };
-    let inputs = list("inputs", &f.inputs, z.l, "known inputs (columns of B)", false)?;
+    // Without input columns the inputs held still: u = u_op (or 0) throughout.
+    let inputs = list("inputs", &f.inputs, z.l, "known inputs (columns of B)", true)?;
+    let input_values = (inputs.is_none() && z.l > 0 && format != "rrd").then(|| u_op.map_or_else(|| vec![0.0; z.l], <[f64]>::to_vec));
     let outputs = list("outputs", &f.outputs, z.p, "outputs (rows of C)", false)?;
     let disturbances = list("disturbances", &f.disturbances, z.q, "unknown inputs (columns of E)", true)?;
     let states = list("states", &f.states, z.n, "states", true)?;
@@ -83,6 +86,7 @@ pub(crate) fn plant_replay(raw: &Option<RawReplay>, dir: Option<&Path>, z: &Size
         "channels": channels,
         "time": f.time,
         "inputs": inputs.unwrap_or_default(),
+        "input_values": input_values,
         "outputs": outputs.unwrap_or_default(),
         "disturbances": disturbances,
         "states": states,

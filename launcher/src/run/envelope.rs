@@ -144,6 +144,10 @@ pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> V
             if s.discrete {
                 model["time"] = json!("discrete");
             }
+            // The point the model is linearised at (PROTOCOL.md §3): the signals stay absolute.
+            if let Some(op) = &s.operating_point {
+                model["operating_point"] = json!(op);
+            }
             model
         },
         signals: Value::Null,

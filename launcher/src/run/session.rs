@@ -308,7 +308,7 @@ impl Session {
         }
         for (o, e) in estimates.iter().enumerate() {
             if let Some(e) = e {
-                metrics.estimate_inputs(o, e.w.clone(), &e.w_c_phi, &e.w_c_gamma_b);
+                metrics.estimate_inputs(o, e.w.clone(), &e.w_c_phi, &e.w_c_gamma_b, e.offset.clone());
             }
         }
         Ok(Session {

@@ -103,7 +103,16 @@ pub(crate) fn free_gain(
 ) -> Result<(Mat, Vec<C64>), DesignError> {
     match (gain, domain) {
         (Gain::Place { poles, method }, _) => place_detectable(
-            checks, pair.a, pair.c, pair.scale, poles, carried, *method, pair.name, domain,
+            checks,
+            pair.a,
+            pair.c,
+            pair.scale,
+            poles,
+            carried,
+            *method,
+            pair.name,
+            domain,
+            pair.state_map.is_none(),
         ),
         (Gain::Lqe(w), Domain::Discrete(dt)) => lqe(checks, pair, w, dt),
         (Gain::Lqe(_), Domain::Continuous) => Err(checks.error(

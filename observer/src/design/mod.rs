@@ -131,6 +131,18 @@ pub struct Designed {
     pub what: Option<InputEstimator>,
 }
 
+impl Designed {
+    /// The same design run on the plant's absolute signals at the operating point `op` (its
+    /// model is the linearisation there, in deviations): the observer's offsets c_z, c_x
+    /// ([`crate::runtime`]) and the input estimate's ([`InputEstimator::at_operating_point`]).
+    pub fn at_operating_point(&mut self, op: &lti::OperatingPoint) {
+        self.runtime.at_operating_point(&op.x, &op.u, &op.y);
+        if let Some(w) = &mut self.what {
+            w.at_operating_point(op);
+        }
+    }
+}
+
 /// A condition that fails, with everything evaluated up to it.
 #[derive(Debug, Clone, thiserror::Error)]
 #[error("{kind}: {condition} does not hold: {detail}")]
@@ -269,8 +281,9 @@ impl Checks {
 
 /// The papers' continuous names and their sampled counterparts, longest first where one
 /// contains another (Φ = e^{A·dt}, Γ_E = ∫e^{Aτ}dτ·E, the same C).
-const SAMPLED_NAMES: [(&str, &str); 14] = [
+const SAMPLED_NAMES: [(&str, &str); 15] = [
     ("(A, E, C)", "(Φ, Γ_E, C)"),
+    ("A − KCA", "Φ − KCΦ"),
     ("rank(CE) = rank(E)", "rank(CΓ_E) = rank(Γ_E)"),
     ("TA − K1C", "TΦ − K1C"),
     ("(TA, C)", "(TΦ, C)"),
@@ -299,6 +312,14 @@ pub(crate) fn sampled_report(
 ) -> Report {
     let discrete = eig(f);
     matrices.extend(sampled.weight_matrices());
+    // The families name their matrices and notes as the papers do (HAF − KCAF, LgAL); in a
+    // sampled-only report they are the sampled ones.
+    for (name, _) in &mut matrices {
+        *name = sampled.in_domain(name);
+    }
+    for note in &mut notes {
+        *note = sampled.in_domain(note);
+    }
     notes.insert(0, "the sampled design only (gain = lqe, or a discrete-time plant): matrices are the sampled observer's, poles are ln(z)/dt".into());
     let (poles, deadbeat) = continuous_image(&discrete, dt);
     if deadbeat > 0 {
@@ -332,6 +353,7 @@ pub(crate) fn sampled_report(
 /// sampled pair keeps a fixed mode of its own there, placed there where sampling made it
 /// observable (an invariant zero of (A, E, C) is often not one of (A_d, E_d, C)). Both designs
 /// then have the same error dynamics, and the user writes one pole list for both.
+/// `plant_coordinates`: the pair's state is the plant's (a refusal names the states).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn place_detectable(
     checks: &mut Checks,
@@ -343,6 +365,7 @@ pub(crate) fn place_detectable(
     method: Method,
     pair: &str,
     domain: Domain,
+    plant_coordinates: bool,
 ) -> Result<(Mat, Vec<C64>), DesignError> {
     let n = a.nrows();
     // Every state measured (rank C = n) is observable: no staircase, whose SVDs and rotations
@@ -369,6 +392,12 @@ pub(crate) fn place_detectable(
             .copied()
             .filter(|&z| !domain.stable(z))
             .collect();
+        if !unstable.is_empty() {
+            // Named as the Riccati path names it: the mode in s and z and the states that
+            // carry it, by the PBH test; the staircase's own words below only where the PBH
+            // test at its tolerance does not confirm the mode.
+            refuse_unseen(checks, a, c, pair, domain, plant_coordinates)?;
+        }
         checks.require(
             &format!("{pair} detectable"),
             unstable.is_empty(),

@@ -34,6 +34,22 @@ pub struct InputEstimator {
     pub w_c_phi: Mat,
     /// WCΓ_B, q×l.
     pub w_c_gamma_b: Mat,
+    /// At an operating point, the constant c = w_op − W(y_op − CΦx_op − CΓ_Bu_op) added to every
+    /// estimate: ŵ = w_op + δŵ with δŵ the recursion in deviations. `None` at the origin.
+    pub offset: Option<Vec<f64>>,
+}
+
+impl InputEstimator {
+    /// Sets the offset for the operating point `op` (its q values of w_op; module docs).
+    pub fn at_operating_point(&mut self, op: &lti::OperatingPoint) {
+        if op.is_origin() {
+            self.offset = None;
+            return;
+        }
+        let col = |v: &[f64]| Mat::from_column_slice(v.len(), 1, v);
+        let at = &self.w * col(&op.y) - &self.w_c_phi * col(&op.x) - &self.w_c_gamma_b * col(&op.u);
+        self.offset = Some(at.iter().zip(&op.w).map(|(a, w)| w - a).collect());
+    }
 }
 
 /// The estimator of the sampled plant `m`, if CΓ_E (or [CΓ_E D], `with_d`) has full column rank.
@@ -62,5 +78,6 @@ pub(crate) fn estimator(m: &Discrete, with_d: bool) -> Option<InputEstimator> {
         w_c_phi: &w_c * &m.a,
         w_c_gamma_b: &w_c * &m.b,
         w,
+        offset: None,
     })
 }

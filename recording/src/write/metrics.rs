@@ -111,9 +111,10 @@ impl Metrics {
         self.fault_free = Some((first, first as f64 * dt, vec![[0.0; 3]; self.observers.len()]));
     }
 
-    /// Observer `o` estimates the unknown inputs: ŵ_k = W y_{k+1} − (WCΦ) x̂_k − (WCΓ_B) u_k.
-    pub fn estimate_inputs(&mut self, o: usize, w: Mat, w_c_phi: &Mat, w_c_gamma_b: &Mat) {
-        self.what[o] = Some(InputEstimate::new(w, w_c_phi, w_c_gamma_b, self.planned, self.planned_tail));
+    /// Observer `o` estimates the unknown inputs: ŵ_k = W y_{k+1} − (WCΦ) x̂_k − (WCΓ_B) u_k
+    /// (+ c at an operating point, `offset`).
+    pub fn estimate_inputs(&mut self, o: usize, w: Mat, w_c_phi: &Mat, w_c_gamma_b: &Mat, offset: Option<Vec<f64>>) {
+        self.what[o] = Some(InputEstimate::new(w, w_c_phi, w_c_gamma_b, offset, self.planned, self.planned_tail));
     }
 
     /// The first step of the tail of the steps completed so far.

@@ -28,10 +28,16 @@ pub struct InputEstimate {
 }
 
 impl InputEstimate {
-    /// From W, WCΦ, WCΓ_B, for a run of `steps` steps whose tail starts at `planned_tail`.
-    pub fn new(w: Mat, w_c_phi: &Mat, w_c_gamma_b: &Mat, steps: u64, planned_tail: u64) -> Self {
+    /// From W, WCΦ, WCΓ_B (and the constant c at an operating point), for a run of `steps`
+    /// steps whose tail starts at `planned_tail`.
+    pub fn new(w: Mat, w_c_phi: &Mat, w_c_gamma_b: &Mat, offset: Option<Vec<f64>>, steps: u64, planned_tail: u64) -> Self {
         let q = w.nrows();
-        InputEstimate { step: InputEstimateStep::new(w, w_c_phi, w_c_gamma_b), prev_w: vec![0.0; q], ready: false, errors: BlockMax::new(steps), exact_tail: 0.0, planned_tail }
+        let step = InputEstimateStep::new(w, w_c_phi, w_c_gamma_b);
+        let step = match offset {
+            Some(c) => step.with_offset(c),
+            None => step,
+        };
+        InputEstimate { step, prev_w: vec![0.0; q], ready: false, errors: BlockMax::new(steps), exact_tail: 0.0, planned_tail }
     }
 
     /// ŵ_{k−1}, completed by the last row (valid when `ready`).
