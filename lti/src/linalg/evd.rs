@@ -100,3 +100,57 @@ mod tests {
         }
     }
 }
+
+/// An eigenvector of A for the computed eigenvalue λ by inverse iteration: three solves with the
+/// LU of A − λI (faer's partial-pivoting LU, complex), from a fixed start. For a simple λ computed
+/// to rounding, A − λI is singular to rounding and each solve multiplies the eigenvector's
+/// share by ~1/ε: the result is the eigenvector to rounding. For a multiple λ it is some vector
+/// of the eigenspace (or a principal vector). Returned scaled to max |xᵢ| = 1, with the
+/// relative residual ‖(A − λI)x‖∞ / (‖A‖∞ + |λ|); `None` if the solve broke down.
+pub fn inverse_iteration(
+    a: &DMatrix<f64>,
+    lambda: Complex<f64>,
+) -> Option<(Vec<Complex<f64>>, f64)> {
+    use faer::c64;
+    use faer::linalg::solvers::Solve;
+    let n = a.nrows();
+    if n == 0 || n != a.ncols() || a.iter().any(|x| !x.is_finite()) {
+        return None;
+    }
+    // An exact eigenvalue (a triangular A) makes A − λI exactly singular and the LU divide by
+    // zero: shifting λ by a few ulps keeps it nonsingular and changes nothing else.
+    let lambda = lambda * (1.0 + 4.0 * f64::EPSILON) + Complex::new(4.0 * f64::EPSILON, 0.0);
+    let shifted = FMat::<c64>::from_fn(n, n, |i, j| {
+        let d = if i == j {
+            lambda
+        } else {
+            Complex::new(0.0, 0.0)
+        };
+        c64::new(a[(i, j)] - d.re, -d.im)
+    });
+    let lu = shifted.partial_piv_lu();
+    // A start with no special direction: 1 + frac(i·φ).
+    let mut x = FMat::<c64>::from_fn(n, 1, |i, _| {
+        c64::new(1.0 + (i as f64 * 0.618_033_988_749_895).fract(), 0.0)
+    });
+    for _ in 0..3 {
+        x = lu.solve(&x);
+        let top = (0..n).map(|i| x[(i, 0)].norm()).fold(0.0, f64::max);
+        if !(top.is_finite() && top > 0.0) {
+            return None;
+        }
+        x = FMat::from_fn(n, 1, |i, _| x[(i, 0)] / top);
+    }
+    let r = &shifted * &x;
+    let residual = (0..n).map(|i| r[(i, 0)].norm()).fold(0.0, f64::max);
+    let norm_a = (0..n)
+        .map(|i| (0..n).map(|j| a[(i, j)].abs()).sum::<f64>())
+        .fold(0.0, f64::max);
+    let v = (0..n)
+        .map(|i| Complex::new(x[(i, 0)].re, x[(i, 0)].im))
+        .collect();
+    Some((
+        v,
+        residual / (norm_a + lambda.norm()).max(f64::MIN_POSITIVE),
+    ))
+}
