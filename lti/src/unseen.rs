@@ -52,7 +52,8 @@ fn seen_by_its_eigenvector(a: &DMatrix<f64>, c: &DMatrix<f64>, z: C64, ev: &[C64
     let Some((v, residual)) = crate::linalg::evd::inverse_iteration(a, z) else {
         return false;
     };
-    if !(residual <= 1e-10) {
+    // (A NaN residual is no eigenvector either.)
+    if residual.is_nan() || residual > 1e-10 {
         return false;
     }
     let cv = (0..c.nrows())

@@ -182,12 +182,12 @@ fn scenario(dir: &Path, name: &str, c: &Case, absolute: bool) -> PathBuf {
         shift(0.0, c.w_op[0])
     )
     .unwrap();
-    for j in 0..l {
+    for r in &r_op {
         writeln!(
             t,
             "[[input]]\nkind = \"step\"\ntime = 1.0\nbefore = {:?}\nafter = {:?}",
-            shift(0.0, r_op[j]),
-            shift(0.2, r_op[j])
+            shift(0.0, *r),
+            shift(0.2, *r)
         )
         .unwrap();
     }

@@ -37,8 +37,11 @@ pub fn eigenvalues(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>> {
         .map_err(|_| LtiError::NoConvergence("the real Schur iteration (faer)"))
 }
 
+/// Eigenvalues and, for each, its right eigenvector.
+pub type Eigen = (Vec<Complex<f64>>, Vec<Vec<Complex<f64>>>);
+
 /// Eigenvalues and right eigenvectors (columns, unit 2-norm) of A, unbalanced.
-pub fn eigen(a: &DMatrix<f64>) -> Result<(Vec<Complex<f64>>, Vec<Vec<Complex<f64>>>)> {
+pub fn eigen(a: &DMatrix<f64>) -> Result<Eigen> {
     let n = a.nrows();
     if n != a.ncols() {
         return Err(LtiError::Dimension(format!(
