@@ -349,6 +349,7 @@ fn spec(case: &Case) -> Spec {
 /// consistent start (x₀ = 0, z₀ = 0), driven by an impulse in one input column, relative to
 /// the terms it is the difference of: max_k(|x_k| + |Pz_k| + |Qy_k|). An error of a few ε of
 /// those is rounding of x̂ = Pz + Qy; a design that does not decouple leaves O(1).
+#[allow(clippy::too_many_arguments)] // the five observer matrices and the plant's three
 fn markov_error(
     f: &Mat,
     g: &Mat,

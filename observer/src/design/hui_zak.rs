@@ -325,7 +325,7 @@ pub(super) fn design(
     let (rho, worst_d) = discrete_certificate(&d_core.acl, decay, dt)
         .map_err(|e| sampled.error("Lyapunov certificate", e))?;
     notes.push(format!(
-        "sampled decay certificate: ρ = e^(−α·dt/2) = {}, λmax(AᵀPA − ρ²P) = {}",
+        "sampled decay certificate: ρ = e^(−α·dt/2) = {}, λmax(FᵀPF − ρ²P) = {} (F = Φ1 − LC)",
         sig(rho),
         sig(worst_d)
     ));
@@ -380,7 +380,7 @@ fn design_sampled(dm: &Discrete, decay: f64, gain: &Gain) -> Result<Designed, De
     let (rho, worst_d) = discrete_certificate(&d_core.acl, decay, dt)
         .map_err(|e| sampled.error("Lyapunov certificate", e))?;
     sampled.require(
-        &format!("decay rate {decay}: AᵀPA − ρ²P ⪯ 0 with ρ = e^(−α·dt/2)"),
+        &format!("decay rate {decay}: FᵀPF − ρ²P ⪯ 0 (F = Φ1 − LC) with ρ = e^(−α·dt/2)"),
         worst_d <= 1e-9,
         format!("ρ = {}, λmax = {}", sig(rho), sig(worst_d)),
     )?;

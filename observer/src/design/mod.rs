@@ -281,8 +281,13 @@ impl Checks {
 
 /// The papers' continuous names and their sampled counterparts, longest first where one
 /// contains another (Φ = e^{A·dt}, Γ_E = ∫e^{Aτ}dτ·E, the same C).
-const SAMPLED_NAMES: [(&str, &str); 15] = [
+const SAMPLED_NAMES: [(&str, &str); 18] = [
     ("(A, E, C)", "(Φ, Γ_E, C)"),
+    // Hui–Żak: B2 is the unknown input's matrix and A1 the projected A (the "B2" entry runs after
+    // the first, which leaves B2 for it).
+    ("(A, B2, C, D)", "(Φ, B2, C, D)"),
+    ("B2", "Γ_B2"),
+    ("A1", "Φ1"),
     ("A − KCA", "Φ − KCΦ"),
     ("rank(CE) = rank(E)", "rank(CΓ_E) = rank(Γ_E)"),
     ("TA − K1C", "TΦ − K1C"),
