@@ -14,6 +14,24 @@
 use crate::Mat;
 use crate::kernel::{copy, mul_into};
 
+/// W y − WCΦ x − WCΓ_B u at a constant point (x, u, y): what the recursion gives there (q
+/// values; with M folded in, M times it). At an operating point the estimator's offset is
+/// w_op minus it, and a controller's cancellation of Mδŵ adds minus it.
+pub fn at_rest(
+    w: &Mat,
+    w_c_phi: &Mat,
+    w_c_gamma_b: &Mat,
+    x: &[f64],
+    u: &[f64],
+    y: &[f64],
+) -> Vec<f64> {
+    let col = |v: &[f64]| Mat::from_column_slice(v.len(), 1, v);
+    (w * col(y) - w_c_phi * col(x) - w_c_gamma_b * col(u))
+        .iter()
+        .copied()
+        .collect()
+}
+
 /// ŵ_{k−1} from sample k, step by step.
 #[derive(Debug, Clone)]
 pub struct InputEstimateStep {

@@ -80,15 +80,14 @@ impl LinearObserver {
         }
     }
 
-    /// The same observer run on absolute signals at the operating point (x_op, u_op, y_op): sets
-    /// c_z = −(G u_op + K y_op) and c_x = x_op − Q y_op (module docs); none at the origin.
-    ///
-    /// Preconditions: n, l and p values.
-    pub fn at_operating_point(&mut self, x_op: &[f64], u_op: &[f64], y_op: &[f64]) {
-        if x_op.iter().chain(u_op).chain(y_op).all(|&v| v == 0.0) {
+    /// The same observer run on absolute signals at the operating point `op` (its x, u, y):
+    /// sets c_z = −(G u_op + K y_op) and c_x = x_op − Q y_op (module docs); none at the origin.
+    pub fn at_operating_point(&mut self, op: &lti::OperatingPoint) {
+        if op.is_origin() {
             self.offset = None;
             return;
         }
+        let (x_op, u_op, y_op) = (&op.x[..], &op.u[..], &op.y[..]);
         let m = |d: &MatData| DMatrix::<f64>::from(d);
         let (u, y) = (
             DMatrix::from_column_slice(u_op.len(), 1, u_op),

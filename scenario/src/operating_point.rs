@@ -7,6 +7,7 @@
 //! default to C x — for an FMU, a log or an external plant, give the outputs it has there when
 //! they are not C x (an output with its own offset).
 
+use lti::eig::sig;
 use lti::{Mat, Model, OperatingPoint};
 
 use super::raw::RawOperatingPoint;
@@ -66,8 +67,4 @@ pub(crate) fn operating_point(raw: &Option<RawOperatingPoint>, model: &Model, di
         }
     }
     Ok(Some(op))
-}
-
-fn sig(v: f64) -> String {
-    format!("{v:.6e}")
 }

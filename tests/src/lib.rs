@@ -89,6 +89,12 @@ pub fn text(o: &Output) -> (String, String) {
     (String::from_utf8_lossy(&o.stdout).into_owned(), String::from_utf8_lossy(&o.stderr).into_owned())
 }
 
+/// A JSON list of [re, im] pairs (as `lti::re_im` writes poles and eigenvalues) as complex
+/// numbers.
+pub fn complex_list(v: &serde_json::Value) -> Vec<lti::C64> {
+    v.as_array().expect("a list of [re, im]").iter().map(|z| lti::C64::new(z[0].as_f64().unwrap(), z[1].as_f64().unwrap())).collect()
+}
+
 /// The summary a run wrote.
 pub fn summary(scratch: &Scratch, name: &str) -> serde_json::Value {
     let p = scratch.join("out").join(format!("{name}.summary.json"));

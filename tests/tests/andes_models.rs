@@ -216,12 +216,7 @@ fn wecc_is_refused_naming_the_stabiliser_states_no_sensor_sees() {
 fn the_eigenvalues_of_every_real_model_match_lapack() {
     for name in ["kundur", "ieee14", "ieee39", "npcc", "wecc"] {
         let (model, reference) = case(name);
-        let want: Vec<lti::C64> = reference["eig_A"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|z| lti::C64::new(z[0].as_f64().unwrap(), z[1].as_f64().unwrap()))
-            .collect();
+        let want = tests::complex_list(&reference["eig_A"]);
         let got = lti::eig::eigenvalues(&model.a).unwrap();
         let err = lti::eig::match_error(&want, &got);
         assert!(

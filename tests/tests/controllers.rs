@@ -21,7 +21,7 @@ fn shipped_closed_loops_have_the_sampled_poles_their_files_ask() {
         let Some(FeedbackSpec::Poles { poles, domain: Domain::Sampled, .. }) = sc.controller.as_ref().and_then(|c| c.spec.clone()) else { continue };
         let out = launcher(&s).args(["design", "--json"]).arg(&path).output().unwrap();
         let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let got: Vec<C64> = v["controller"]["discrete_closed_loop_poles"].as_array().unwrap().iter().map(|p| C64::new(p[0].as_f64().unwrap(), p[1].as_f64().unwrap())).collect();
+        let got: Vec<C64> = complex_list(&v["controller"]["discrete_closed_loop_poles"]);
         let want = poles.to_discrete(sc.dt);
         let err = lti::eig::match_error(want.values(), &got);
         assert!(err <= 1e-12, "{}: sampled poles {got:?} vs e^(p·dt) {:?}: {err:e}", path.display(), want.values());

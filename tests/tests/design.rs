@@ -197,12 +197,7 @@ fn design_json_sampled_matrices_reproduce_the_recorded_estimates() {
             mat(&sm["Q"]),
         );
         // eig(F) are the reported discrete poles.
-        let want: Vec<lti::C64> = o["discrete_poles"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|z| lti::C64::new(z[0].as_f64().unwrap(), z[1].as_f64().unwrap()))
-            .collect();
+        let want = complex_list(&o["discrete_poles"]);
         assert!(
             lti::eig::match_error(&want, &lti::eig::eigenvalues(&f).unwrap()) < 1e-12,
             "{name}"

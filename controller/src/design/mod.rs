@@ -101,6 +101,20 @@ pub struct FeedbackDesign {
 }
 
 impl FeedbackDesign {
+    /// c_u = u_op − N r_op + G x_op of this feedback designed in deviations from `op`
+    /// ([`crate::ControllerConfig::offset`]): r_op = C_t x_op, the tracked outputs at the point
+    /// (`track`), or u_op without tracked outputs (N = I: the references are then the inputs'
+    /// absolute levels).
+    pub fn offset_at(&self, track: Option<&Mat>, op: &lti::OperatingPoint) -> Vec<f64> {
+        let col = |v: &[f64]| Mat::from_column_slice(v.len(), 1, v);
+        let x = col(&op.x);
+        let r_op = match track {
+            Some(ct) => ct * &x,
+            None => col(&op.u),
+        };
+        (col(&op.u) - &self.n * r_op + &self.g * x).iter().copied().collect()
+    }
+
     /// Whether the continuous and the sampled loops are both asymptotically stable.
     pub fn stable(&self) -> bool {
         self.unstable.is_empty() && self.discrete_closed_loop.iter().all(|z| z.norm() < 1.0)

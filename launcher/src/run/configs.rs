@@ -9,26 +9,6 @@ use plant::PlantConfig;
 use crate::plan::Plan;
 use scenario::Scenario;
 
-/// c_u = u_op − N r_op + G x_op of a state feedback designed in deviations from `op`
-/// ([`ControllerConfig::offset`]): r_op = C_t x_op, the tracked outputs at the point, or u_op
-/// without tracked outputs (N = I: the references are then the inputs' absolute levels).
-fn controller_offset(track: Option<&lti::Mat>, fb: &controller::design::FeedbackDesign, op: &lti::OperatingPoint) -> Vec<f64> {
-    let col = |v: &[f64]| lti::Mat::from_column_slice(v.len(), 1, v);
-    let x = col(&op.x);
-    let r_op = match track {
-        Some(ct) => ct * &x,
-        None => col(&op.u),
-    };
-    (col(&op.u) - &fb.n * r_op + &fb.g * x).iter().copied().collect()
-}
-
-/// M(c − w_op) = −(MW y_op − MWCΦ x_op − MWCΓ_B u_op): what the controller's M ŵ recursion adds
-/// so that it cancels Mδŵ ([`FeedforwardConfig::offset`]).
-fn feedforward_offset(mw: &lti::Mat, mw_c_phi: &lti::Mat, mw_c_gamma_b: &lti::Mat, op: &lti::OperatingPoint) -> Vec<f64> {
-    let col = |v: &[f64]| lti::Mat::from_column_slice(v.len(), 1, v);
-    (-(mw * col(&op.y) - mw_c_phi * col(&op.x) - mw_c_gamma_b * col(&op.u))).iter().copied().collect()
-}
-
 /// Every component's configuration.
 #[derive(Debug, Clone)]
 pub struct Configs {
@@ -119,9 +99,12 @@ pub fn configs(s: &Scenario, plan: &Plan) -> Configs {
                 mw_c_gamma_b: b.into(),
                 y: [layout.y().start, layout.y().end],
                 u_prev: [layout.u_prev().start, layout.u_prev().end],
-                offset: s.operating_point.as_ref().filter(|op| !op.is_origin()).map(|op| feedforward_offset(mw, a, b, op)),
+                offset: s.operating_point.as_ref().filter(|op| !op.is_origin()).map(|op| {
+                    // M(c − w_op) = −M(W y_op − WCΦ x_op − WCΓ_B u_op): what cancels Mδŵ.
+                    lti::input_estimate::at_rest(mw, a, b, &op.x, &op.u, &op.y).iter().map(|v| -v).collect()
+                }),
             }),
-            offset: s.operating_point.as_ref().filter(|op| !op.is_origin()).map(|op| controller_offset(c.track.as_ref(), fb, op)),
+            offset: s.operating_point.as_ref().filter(|op| !op.is_origin()).map(|op| fb.offset_at(c.track.as_ref(), op)),
         }),
         _ => None,
     };

@@ -78,32 +78,6 @@ pub fn eigen(a: &DMatrix<f64>) -> Result<Eigen> {
     Ok((values, vectors))
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_rotation_has_a_conjugate_pair() {
-        let a = DMatrix::from_row_slice(2, 2, &[0.0, -2.0, 2.0, 0.0]);
-        let mut ev = eigenvalues(&a).unwrap();
-        ev.sort_by(|x, y| x.im.total_cmp(&y.im));
-        assert_eq!(ev[0], ev[1].conj());
-        assert!((ev[1] - Complex::new(0.0, 2.0)).norm() < 1e-15);
-    }
-
-    #[test]
-    fn eigenvectors_satisfy_the_eigen_equation() {
-        let a = DMatrix::from_row_slice(3, 3, &[0.0, 1.0, 0.0, 0.0, 0.0, 1.0, -6.0, -11.0, -6.0]);
-        let (values, vectors) = eigen(&a).unwrap();
-        for (l, v) in values.iter().zip(&vectors) {
-            for i in 0..3 {
-                let av: Complex<f64> = (0..3).map(|j| v[j] * a[(i, j)]).sum();
-                assert!((av - v[i] * l).norm() < 1e-13);
-            }
-        }
-    }
-}
-
 /// An eigenvector of A for the computed eigenvalue λ by inverse iteration: three solves with the
 /// LU of A − λI (faer's partial-pivoting LU, complex), from a fixed start. For a simple λ computed
 /// to rounding, A − λI is singular to rounding and each solve multiplies the eigenvector's
@@ -156,4 +130,30 @@ pub fn inverse_iteration(
         v,
         residual / (norm_a + lambda.norm()).max(f64::MIN_POSITIVE),
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_rotation_has_a_conjugate_pair() {
+        let a = DMatrix::from_row_slice(2, 2, &[0.0, -2.0, 2.0, 0.0]);
+        let mut ev = eigenvalues(&a).unwrap();
+        ev.sort_by(|x, y| x.im.total_cmp(&y.im));
+        assert_eq!(ev[0], ev[1].conj());
+        assert!((ev[1] - Complex::new(0.0, 2.0)).norm() < 1e-15);
+    }
+
+    #[test]
+    fn eigenvectors_satisfy_the_eigen_equation() {
+        let a = DMatrix::from_row_slice(3, 3, &[0.0, 1.0, 0.0, 0.0, 0.0, 1.0, -6.0, -11.0, -6.0]);
+        let (values, vectors) = eigen(&a).unwrap();
+        for (l, v) in values.iter().zip(&vectors) {
+            for i in 0..3 {
+                let av: Complex<f64> = (0..3).map(|j| v[j] * a[(i, j)]).sum();
+                assert!((av - v[i] * l).norm() < 1e-13);
+            }
+        }
+    }
 }

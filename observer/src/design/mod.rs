@@ -136,7 +136,7 @@ impl Designed {
     /// model is the linearisation there, in deviations): the observer's offsets c_z, c_x
     /// ([`crate::runtime`]) and the input estimate's ([`InputEstimator::at_operating_point`]).
     pub fn at_operating_point(&mut self, op: &lti::OperatingPoint) {
-        self.runtime.at_operating_point(&op.x, &op.u, &op.y);
+        self.runtime.at_operating_point(op);
         if let Some(w) = &mut self.what {
             w.at_operating_point(op);
         }

@@ -46,8 +46,14 @@ impl InputEstimator {
             self.offset = None;
             return;
         }
-        let col = |v: &[f64]| Mat::from_column_slice(v.len(), 1, v);
-        let at = &self.w * col(&op.y) - &self.w_c_phi * col(&op.x) - &self.w_c_gamma_b * col(&op.u);
+        let at = lti::input_estimate::at_rest(
+            &self.w,
+            &self.w_c_phi,
+            &self.w_c_gamma_b,
+            &op.x,
+            &op.u,
+            &op.y,
+        );
         self.offset = Some(at.iter().zip(&op.w).map(|(a, w)| w - a).collect());
     }
 }
