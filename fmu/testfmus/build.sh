@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Test FMUs (issue 22): builds OUTDIR/{lti_plant,dc_motor,faulty}_{fmi2,fmi3}.fmu — FMI 2.0 and 3.0
 # co-simulation FMUs for linux x86_64 — from the C sources next to this script, against the
-# FMI headers that FMPy ships, and validates each with FMPy. Idempotent (each FMU is rebuilt
+# FMI headers that FMPy ships, and validates each with FMPy; and OUTDIR/three_tank.fmu, made
+# by pythonfmu (a third-party exporter, PyPI) from python/three_tank.py. Idempotent (each FMU is rebuilt
 # and replaced atomically); takes a second or two.
 #
-#   fmu/testfmus/build.sh OUTDIR        (PYTHON: a python with fmpy; default python3)
+#   fmu/testfmus/build.sh OUTDIR        (PYTHON: a python with fmpy and pythonfmu; default python3)
 set -euo pipefail
 
 [ $# -eq 1 ] || { echo "usage: $0 OUTDIR" >&2; exit 2; }
@@ -54,5 +55,11 @@ for path in sys.argv[1:]:
     fmu = fmpy.instantiate_fmu(unzipdir, md, fmi_type="CoSimulation")
     fmu.freeInstance()
 EOF
+# A third-party exporter's FMU (issue 31): pythonfmu (PyPI) builds python/three_tank.py into an
+# FMI 2.0 co-simulation FMU whose library embeds Python.
+mkdir -p "$tmp/py"
+"$py" -m pythonfmu build -f "$src/python/three_tank.py" -d "$tmp/py" >/dev/null
+"$py" -c 'import fmpy, sys; fmpy.read_model_description(sys.argv[1], validate=True)' "$tmp/py/three_tank.fmu"
+mv -f "$tmp"/py/three_tank.fmu "$tmp"/
 mv -f "$tmp"/*.fmu "$out"/
-echo "build.sh: $(cd "$out" && ls {lti_plant,dc_motor,faulty}_fmi{2,3}.fmu | tr '\n' ' ')in $out"
+echo "build.sh: $(cd "$out" && ls {lti_plant,dc_motor,faulty}_fmi{2,3}.fmu three_tank.fmu | tr '\n' ' ')in $out"

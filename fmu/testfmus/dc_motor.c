@@ -6,7 +6,8 @@
  *       dtheta/dt =  omega
  *
  * u1 is the voltage (known input), w1 the load torque (unknown input). Outputs y1 = omega,
- * y2 = theta, and the states x1 = i, x2 = omega, x3 = theta; x(0) = 0.
+ * y2 = theta, and the states x1 = i, x2 = omega, x3 = theta; x(0) = their start values
+ * (0 unless set before initialisation).
  *
  * One doStep of length h integrates with `substeps` classical RK4 steps of length
  * h / substeps, the inputs held at their values at the step's start. Any h > 0 is accepted.
@@ -40,9 +41,9 @@ const ModelVar MODEL_VARS[] = {
     [W1] = { "w1", INPUT, 0, "load torque [N m]" },
     [Y1] = { "y1", OUTPUT, 0, "speed omega [rad/s]" },
     [Y2] = { "y2", OUTPUT, 0, "angle theta [rad]" },
-    [XI] = { "x1", OUTPUT, 0, "state: current i [A]" },
-    [XOMEGA] = { "x2", OUTPUT, 0, "state: speed omega [rad/s]" },
-    [XTHETA] = { "x3", OUTPUT, 0, "state: angle theta [rad]" },
+    [XI] = { "x1", STATE, 0, "state: current i [A]" },
+    [XOMEGA] = { "x2", STATE, 0, "state: speed omega [rad/s]" },
+    [XTHETA] = { "x3", STATE, 0, "state: angle theta [rad]" },
 };
 const size_t MODEL_NV = sizeof MODEL_VARS / sizeof MODEL_VARS[0];
 _Static_assert(sizeof MODEL_VARS / sizeof MODEL_VARS[0] == NV, "variable table and enum");
@@ -65,8 +66,8 @@ static const char *check(const double *v) {
 const char *model_initialize(double *v) {
     const char *err = check(v);
     if (err) return err;
-    v[XI] = v[XOMEGA] = v[XTHETA] = 0.0;
-    v[Y1] = v[Y2] = 0.0;
+    v[Y1] = v[XOMEGA];
+    v[Y2] = v[XTHETA];
     return NULL;
 }
 

@@ -52,6 +52,9 @@ static void variable2(unsigned vr, const ModelVar *v) {
                "<Real start=\"%.17g\"/>", v->start);
     } else if (v->causality == INPUT) {
         printf(" causality=\"input\" variability=\"continuous\"><Real start=\"%.17g\"/>", v->start);
+    } else if (v->causality == STATE) {
+        printf(" causality=\"output\" variability=\"continuous\" initial=\"exact\">"
+               "<Real start=\"%.17g\"/>", v->start);
     } else {
         printf(" causality=\"output\" variability=\"continuous\" initial=\"calculated\"><Real/>");
     }
@@ -70,6 +73,9 @@ static void variable3(unsigned vr, const ModelVar *v) {
                v->start);
     else if (v->causality == INPUT)
         printf(" causality=\"input\" variability=\"continuous\" start=\"%.17g\"", v->start);
+    else if (v->causality == STATE)
+        printf(" causality=\"output\" variability=\"continuous\" initial=\"exact\" start=\"%.17g\"",
+               v->start);
     else
         printf(" causality=\"output\" variability=\"continuous\" initial=\"calculated\"");
     printf("/>\n");
@@ -90,7 +96,9 @@ int main(int argc, char **argv) {
     for (int kind = 0; kind < 2; kind++) {
         if (fmi == 2) printf("    <%s>\n", kinds2[kind]);
         for (size_t k = 0; k < MODEL_NV; k++) {
-            if (MODEL_VARS[k].causality != OUTPUT) continue;
+            /* states are outputs too; an initial unknown only when calculated (not exact) */
+            Causality c = MODEL_VARS[k].causality;
+            if (!(c == OUTPUT || (c == STATE && kind == 0))) continue;
             if (fmi == 2) printf("      <Unknown index=\"%zu\"/>\n", k + 2);
             else printf("    <%s valueReference=\"%zu\"/>\n", kinds3[kind], k + 1);
         }

@@ -105,10 +105,10 @@ int instance_set(Instance *inst, const unsigned vr[], size_t nvr, const double v
         if (vr[k] == 0) return instance_fail(inst, "time cannot be set");
         const ModelVar *var = &MODEL_VARS[vr[k] - 1];
         if (var->causality == OUTPUT) return instance_fail(inst, "%s is an output", var->name);
-        if (var->causality == PARAMETER && inst->state != ST_INSTANTIATED
+        if ((var->causality == PARAMETER || var->causality == STATE) && inst->state != ST_INSTANTIATED
             && inst->state != ST_INITIALIZATION)
-            return instance_fail(inst, "%s is a fixed parameter: set it before "
-                                 "exitInitializationMode", var->name);
+            return instance_fail(inst, "%s is a %s: set it before exitInitializationMode",
+                                 var->name, var->causality == STATE ? "state's start value" : "fixed parameter");
         if (var->causality == INPUT && inst->state == ST_TERMINATED)
             return instance_fail(inst, "%s: the instance is terminated", var->name);
     }

@@ -2,9 +2,10 @@
  * scenarios/seed002-piecewise.toml (n = 3 states, l = 2 inputs, q = 1 unknown input,
  * p = 2 outputs):
  *
- *     x_{k+1} = Phi x_k + Gamma_B u_k + Gamma_E w_k,    y_k = C x_k,    x_0 = x0.
+ *     x_{k+1} = Phi x_k + Gamma_B u_k + Gamma_E w_k,    y_k = C x_k,    x_0 = the start values of x.
  *
- * Phi_i_j, Gamma_B_i_j, Gamma_E_i_j, C_i_j and x0_i (1-based indices) are fixed parameters;
+ * Phi_i_j, Gamma_B_i_j, Gamma_E_i_j and C_i_j (1-based indices) are fixed parameters; the
+ * states x1..x3 take their start values (0 unless set before initialisation);
  * u1, u2, w1 inputs; y1, y2 and the states x1, x2, x3 outputs.
  *
  * One doStep advances exactly one sample, k -> k+1: the FMU assumes that the communication
@@ -40,8 +41,7 @@ enum {
     GB = PHI + N * N,     /* Gamma_B[i][j] at GB + i*L + j */
     GE = GB + N * L,      /* Gamma_E[i][j] at GE + i*Q + j */
     CM = GE + N * Q,      /* C[i][j]       at CM + i*N + j */
-    X0 = CM + P * N,      /* x0[i] */
-    U = X0 + N,           /* u1, u2 */
+    U = CM + P * N,       /* u1, u2 */
     W = U + L,            /* w1 */
     Y = W + Q,            /* y1, y2 */
     X = Y + P,            /* x1, x2, x3 */
@@ -59,15 +59,14 @@ const ModelVar MODEL_VARS[] = {
     PAR("Gamma_E_1_1", 0), PAR("Gamma_E_2_1", 0), PAR("Gamma_E_3_1", 0),
     PAR("C_1_1", 1), PAR("C_1_2", 0), PAR("C_1_3", 0),
     PAR("C_2_1", 0), PAR("C_2_2", 0), PAR("C_2_3", 1),
-    PAR("x0_1", 0), PAR("x0_2", 0), PAR("x0_3", 0),
     { "u1", INPUT, 0, "known input 1" },
     { "u2", INPUT, 0, "known input 2" },
     { "w1", INPUT, 0, "unknown input (disturbance) 1" },
     { "y1", OUTPUT, 0, "measured output 1, (C x)_1" },
     { "y2", OUTPUT, 0, "measured output 2, (C x)_2" },
-    { "x1", OUTPUT, 0, "state 1" },
-    { "x2", OUTPUT, 0, "state 2" },
-    { "x3", OUTPUT, 0, "state 3" },
+    { "x1", STATE, 0, "state 1" },
+    { "x2", STATE, 0, "state 2" },
+    { "x3", STATE, 0, "state 3" },
 };
 const size_t MODEL_NV = sizeof MODEL_VARS / sizeof MODEL_VARS[0];
 _Static_assert(sizeof MODEL_VARS / sizeof MODEL_VARS[0] == NV, "variable table and offsets");
@@ -81,7 +80,6 @@ static void outputs(double *v) {
 }
 
 const char *model_initialize(double *v) {
-    for (int i = 0; i < N; i++) v[X + i] = v[X0 + i];
     outputs(v);
     return NULL;
 }

@@ -5,18 +5,20 @@
  * A model is a table of real scalar variables and two functions. The FMI value reference of
  * MODEL_VARS[k] is k + 1; value reference 0 is the independent variable `time`. All variables
  * are float64: parameters (variability "fixed", settable until exitInitializationMode),
- * inputs (settable at any time) and outputs (calculated). */
+ * inputs (settable at any time), outputs (calculated) and states: outputs whose start value
+ * (initial "exact") is the state at t = 0, settable until exitInitializationMode, so that an
+ * importer (the FMU plant's `[plant] x0`, `launcher linearize`) can start the model anywhere. */
 #ifndef TESTFMUS_MODEL_H
 #define TESTFMUS_MODEL_H
 
 #include <stddef.h>
 
-typedef enum { PARAMETER, INPUT, OUTPUT } Causality;
+typedef enum { PARAMETER, INPUT, OUTPUT, STATE } Causality;
 
 typedef struct {
     const char *name;
     Causality causality;
-    double start;            /* parameters and inputs; ignored for outputs */
+    double start;            /* parameters, inputs and states; ignored for outputs */
     const char *description; /* plain ASCII, no XML markup */
 } ModelVar;
 

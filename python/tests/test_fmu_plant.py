@@ -53,7 +53,8 @@ def discrete_seed002(fmu_table=""):
 
 def lti_table(path):
     Phi, GB, GE, C, x0, _ = seed002_zoh()
-    params = ", ".join(f"{k} = {num(v)}" for k, v in lti_parameters(Phi, GB, GE, C, x0).items())
+    # x(0): the scenario's [plant] x0, which sets the states' start values
+    params = ", ".join(f"{k} = {num(v)}" for k, v in lti_parameters(Phi, GB, GE, C).items())
     return f"""
 [plant.fmu]
 path = "{path}"
@@ -295,7 +296,6 @@ A = [[-1.0]]
 B = [[1.0]]
 C = [[1.0]]
 E = [[1.0]]
-x0 = [0.0]
 [plant.fmu]
 path = "{path}"
 inputs = ["u1"]

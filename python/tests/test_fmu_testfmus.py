@@ -32,7 +32,7 @@ from scipy.integrate import solve_ivp
 from conftest import REPO
 
 SOURCES = os.path.join(REPO, "fmu", "testfmus")
-NAMES = [f"{model}_fmi{v}" for model in ("lti_plant", "dc_motor", "faulty") for v in (2, 3)]
+NAMES = [f"{model}_fmi{v}" for model in ("lti_plant", "dc_motor", "faulty") for v in (2, 3)] + ["three_tank"]
 SCENARIO = os.path.join(REPO, "scenarios", "seed002-piecewise.toml")
 
 
@@ -115,11 +115,13 @@ def seed002_zoh():
     return F[:n, :n], F[:n, n:n + l], F[:n, n + l:], C, np.array(plant["x0"], dtype=float), sc["dt"]
 
 
-def lti_parameters(Phi, GB, GE, C, x0):
+def lti_parameters(Phi, GB, GE, C, x0=None):
+    """lti_plant's parameters and, with `x0`, its states' start values (x1..x3, initial exact)."""
     p = {}
     for name, m in (("Phi", Phi), ("Gamma_B", GB), ("Gamma_E", GE), ("C", C)):
         p.update({f"{name}_{i + 1}_{j + 1}": m[i, j] for i in range(m.shape[0]) for j in range(m.shape[1])})
-    p.update({f"x0_{i + 1}": v for i, v in enumerate(x0)})
+    if x0 is not None:
+        p.update({f"x{i + 1}": v for i, v in enumerate(x0)})
     return p
 
 

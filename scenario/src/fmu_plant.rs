@@ -17,7 +17,8 @@ use super::ProcessSpec;
 pub const FMU_PLANT_PROGRAM: &str = "fmu_plant";
 
 /// The FMU plant as the process that runs it, and the FMU's absolute path.
-pub(crate) fn plant_fmu(raw: &Option<RawFmu>, dir: Option<&Path>, z: &Sizes) -> Result<Option<(std::path::PathBuf, ProcessSpec)>, Bad> {
+/// `x0`, when the scenario gives it, sets the start values of the `states` variables.
+pub(crate) fn plant_fmu(raw: &Option<RawFmu>, dir: Option<&Path>, z: &Sizes, x0: Option<&[f64]>) -> Result<Option<(std::path::PathBuf, ProcessSpec)>, Bad> {
     let Some(f) = raw else { return Ok(None) };
     let path = plant_file::path("plant.fmu.path", dir, &f.path)?;
     let list = |key: &str, given: &Option<Vec<String>>, want: usize, what: &str| -> Result<Vec<String>, Bad> {
@@ -57,6 +58,7 @@ pub(crate) fn plant_fmu(raw: &Option<RawFmu>, dir: Option<&Path>, z: &Sizes) -> 
         "states": states,
         "parameters": parameters,
         "substeps": substeps,
+        "x0": x0,
     });
     Ok(Some((path, ProcessSpec { command: vec![FMU_PLANT_PROGRAM.into()], params })))
 }

@@ -161,7 +161,8 @@ pub struct RawPlant {
     pub e: Option<Rows>,
     #[serde(rename = "D")]
     pub d: Option<Rows>,
-    pub x0: Vec<f64>,
+    /// x(0); an FMU plant may leave it out (then its own start values).
+    pub x0: Option<Vec<f64>>,
     /// |x_i| beyond this stops the run (default 1e9).
     pub state_bound: Option<f64>,
     /// Names of the states for plots and exports (default x1, x2, …).

@@ -262,11 +262,20 @@ fn build(raw: RawScenario, dir: Option<&Path>) -> Result<Scenario, Bad> {
         Some(rows) => matrix("plant.D", rows, (Some(pn), None), "one row per output, one column per measurement disturbance")?,
         None => Mat::zeros(pn, 0),
     };
-    if p.x0.len() != n {
-        return Err(bad("plant.x0", format!("has {} entries, the plant has {n} states", p.x0.len())));
-    }
-    for (i, &v) in p.x0.iter().enumerate() {
-        finite(&format!("plant.x0[{}]", i + 1), v)?;
+    // x(0): required, but an FMU plant starts from its own start values when it is left out
+    // (given, it sets the start values of the FMU's state variables).
+    let x0 = match &p.x0 {
+        Some(x0) => Some(x0.clone()),
+        None if p.fmu.is_some() => None,
+        None => return Err(bad("plant.x0", "missing: the plant's state at t = 0 (only an FMU plant may leave it out and start from its own start values)")),
+    };
+    if let Some(x0) = &x0 {
+        if x0.len() != n {
+            return Err(bad("plant.x0", format!("has {} entries, the plant has {n} states", x0.len())));
+        }
+        for (i, &v) in x0.iter().enumerate() {
+            finite(&format!("plant.x0[{}]", i + 1), v)?;
+        }
     }
     let state_bound = finite("plant.state_bound", p.state_bound.unwrap_or(1e9))?;
     if state_bound <= 0.0 {
@@ -334,7 +343,7 @@ fn build(raw: RawScenario, dir: Option<&Path>) -> Result<Scenario, Bad> {
         }
     }
     let sizes = super::plant_file::Sizes { n, p: model.c.nrows(), l: model.b.ncols(), q: model.e.ncols() };
-    let fmu = super::fmu_plant::plant_fmu(&p.fmu, dir, &sizes)?;
+    let fmu = super::fmu_plant::plant_fmu(&p.fmu, dir, &sizes, x0.as_deref())?;
     if p.replay.is_some() {
         // Recorded data holds its own faults and noise: [[fault]] and [noise] then describe
         // them (for the design and the scoring), and nothing is applied.
@@ -433,7 +442,7 @@ fn build(raw: RawScenario, dir: Option<&Path>) -> Result<Scenario, Bad> {
         steps,
         model,
         discrete,
-        x0: p.x0.clone(),
+        x0: x0.unwrap_or_else(|| vec![0.0; n]),
         operating_point,
         state_bound,
         names: layout_names,

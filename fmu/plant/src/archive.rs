@@ -6,8 +6,9 @@ use std::collections::BTreeMap;
 use std::io::Read;
 use std::path::Path;
 
+use fmi::schema::fmi2::Initial as I2;
 use fmi::schema::fmi2::{Causality as C2, Fmi2ModelDescription, ScalarVariableElement};
-use fmi::schema::fmi3::{AbstractVariableTrait, ArrayableVariableTrait, Causality as C3, Fmi3ModelDescription, Variable};
+use fmi::schema::fmi3::{AbstractVariableTrait, ArrayableVariableTrait, Causality as C3, Fmi3ModelDescription, Initial as I3, InitializableVariableTrait, Variable};
 use fmi::schema::minimal::MinModelDescription;
 use fmi::schema::traits::FmiModelDescription;
 
@@ -77,6 +78,16 @@ pub struct Var {
     pub ty: Type,
     /// An array variable (FMI 3 dimensions): not exchanged as a scalar.
     pub array: bool,
+    /// Its start value may be set before initialisation (initial = exact or approx, or a
+    /// parameter or an input): a state that may be started anywhere.
+    pub settable_start: bool,
+}
+
+/// Whether a start value may be set (FMI 2.0 §2.2.7, FMI 3.0 §2.4.7.4): initial exact or
+/// approx; without `initial`, a parameter's default is exact and an input has a start value;
+/// an output's or a local variable's default is calculated.
+fn settable(initial_exact_or_approx: Option<bool>, causality: Causality) -> bool {
+    initial_exact_or_approx.unwrap_or(matches!(causality, Causality::Parameter | Causality::Input))
 }
 
 /// An FMU's description, as far as the plant needs it.
@@ -85,6 +96,8 @@ pub struct Fmu {
     pub version: Version,
     pub model_identifier: String,
     pub vars: BTreeMap<String, Var>,
+    /// The library embeds Python: the first `Py…` symbol it needs from its host.
+    pub python: Option<String>,
 }
 
 /// Where this platform's binary sits in an FMU of `version`.
@@ -133,10 +146,21 @@ pub fn read(path: &Path) -> Result<Fmu, String> {
     let binary = binary_path(version, &fmu.model_identifier);
     if zip.index_for_name(&binary).is_none() {
         let present: Vec<String> = zip.file_names().filter(|n| n.starts_with("binaries/") && !n.ends_with('/')).map(str::to_string).collect();
-        let has = if present.is_empty() { "none (a source-only FMU is not compiled here)".to_string() } else { present.join(", ") };
+        let has = if present.is_empty() {
+            "none (a source-only FMU is not compiled here)".to_string()
+        } else {
+            present.join(", ")
+        };
         return Err(at(format!("no binary for this platform: {binary} is not in the archive (binaries: {has})")));
     }
-    Ok(fmu)
+    let mut library = Vec::new();
+    zip.by_name(&binary)
+        .and_then(|f| f.take(MAX_UNPACKED).read_to_end(&mut library).map_err(Into::into))
+        .map_err(|e| at(format!("{binary}: {e}")))?;
+    Ok(Fmu {
+        python: crate::python::needs(&library),
+        ..fmu
+    })
 }
 
 fn first_line(s: &str) -> &str {
@@ -171,9 +195,24 @@ fn from_fmi2(xml: &str) -> Result<Fmu, String> {
             ScalarVariableElement::String => Type::Other("String"),
             ScalarVariableElement::Enumeration => Type::Other("Enumeration"),
         };
-        vars.insert(v.name.clone(), Var { vr: v.value_reference, causality, ty, array: false });
+        let initial = v.initial.as_ref().map(|i| matches!(i, I2::Exact | I2::Approx));
+        vars.insert(
+            v.name.clone(),
+            Var {
+                vr: v.value_reference,
+                causality,
+                ty,
+                array: false,
+                settable_start: settable(initial, causality),
+            },
+        );
     }
-    Ok(Fmu { version: Version::Two, model_identifier: cs.model_identifier.clone(), vars })
+    Ok(Fmu {
+        version: Version::Two,
+        model_identifier: cs.model_identifier.clone(),
+        vars,
+        python: None,
+    })
 }
 
 fn from_fmi3(xml: &str) -> Result<Fmu, String> {
@@ -210,7 +249,26 @@ fn from_fmi3(xml: &str) -> Result<Fmu, String> {
             C3::Independent => Causality::Independent,
             _ => Causality::Other,
         };
-        vars.insert(a.name().to_string(), Var { vr: a.value_reference(), causality, ty, array });
+        // Only a Float64 is ever a state; its `initial` decides whether it may be started.
+        let initial = match v {
+            Variable::Float64(x) => x.initial().map(|i| matches!(i, I3::Exact | I3::Approx)),
+            _ => None,
+        };
+        vars.insert(
+            a.name().to_string(),
+            Var {
+                vr: a.value_reference(),
+                causality,
+                ty,
+                array,
+                settable_start: settable(initial, causality),
+            },
+        );
     }
-    Ok(Fmu { version: Version::Three, model_identifier: cs.model_identifier.clone(), vars })
+    Ok(Fmu {
+        version: Version::Three,
+        model_identifier: cs.model_identifier.clone(),
+        vars,
+        python: None,
+    })
 }

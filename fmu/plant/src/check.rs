@@ -24,6 +24,10 @@ pub struct Map {
     pub outputs: Vec<u32>,
     pub states: Vec<u32>,
     pub parameters: Vec<(u32, Start)>,
+    /// `[plant] x0` as the start values of the state variables (empty: the FMU's own).
+    pub x0: Vec<(u32, f64)>,
+    /// The Python the FMU's library embeds, found.
+    pub python: Option<crate::python::Python>,
 }
 
 /// The FMU at `p.path`, its map resolved.
@@ -73,7 +77,35 @@ pub fn resolve(p: &Params) -> Result<(Fmu, Map), String> {
         };
         parameters.push((v.vr, start));
     }
-    Ok((fmu, Map { inputs, disturbances, outputs, states, parameters }))
+    // x0 sets the states' start values; a state the FMU computes at initialisation cannot be
+    // started elsewhere, and x0 is never silently ignored.
+    let mut x0 = Vec::new();
+    for (i, (name, &value)) in p.states.iter().zip(p.x0.iter().flatten()).enumerate() {
+        let v = &fmu.vars[name];
+        if !v.settable_start {
+            return Err(format!(
+                "plant.x0[{}]: the state '{name}' of {file} takes no start value (its initial is calculated): leave x0 out to start from the FMU's own state",
+                i + 1
+            ));
+        }
+        x0.push((v.vr, value));
+    }
+    let python = match &fmu.python {
+        Some(symbol) => Some(crate::python::find(symbol).map_err(|e| format!("plant.fmu.path: {file}: {e}"))?),
+        None => None,
+    };
+    Ok((
+        fmu,
+        Map {
+            inputs,
+            disturbances,
+            outputs,
+            states,
+            parameters,
+            x0,
+            python,
+        },
+    ))
 }
 
 /// `fmu_plant --check`: the map (the plant's `params`) on stdin; exit 0, or 2 with one line.

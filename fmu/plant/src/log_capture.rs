@@ -1,39 +1,66 @@
 //! The FMU's own words: the `fmi` crate hands what an FMU logs (its logger callback) to the
-//! `log` facade. The last warning or error is kept, so that a failed call is reported with the
-//! reason the FMU gave.
+//! `log` facade. Here every message is kept (the last [`KEPT`]), warnings and errors are also
+//! written to stderr the moment they arrive — so that when the FMU's library kills the
+//! process (a segfault inside an embedded interpreter), the launcher still quotes the FMU's
+//! last words — and a failed call is reported with what the FMU logged since the last one.
 
+use std::collections::VecDeque;
 use std::sync::Mutex;
 
-static LAST: Mutex<String> = Mutex::new(String::new());
+/// How many of the FMU's messages are kept for the next failure's report.
+pub const KEPT: usize = 4;
+
+static LAST: Mutex<VecDeque<String>> = Mutex::new(VecDeque::new());
 
 struct Capture;
 
 impl log::Log for Capture {
     fn enabled(&self, m: &log::Metadata) -> bool {
-        m.level() <= log::Level::Warn
+        // The FMU's logger messages (fmi-sys logs them with module "logger"); OK-status ones
+        // come as Info, a Discard in FMI 2.0 as Trace.
+        m.level() <= log::Level::Trace
     }
 
     fn log(&self, r: &log::Record) {
-        if self.enabled(r.metadata())
-            && let Ok(mut last) = LAST.lock()
-        {
-            *last = r.args().to_string().lines().next().unwrap_or("").trim().to_string();
+        if r.module_path() != Some("logger") && r.level() > log::Level::Warn {
+            return; // the fmi crate's own tracing
         }
+        record(r.target(), r.level(), "", &r.args().to_string());
     }
 
     fn flush(&self) {}
+}
+
+/// Keeps one message of the FMU (instance `instance`); a warning or an error also goes to
+/// stderr at once.
+pub fn record(instance: &str, level: log::Level, category: &str, text: &str) {
+    let line = text.lines().map(str::trim).filter(|l| !l.is_empty()).collect::<Vec<_>>().join(" / ");
+    if line.is_empty() {
+        return;
+    }
+    if level <= log::Level::Warn {
+        let category = if category.is_empty() { String::new() } else { format!(", {category}") };
+        eprintln!("FMU {instance} ({}{category}): {line}", level.as_str().to_lowercase());
+    }
+    if let Ok(mut last) = LAST.lock() {
+        if last.len() == KEPT {
+            last.pop_front();
+        }
+        last.push_back(line);
+    }
 }
 
 /// Installs the capture (once).
 pub fn install() {
     static CAPTURE: Capture = Capture;
     if log::set_logger(&CAPTURE).is_ok() {
-        log::set_max_level(log::LevelFilter::Warn);
+        log::set_max_level(log::LevelFilter::Trace);
     }
 }
 
-/// Takes the last message the FMU logged, if any: ": <message>", ready to append.
+/// Takes what the FMU logged since the last take, if anything: ": <m1> | <m2>", ready to
+/// append.
 pub fn take() -> String {
-    let last = LAST.lock().map(|mut l| std::mem::take(&mut *l)).unwrap_or_default();
-    if last.is_empty() { String::new() } else { format!(": {last}") }
+    let last: Vec<String> = LAST.lock().map(|mut l| l.drain(..).collect()).unwrap_or_default();
+    if last.is_empty() { String::new() } else { format!(": the FMU logged: {}", last.join(" | ")) }
 }

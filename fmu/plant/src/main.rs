@@ -7,14 +7,25 @@
 
 mod archive;
 mod check;
+mod fmi2;
 mod log_capture;
 mod params;
 mod plant;
+mod python;
 mod slave;
 
 fn main() -> std::process::ExitCode {
     if std::env::args().nth(1).as_deref() == Some("--check") {
         return check::main();
     }
-    lockstep::component::main::<plant::FmuPlant>("fmu_plant")
+    let code = lockstep::component::main::<plant::FmuPlant>("fmu_plant");
+    if fmi2::fatal() {
+        // The run's message is written and the kit has left the run; the FMU's libraries are
+        // not to run their exit handlers (see fmi2::fatal).
+        use std::io::Write as _;
+        let _ = std::io::stderr().flush();
+        // SAFETY: ends the process at once; nothing of ours is left to flush.
+        unsafe { libc::_exit(lockstep::component::EXIT_FAILED) };
+    }
+    code
 }

@@ -22,4 +22,7 @@ pub struct Params {
     pub parameters: serde_json::Map<String, serde_json::Value>,
     /// doStep calls per sample.
     pub substeps: u32,
+    /// `[plant] x0`: start values of the `states` variables (none: the FMU's own).
+    #[serde(default)]
+    pub x0: Option<Vec<f64>>,
 }

@@ -3,13 +3,13 @@
 //! failed call says which call, at what time, and what the FMU logged about it.
 
 use fmi::fmi2::import::Fmi2Import;
-use fmi::fmi2::instance::{CoSimulation as _, Common as _, InstanceCS as Cs2};
 use fmi::fmi3::import::Fmi3Import;
 use fmi::fmi3::instance::InstanceCS as Cs3;
 use fmi::fmi3::{CoSimulation as _, Common as _, Fmi3Model as _, GetSet as _};
 
 use crate::archive::Version;
 use crate::check::Start;
+use crate::fmi2::Cs2;
 use crate::log_capture;
 
 /// An instance; the import (the extracted archive) lives as long as it. Fields drop in order:
@@ -26,39 +26,46 @@ fn failed(call: &str, t: f64, status: impl std::fmt::Debug) -> String {
 
 impl Slave {
     /// Extracts and instantiates the FMU at `path` for co-simulation, sets the parameters'
-    /// start values and initialises it at t = 0.
-    pub fn start(path: &str, version: Version, name: &str, parameters: &[(u32, Start)]) -> Result<Self, String> {
+    /// and the states' start values (`x0`, may be empty) and initialises it at t = 0. An FMU
+    /// whose library embeds Python gets `python` loaded first.
+    pub fn start(path: &str, version: Version, name: &str, parameters: &[(u32, Start)], x0: &[(u32, f64)], python: Option<&crate::python::Python>) -> Result<Self, String> {
         log_capture::install();
+        if let Some(py) = python {
+            crate::python::load(py)?;
+        }
         let mut s = match version {
             Version::Two => {
                 let import: Fmi2Import = fmi::import::from_path(path).map_err(|e| format!("cannot extract: {e}"))?;
-                let inst = import.instantiate_cs(name, false, true).map_err(|e| format!("fmi2Instantiate failed ({e}){}", log_capture::take()))?;
+                let inst = Cs2::instantiate(&import, name)?;
                 Slave::Two { inst, _import: import }
             }
             Version::Three => {
                 let import: Fmi3Import = fmi::import::from_path(path).map_err(|e| format!("cannot extract: {e}"))?;
-                let inst = import.instantiate_cs(name, false, true, false, false, &[]).map_err(|e| format!("fmi3InstantiateCoSimulation failed ({e}){}", log_capture::take()))?;
+                let inst = import
+                    .instantiate_cs(name, false, true, false, false, &[])
+                    .map_err(|e| format!("fmi3InstantiateCoSimulation failed ({e}){}", log_capture::take()))?;
                 Slave::Three { inst, _import: import }
             }
         };
-        s.initialise(parameters)?;
+        let starts: Vec<(u32, Start)> = parameters.iter().cloned().chain(x0.iter().map(|&(vr, x)| (vr, Start::Real(x)))).collect();
+        s.initialise(&starts)?;
         Ok(s)
     }
 
     fn initialise(&mut self, parameters: &[(u32, Start)]) -> Result<(), String> {
         match self {
             Slave::Two { inst: i, .. } => {
-                i.setup_experiment(None, 0.0, None).map_err(|e| failed("fmi2SetupExperiment", 0.0, e))?;
+                i.setup_experiment(0.0)?;
                 for (vr, v) in parameters {
                     match v {
-                        Start::Real(x) => i.set_real(&[*vr], &[*x]).map(drop),
-                        Start::Integer(x) => i.set_integer(&[*vr], &[*x]).map(drop),
-                        Start::Boolean(b) => i.set_boolean(&[*vr], &[*b as i32]).map(drop),
+                        Start::Real(x) => i.set_real(&[*vr], &[*x], 0.0),
+                        Start::Integer(x) => i.set_integer(&[*vr], &[*x], 0.0),
+                        Start::Boolean(b) => i.set_boolean(&[*vr], &[*b as i32], 0.0),
                     }
-                    .map_err(|e| failed("setting a parameter's start value", 0.0, e))?;
+                    .map_err(|e| format!("setting a start value: {e}"))?;
                 }
-                i.enter_initialization_mode().map_err(|e| failed("fmi2EnterInitializationMode", 0.0, e))?;
-                i.exit_initialization_mode().map_err(|e| failed("fmi2ExitInitializationMode", 0.0, e))?;
+                i.enter_initialization_mode()?;
+                i.exit_initialization_mode()?;
             }
             Slave::Three { inst: i, .. } => {
                 for (vr, v) in parameters {
@@ -67,7 +74,7 @@ impl Slave {
                         Start::Integer(x) => i.set_int32(&[*vr], &[*x]).map(drop),
                         Start::Boolean(b) => i.set_boolean(&[*vr], &[*b]).map(drop),
                     }
-                    .map_err(|e| failed("setting a parameter's start value", 0.0, e))?;
+                    .map_err(|e| failed("setting a start value", 0.0, e))?;
                 }
                 i.enter_initialization_mode(None, 0.0, None).map_err(|e| failed("fmi3EnterInitializationMode", 0.0, e))?;
                 i.exit_initialization_mode().map_err(|e| failed("fmi3ExitInitializationMode", 0.0, e))?;
@@ -82,7 +89,7 @@ impl Slave {
             return Ok(());
         }
         match self {
-            Slave::Two { inst: i, .. } => i.set_real(vrs, values).map(drop).map_err(|e| failed("fmi2SetReal", t, e)),
+            Slave::Two { inst: i, .. } => i.set_real(vrs, values, t),
             Slave::Three { inst: i, .. } => i.set_float64(vrs, values).map(drop).map_err(|e| failed("fmi3SetFloat64", t, e)),
         }
     }
@@ -93,7 +100,7 @@ impl Slave {
             return Ok(());
         }
         match self {
-            Slave::Two { inst: i, .. } => i.get_real(vrs, out).map(drop).map_err(|e| failed("fmi2GetReal", t, e)),
+            Slave::Two { inst: i, .. } => i.get_real(vrs, out, t),
             Slave::Three { inst: i, .. } => i.get_float64(vrs, out).map(drop).map_err(|e| failed("fmi3GetFloat64", t, e)),
         }
     }
@@ -101,7 +108,7 @@ impl Slave {
     /// One communication step from t of length h.
     pub fn step(&mut self, t: f64, h: f64) -> Result<(), String> {
         match self {
-            Slave::Two { inst: i, .. } => i.do_step(t, h, true).map(drop).map_err(|e| failed("fmi2DoStep", t, e)),
+            Slave::Two { inst: i, .. } => i.do_step(t, h),
             Slave::Three { inst: i, .. } => {
                 let (mut event, mut terminate, mut early, mut last) = (false, false, false, t);
                 i.do_step(t, h, true, &mut event, &mut terminate, &mut early, &mut last).map_err(|e| failed("fmi3DoStep", t, e))?;
