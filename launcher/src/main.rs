@@ -14,6 +14,7 @@ use scenario::Scenario;
 use lockstep::Wait;
 
 mod export_fmu;
+mod linearize;
 
 #[derive(Parser)]
 #[command(name = "launcher", version, about = "Design and co-simulate unknown input observers for LTI plants")]
@@ -247,6 +248,19 @@ enum Command {
         /// FMI version.
         #[arg(long, value_parser = ["2", "3"], default_value = "3")]
         fmi: String,
+    },
+    /// The sampled model (Φ, Γ_B, Γ_E, C) of a scenario's FMU plant at its operating point, made
+    /// from the FMU: DIR/{Phi,Gamma_B,Gamma_E,C}.npy and DIR/<name>.toml, a scenario that runs.
+    Linearize {
+        /// The scenario file: dt, [plant.fmu] and [plant.operating_point] are read.
+        scenario: PathBuf,
+        /// First find the equilibrium x_op for the operating point's u and w (Newton's method;
+        /// the given x is the first guess).
+        #[arg(long)]
+        trim: bool,
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
     },
     /// Run one component (used by the launcher when the component binaries are not beside it).
     #[command(hide = true, disable_help_flag = true)]
@@ -578,6 +592,13 @@ fn main() -> ExitCode {
                 Err(e) => fail(&e),
             }
         }
+        Command::Linearize { scenario, trim, out } => match linearize::linearize(&scenario, trim, &out) {
+            Ok(path) => {
+                println!("wrote {}", path.display());
+                ExitCode::SUCCESS
+            }
+            Err(e) => fail(&e),
+        },
         Command::Component { kind, args } => component(&kind, args),
     }
 }

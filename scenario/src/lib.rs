@@ -7,6 +7,7 @@ mod fault_diagnosis;
 mod fmu_plant;
 mod plant_file;
 mod hosts;
+pub mod linearized;
 pub mod limits;
 pub use observer_processes::{observer_processes, ObserverProcess};
 mod locate;

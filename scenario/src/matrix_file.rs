@@ -133,3 +133,25 @@ fn data_offset<R: std::io::Read + std::io::Seek>(file: &mut R, len: u64) -> Resu
     file.seek(std::io::SeekFrom::Start(0)).map_err(|e| e.to_string())?;
     Ok(at + size)
 }
+
+/// A 2-D float64 `.npy` file's bytes (C order), as `numpy.save` writes it: what
+/// `launcher linearize` leaves beside the scenario it writes.
+pub fn npy_bytes(rows: &[Vec<f64>]) -> Result<Vec<u8>, String> {
+    let (r, c) = (rows.len(), rows.first().map_or(0, Vec::len));
+    if rows.iter().any(|row| row.len() != c) {
+        return Err("rows of different lengths".into());
+    }
+    let mut bytes = Vec::new();
+    {
+        use npyz::WriterBuilder as _;
+        let mut w = npyz::WriteOptions::new()
+            .default_dtype()
+            .shape(&[r as u64, c as u64])
+            .writer(&mut bytes)
+            .begin_nd()
+            .map_err(|e| e.to_string())?;
+        w.extend(rows.iter().flatten().copied()).map_err(|e| e.to_string())?;
+        w.finish().map_err(|e| e.to_string())?;
+    }
+    Ok(bytes)
+}

@@ -3,11 +3,13 @@
 //! its variables carry u, w, y and x; the launcher starts this program with that map as
 //! `params`. `fmu_plant --check` reads the map from stdin and checks the FMU against it without
 //! loading the FMU's library: the launcher's pre-flight, so that a bad FMU exits 2 before
-//! anything runs.
+//! anything runs. `fmu_plant --linearize` makes the sampled model at an operating point from
+//! the FMU (`launcher linearize`, module `linearize`).
 
 mod archive;
 mod check;
 mod fmi2;
+mod linearize;
 mod log_capture;
 mod params;
 mod plant;
@@ -15,17 +17,26 @@ mod python;
 mod slave;
 
 fn main() -> std::process::ExitCode {
-    if std::env::args().nth(1).as_deref() == Some("--check") {
-        return check::main();
+    match std::env::args().nth(1).as_deref() {
+        Some("--check") => return check::main(),
+        Some("--linearize") => return linearize::main(),
+        _ => {}
     }
-    let code = lockstep::component::main::<plant::FmuPlant>("fmu_plant");
-    if fmi2::fatal() {
-        // The run's message is written and the kit has left the run; the FMU's libraries are
-        // not to run their exit handlers (see fmi2::fatal).
+    let code = lockstep::component::exit_status::<plant::FmuPlant>("fmu_plant", std::env::args().skip(1));
+    end(code)
+}
+
+/// Ends the process with `code`. After an FMU that embeds Python or returned fmi2Fatal, the
+/// libraries it loaded do not run their exit handlers (`_exit`): numpy's bundled libgfortran
+/// freed corrupted memory at exit after pythonfmu instances were freed or failed (glibc's
+/// "free(): corrupted unsorted chunks", SIGABRT, after an otherwise finished run).
+pub fn end(code: i32) -> std::process::ExitCode {
+    if fmi2::fatal() || python::loaded() {
         use std::io::Write as _;
+        let _ = std::io::stdout().flush();
         let _ = std::io::stderr().flush();
-        // SAFETY: ends the process at once; nothing of ours is left to flush.
-        unsafe { libc::_exit(lockstep::component::EXIT_FAILED) };
+        // SAFETY: ends the process at once; what is ours is flushed, the run left behind.
+        unsafe { libc::_exit(code) };
     }
-    code
+    std::process::ExitCode::from(code as u8)
 }

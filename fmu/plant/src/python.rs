@@ -61,6 +61,13 @@ pub fn find(symbol: &str) -> Result<Python, String> {
     Ok(Python { library, path })
 }
 
+static LOADED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Whether this process loaded a libpython for an FMU.
+pub fn loaded() -> bool {
+    LOADED.load(std::sync::atomic::Ordering::Relaxed)
+}
+
 /// Opens the library with global symbols and hands its `sys.path` to the embedded
 /// interpreter. Call before the FMU's library is loaded, while the process has one thread
 /// (it sets an environment variable).
@@ -79,6 +86,7 @@ pub fn load(py: &Python) -> Result<(), String> {
         };
         return Err(format!("cannot load {}: {msg}", py.library));
     }
+    LOADED.store(true, std::sync::atomic::Ordering::Relaxed);
     if std::env::var_os("PYTHONPATH").is_none() && !py.path.is_empty() {
         // SAFETY: the caller holds the process's only thread.
         unsafe { std::env::set_var("PYTHONPATH", &py.path) };

@@ -91,12 +91,18 @@ pub fn main<C: Component>(kind: &str) -> ExitCode {
 
 /// [`main`] with the command-line arguments given (the launcher's `component` fallback).
 pub fn main_with_args<C: Component>(kind: &str, args: impl IntoIterator<Item = String>) -> ExitCode {
+    ExitCode::from(exit_status::<C>(kind, args) as u8)
+}
+
+/// [`main_with_args`] as the process's exit status, for a component that must end its
+/// process itself (`_exit`: an FMU plant whose libraries must not run their exit handlers).
+pub fn exit_status<C: Component>(kind: &str, args: impl IntoIterator<Item = String>) -> i32 {
     die_with_parent();
     let launch = match parse_launch(kind, args) {
         Ok(l) => l,
         Err(msg) => {
             eprintln!("{msg}");
-            return ExitCode::from(EXIT_USAGE as u8);
+            return EXIT_USAGE;
         }
     };
     let label = if launch.name == kind { kind.to_string() } else { format!("{kind} {}", launch.name) };
@@ -104,14 +110,14 @@ pub fn main_with_args<C: Component>(kind: &str, args: impl IntoIterator<Item = S
         Ok(c) => c,
         Err(msg) => {
             eprintln!("{label}: {msg}");
-            return ExitCode::from(EXIT_USAGE as u8);
+            return EXIT_USAGE;
         }
     };
     match live::<C>(&launch, &cfg) {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(()) => 0,
         Err(e) => {
             eprintln!("{label}: {}", e.message);
-            ExitCode::from(e.code as u8)
+            e.code
         }
     }
 }

@@ -1,0 +1,167 @@
+"""`launcher linearize` (issue 31, item 2): the sampled model of an FMU plant at an operating
+point, made from the FMU itself (trim by Newton's method on the one-sample map, central
+differences with Richardson's extrapolation), checked against independent numbers:
+
+* on the linear test FMU (FMI 2.0 and 3.0) it returns the Φ, Γ_B, Γ_E and C the FMU was given,
+  to 1e-9 relative, at random operating points;
+* on the nonlinear DC-motor FMU at a non-zero operating point it matches scipy's exact
+  discretisation of the analytic Jacobian of the motor's equations to 1e-6, and the trim finds
+  the speed and current the voltage holds and names the shaft angle as a free integrator;
+* on the pythonfmu three-tank FMU it trims to the levels a numpy root finder gives, and the
+  scenario it writes runs as is: a UIO designed from it follows the leak, in absolute units.
+"""
+
+import os
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+import scipy.linalg as sla
+import scipy.optimize as so
+
+from test_diagnosis_scipy import launcher
+from test_fmu_plant import num, run, table, export_csv
+from test_fmu_pythonfmu import AREA, AZ, G, SN, f as tank_f  # noqa: F401
+from test_fmu_testfmus import fmu_dir, lti_parameters  # noqa: F401 (fixture)
+
+
+def linearize(scenario, out, *extra):
+    done = subprocess.run([launcher(), "linearize", str(scenario), "--out", str(out), *extra],
+                          capture_output=True, text=True, timeout=300)
+    return done
+
+
+def vec(v):
+    return "[" + ", ".join(num(x) for x in v) + "]"
+
+
+@pytest.mark.parametrize("v", [2, 3])
+def test_the_linear_fmu_gives_back_its_own_matrices(fmu_dir, tmp_path, v):
+    rng = np.random.default_rng(31 + v)
+    Phi = rng.normal(size=(3, 3)) * 0.4
+    GB, GE, C = rng.normal(size=(3, 2)), rng.normal(size=(3, 1)), rng.normal(size=(2, 3))
+    params = ", ".join(f"{k} = {num(x)}" for k, x in lti_parameters(Phi, GB, GE, C).items())
+    x, u, w = rng.uniform(-3, 3, 3), rng.uniform(-3, 3, 2), rng.uniform(-3, 3, 1)
+    (tmp_path / "lti.toml").write_text(f"""name = "lti"
+dt = 0.1
+[plant.operating_point]
+x = {vec(x)}
+u = {vec(u)}
+w = {vec(w)}
+[plant.fmu]
+path = "{os.path.join(fmu_dir, f'lti_plant_fmi{v}.fmu')}"
+inputs = ["u1", "u2"]
+disturbances = ["w1"]
+outputs = ["y1", "y2"]
+states = ["x1", "x2", "x3"]
+parameters = {{ {params} }}
+""")
+    done = linearize(tmp_path / "lti.toml", tmp_path / "out")
+    assert done.returncode == 0, done.stderr
+    print(done.stdout)
+    got = {k: np.load(tmp_path / "out" / f"{k}.npy") for k in ("Phi", "Gamma_B", "Gamma_E", "C")}
+    for k, want in (("Phi", Phi), ("Gamma_B", GB), ("Gamma_E", GE), ("C", C)):
+        rel = np.abs(got[k] - want).max() / np.abs(want).max()
+        print(f"FMI {v}: {k} relative error {rel:.2e}")
+        assert got[k].shape == want.shape and rel <= 1e-9, (k, rel)
+
+
+def test_the_dc_motor_fmu_matches_the_analytic_jacobian_at_a_nonzero_operating_point(fmu_dir, tmp_path):
+    R, L, K, J, b, tau_c, omega_s = 2.0, 0.5, 0.1, 0.02, 0.05, 0.01, 0.05  # dc_motor.c's defaults
+    u, w, dt = 12.0, 0.02, 0.01
+    (tmp_path / "dc.toml").write_text(f"""name = "dc"
+dt = {dt}
+[plant.operating_point]
+x = [1.0, 5.0, 0.3]     # the trim's first guess
+u = [{u}]
+w = [{w}]
+[plant.fmu]
+path = "{os.path.join(fmu_dir, 'dc_motor_fmi2.fmu')}"
+inputs = ["u1"]
+disturbances = ["w1"]
+outputs = ["y1", "y2"]
+states = ["x1", "x2", "x3"]
+""")
+    done = linearize(tmp_path / "dc.toml", tmp_path / "out", "--trim")
+    assert done.returncode == 0, done.stderr
+    print(done.stdout)
+    # The equilibrium of (i, ω) for this voltage and load, by scipy; θ turns freely.
+    def f2(v):
+        i, om = v
+        return [(-R * i - K * om + u) / L, (K * i - b * om - tau_c * np.tanh(om / omega_s) - w) / J]
+    i_op, om_op = so.fsolve(f2, [1.0, 5.0], xtol=1e-14)
+    import tomllib
+    sc = tomllib.loads((tmp_path / "out" / "dc.toml").read_text())
+    x_op = np.array(sc["plant"]["operating_point"]["x"])
+    assert abs(x_op[0] - i_op) < 1e-9 and abs(x_op[1] - om_op) < 1e-9 and x_op[2] == 0.3, (x_op, i_op, om_op)
+    assert "not unique: Φ − I is singular along x3" in done.stdout
+    # The analytic Jacobian there, discretised exactly (ZOH) by scipy.
+    sech2 = 1.0 / np.cosh(om_op / omega_s) ** 2
+    A = np.array([[-R / L, -K / L, 0.0], [K / J, (-b - tau_c * sech2 / omega_s) / J, 0.0], [0.0, 1.0, 0.0]])
+    B, E = np.array([[1 / L], [0.0], [0.0]]), np.array([[0.0], [-1 / J], [0.0]])
+    M = np.zeros((5, 5))
+    M[:3, :3], M[:3, 3:4], M[:3, 4:5] = A, B, E
+    F = sla.expm(M * dt)
+    for k, want in (("Phi", F[:3, :3]), ("Gamma_B", F[:3, 3:4]), ("Gamma_E", F[:3, 4:5])):
+        got = np.load(tmp_path / "out" / f"{k}.npy")
+        rel = np.abs(got - want).max() / np.abs(want).max()
+        print(f"dc_motor: {k} relative to the analytic model {rel:.2e}")
+        assert rel <= 1e-6, (k, rel)
+    assert np.array_equal(np.load(tmp_path / "out" / "C.npy"), [[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+
+
+def test_the_python_fmu_is_trimmed_linearised_and_its_scenario_runs_under_a_uio(fmu_dir, tmp_path):
+    shutil.copy(os.path.join(fmu_dir, "three_tank.fmu"), tmp_path)
+    Q1, Q2 = 3.5e-5, 1.45e-5
+    (tmp_path / "tank.toml").write_text(f"""name = "three-tank"
+dt = 1.0
+duration = 600.0
+[plant]
+x0 = [0.4, 0.2, 0.3]
+state_names = ["h1", "h2", "h3"]
+state_units = ["m", "m", "m"]
+[plant.operating_point]
+x = [0.45, 0.25, 0.33]          # the trim's first guess
+u = [{Q1}, {Q2}]
+[plant.fmu]
+path = "three_tank.fmu"
+inputs = ["Q1", "Q2"]
+disturbances = ["leak"]
+outputs = ["y1", "y2", "y3"]
+states = ["h1", "h2", "h3"]
+[[input]]
+kind = "constant"
+value = {Q1}
+[[input]]
+kind = "constant"
+value = {Q2}
+[[disturbance]]
+kind = "step"
+time = 100.0
+after = 5e-6
+[[observer]]
+name = "uio"
+kind = "chen-patton-uio"
+poles = [-0.05, -0.06, -0.07]
+""")
+    done = linearize(tmp_path / "tank.toml", tmp_path / "lin", "--trim")
+    assert done.returncode == 0, done.stderr
+    print(done.stdout)
+    h_op = so.fsolve(lambda h: tank_f(h, [Q1, Q2], [0.0]), [0.45, 0.25, 0.33], xtol=1e-14)
+    import tomllib
+    sc = tomllib.loads((tmp_path / "lin" / "three-tank.toml").read_text())
+    x_op = np.array(sc["plant"]["operating_point"]["x"])
+    print(f"trim {x_op} against scipy {h_op}")
+    # RK4 with 20 substeps of 50 ms holds the levels where the exact equilibrium is, to ~1e-9.
+    assert np.abs(x_op - h_op).max() < 1e-8
+    p, _ = run(tmp_path / "lin" / "three-tank.toml", tmp_path / "out", tmp_path / "runs")
+    assert p.returncode == 0, p.stderr_text
+    csvs = export_csv(tmp_path / "out" / "three-tank.rrd", tmp_path / "csv")
+    X, Xh = table(csvs / "plant_x.csv"), table(csvs / "observer_uio_xhat.csv")
+    W, Wh = table(csvs / "disturbance.csv"), table(csvs / "observer_uio_what.csv")
+    W = W[:len(Wh)]
+    tail = slice(450, None)
+    e, ew = np.abs(X[tail] - Xh[tail]).max(), np.abs(W[tail] - Wh[tail]).max()
+    print(f"three_tank from launcher linearize: tail max|x − x̂| {e:.3e} m, max|w − ŵ| {ew:.3e} m3/s (leak 5e-6)")
+    assert np.abs(Xh[tail] - x_op).max() < 0.05 and e < 1e-3 and ew < 0.1 * 5e-6

@@ -1,0 +1,144 @@
+//! `launcher linearize`: what it needs of a scenario, and the scenario it writes.
+//!
+//! Its input need not run yet: only `dt`, `[plant.fmu]` (the FMU and its map), and where to
+//! linearise — `[plant.operating_point]` x, u, w (u, w default 0; x defaults to `[plant] x0`,
+//! and with `--trim` is only the first guess) — are read; `[plant]`'s matrices, if any, are
+//! what the output replaces. The output is the same scenario (its comments lost: it is
+//! re-serialised) with `[plant]` the sampled model at dt — `time = "discrete"`, Φ, Γ_B, Γ_E
+//! and C as `.npy` files beside it — `[plant.operating_point]` the point (x, u, w and y as the
+//! FMU gives it), and the FMU's path absolute, so that it runs as is.
+
+use std::path::{Path, PathBuf};
+
+use serde_json::json;
+
+use super::plant_file::Sizes;
+use super::raw::{RawFmu, RawOperatingPoint};
+use super::validate::{bad, finite, Bad};
+use super::{untrusted, ScenarioError, MAX_SCENARIO_BYTES};
+
+/// What `fmu_plant --linearize` is asked.
+#[derive(Debug, Clone)]
+pub struct Request {
+    /// The scenario's name (the output file's stem).
+    pub name: String,
+    pub dt: f64,
+    /// The FMU plant's `params` (its map), `x0` = x_op or the trim's first guess.
+    pub params: serde_json::Value,
+    pub u: Vec<f64>,
+    pub w: Vec<f64>,
+    /// The FMU (absolute).
+    pub fmu: PathBuf,
+    /// The scenario's text, to be rewritten.
+    text: String,
+}
+
+impl Request {
+    /// The request as `fmu_plant --linearize` reads it.
+    pub fn json(&self, trim: bool) -> serde_json::Value {
+        json!({ "params": self.params, "u": self.u, "w": self.w, "dt": self.dt, "trim": trim })
+    }
+}
+
+/// Reads what `launcher linearize` needs from the scenario at `path`.
+pub fn request(path: &Path) -> Result<Request, ScenarioError> {
+    let err = |(field, reason): Bad| ScenarioError { file: path.to_path_buf(), at: None, field, reason };
+    let text = untrusted::read_bounded(path, MAX_SCENARIO_BYTES).map_err(|r| err((String::new(), r)))?;
+    let table: toml::Table = text.parse().map_err(|e: toml::de::Error| err((String::new(), format!("malformed TOML: {}", e.message().lines().next().unwrap_or("")))))?;
+    let dt = table.get("dt").and_then(|v| v.as_float().or(v.as_integer().map(|i| i as f64))).ok_or_else(|| err(bad("dt", "missing: the sample period the model is made for")))?;
+    if !(dt > 0.0 && dt.is_finite()) {
+        return Err(err(bad("dt", format!("{dt}: must be finite and > 0"))));
+    }
+    let name = table.get("name").and_then(|v| v.as_str()).unwrap_or("linearized").to_string();
+    let plant = table.get("plant").and_then(|v| v.as_table()).ok_or_else(|| err(bad("plant", "missing: [plant.fmu] names the FMU to linearise")))?;
+    let fmu: RawFmu = plant.get("fmu").ok_or_else(|| err(bad("plant.fmu", "missing: `launcher linearize` makes the model of an FMU plant")))?.clone().try_into().map_err(|e: toml::de::Error| err(bad("plant.fmu", e.message().lines().next().unwrap_or("").to_string())))?;
+    let op: Option<RawOperatingPoint> = match plant.get("operating_point") {
+        Some(v) => Some(v.clone().try_into().map_err(|e: toml::de::Error| err(bad("plant.operating_point", e.message().lines().next().unwrap_or("").to_string())))?),
+        None => None,
+    };
+    let x0: Option<Vec<f64>> = match plant.get("x0") {
+        Some(v) => Some(v.clone().try_into().map_err(|_| err(bad("plant.x0", "a list of numbers")))?),
+        None => None,
+    };
+    let (n, p) = (fmu.states.len(), fmu.outputs.len());
+    let (l, q) = (fmu.inputs.as_ref().map_or(0, Vec::len), fmu.disturbances.as_ref().map_or(0, Vec::len));
+    let vector = |field: &str, v: Option<Vec<f64>>, len: usize, default: Option<Vec<f64>>| -> Result<Vec<f64>, Bad> {
+        let v = match v.or(default) {
+            Some(v) => v,
+            None => return Err(bad(field, format!("missing: the operating point's {len} values (or [plant] x0)"))),
+        };
+        if v.len() != len {
+            return Err(bad(field, format!("has {} entries; the FMU map has {len}", v.len())));
+        }
+        for (i, &x) in v.iter().enumerate() {
+            finite(&format!("{field}[{}]", i + 1), x)?;
+        }
+        Ok(v)
+    };
+    let (ox, ou, ow) = op.map_or((None, None, None), |o| (o.x, o.u, o.w));
+    let x = vector("plant.operating_point.x", ox, n, x0).map_err(err)?;
+    let u = vector("plant.operating_point.u", ou, l, Some(vec![0.0; l])).map_err(err)?;
+    let w = vector("plant.operating_point.w", ow, q, Some(vec![0.0; q])).map_err(err)?;
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let (fmu_path, spec) = super::fmu_plant::plant_fmu(&Some(fmu), Some(dir), &Sizes { n, p, l, q }, Some(&x)).map_err(err)?.expect("given");
+    Ok(Request { name, dt, params: spec.params, u, w, fmu: fmu_path, text })
+}
+
+/// The model made, as `fmu_plant --linearize` answers.
+pub struct Linearized<'a> {
+    pub x: &'a [f64],
+    pub u: &'a [f64],
+    pub w: &'a [f64],
+    pub y: &'a [f64],
+    pub phi: &'a [Vec<f64>],
+    pub gamma_b: &'a [Vec<f64>],
+    pub gamma_e: &'a [Vec<f64>],
+    pub c: &'a [Vec<f64>],
+}
+
+/// Writes Phi.npy, Gamma_B.npy, Gamma_E.npy, C.npy and `<name>.toml` into `out` (made if
+/// missing); each file is written beside its name and renamed into place, so that a failure
+/// leaves no half-written file. Returns the scenario's path.
+pub fn write(req: &Request, m: &Linearized, out: &Path) -> Result<PathBuf, String> {
+    std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let mut table: toml::Table = req.text.parse().map_err(|e: toml::de::Error| e.to_string())?;
+    let plant = table.entry("plant").or_insert_with(|| toml::Value::Table(Default::default()));
+    let plant = plant.as_table_mut().ok_or("plant: not a table")?;
+    for key in ["A", "B", "E", "Phi", "Gamma_B", "Gamma_E", "C", "time"] {
+        plant.remove(key);
+    }
+    let mut files = Vec::new();
+    for (key, rows) in [("Phi", m.phi), ("Gamma_B", m.gamma_b), ("Gamma_E", m.gamma_e), ("C", m.c)] {
+        let file = format!("{key}.npy");
+        files.push((out.join(&file), super::matrix_file::npy_bytes(rows)?));
+        plant.insert(key.into(), toml::Value::String(file));
+    }
+    plant.insert("time".into(), "discrete".into());
+    let list = |v: &[f64]| toml::Value::Array(v.iter().map(|&x| toml::Value::Float(x)).collect());
+    let mut op = toml::Table::new();
+    for (k, v) in [("x", m.x), ("u", m.u), ("w", m.w), ("y", m.y)] {
+        if !v.is_empty() {
+            op.insert(k.into(), list(v));
+        }
+    }
+    plant.insert("operating_point".into(), toml::Value::Table(op));
+    if let Some(fmu) = plant.get_mut("fmu").and_then(|f| f.as_table_mut()) {
+        fmu.insert("path".into(), req.fmu.display().to_string().into());
+    }
+    let header = format!(
+        "# Made by `launcher linearize` from the FMU {}: the sampled model at dt = {} in deviations\n# from [plant.operating_point] (Phi, Gamma_B, Gamma_E, C beside this file, as .npy).\n",
+        req.fmu.display(),
+        req.dt
+    );
+    let text = header + &toml::to_string(&table).map_err(|e| e.to_string())?;
+    let scenario = out.join(format!("{}.toml", req.name.replace(['/', '\\'], "_")));
+    files.push((scenario.clone(), text.into_bytes()));
+    for (path, bytes) in &files {
+        let tmp = path.with_extension("partial");
+        std::fs::write(&tmp, bytes).map_err(|e| format!("{}: {e}", tmp.display()))?;
+    }
+    for (path, _) in &files {
+        std::fs::rename(path.with_extension("partial"), path).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    Ok(scenario)
+}
