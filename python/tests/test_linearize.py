@@ -20,6 +20,7 @@ import pytest
 import scipy.linalg as sla
 import scipy.optimize as so
 
+from conftest import REPO
 from test_diagnosis_scipy import launcher
 from test_fmu_plant import num, run, table, export_csv
 from test_fmu_pythonfmu import AREA, AZ, G, SN, f as tank_f  # noqa: F401
@@ -114,37 +115,8 @@ states = ["x1", "x2", "x3"]
 def test_the_python_fmu_is_trimmed_linearised_and_its_scenario_runs_under_a_uio(fmu_dir, tmp_path):
     shutil.copy(os.path.join(fmu_dir, "three_tank.fmu"), tmp_path)
     Q1, Q2 = 3.5e-5, 1.45e-5
-    (tmp_path / "tank.toml").write_text(f"""name = "three-tank"
-dt = 1.0
-duration = 600.0
-[plant]
-x0 = [0.4, 0.2, 0.3]
-state_names = ["h1", "h2", "h3"]
-state_units = ["m", "m", "m"]
-[plant.operating_point]
-x = [0.45, 0.25, 0.33]          # the trim's first guess
-u = [{Q1}, {Q2}]
-[plant.fmu]
-path = "three_tank.fmu"
-inputs = ["Q1", "Q2"]
-disturbances = ["leak"]
-outputs = ["y1", "y2", "y3"]
-states = ["h1", "h2", "h3"]
-[[input]]
-kind = "constant"
-value = {Q1}
-[[input]]
-kind = "constant"
-value = {Q2}
-[[disturbance]]
-kind = "step"
-time = 100.0
-after = 5e-6
-[[observer]]
-name = "uio"
-kind = "chen-patton-uio"
-poles = [-0.05, -0.06, -0.07]
-""")
+    # The README's worked example: the scenario shipped beside the FMU's source.
+    shutil.copy(os.path.join(REPO, "fmu", "testfmus", "python", "three-tank.toml"), tmp_path / "tank.toml")
     done = linearize(tmp_path / "tank.toml", tmp_path / "lin", "--trim")
     assert done.returncode == 0, done.stderr
     print(done.stdout)
