@@ -7,9 +7,7 @@
 //! extrapolation). This prints the report: the trim, the point, each matrix's estimated
 //! difference error, and a direct feedthrough the sampled model has no place for.
 
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
 
 use launcher::LaunchError;
 use scenario::linearized::{self, Linearized};
@@ -32,25 +30,8 @@ fn fmt(v: &[f64]) -> String {
 /// Runs `launcher linearize`; the scenario written.
 pub fn linearize(path: &Path, trim: bool, out: &Path) -> Result<PathBuf, LaunchError> {
     let req = linearized::request(path)?;
-    let bad = |why: String| LaunchError::BadInput(format!("{}: {why}", path.display()));
-    let exe = std::env::current_exe().unwrap_or_else(|_| "launcher".into()).with_file_name(PROGRAM);
-    let exe = if exe.is_file() { exe } else { PROGRAM.into() };
-    let mut child = Command::new(&exe)
-        .arg("--linearize")
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .map_err(|e| bad(format!("cannot start {PROGRAM} ({e}); it is built with `cargo build --release -p fmu-plant`")))?;
-    let text = serde_json::to_string(&req.json(trim)).expect("serialises");
-    child.stdin.take().expect("piped").write_all(text.as_bytes()).map_err(|e| bad(format!("{PROGRAM} --linearize: {e}")))?;
-    let done = child.wait_with_output().map_err(|e| bad(format!("{PROGRAM} --linearize: {e}")))?;
-    if !done.status.success() {
-        let said = String::from_utf8_lossy(&done.stderr);
-        let line = said.lines().rfind(|l| !l.trim().is_empty()).unwrap_or("").trim().to_string();
-        return Err(bad(format!("plant.fmu: {}", if line.is_empty() { format!("{PROGRAM} --linearize failed ({})", done.status) } else { line })));
-    }
-    let a: Value = serde_json::from_slice(&done.stdout).map_err(|e| bad(format!("{PROGRAM} --linearize: its answer: {e}")))?;
+    let answer = launcher::run::preflight::sibling(path, ["plant.fmu: "; 2], PROGRAM, "--linearize", "fmu-plant", &req.json(trim))?;
+    let a: Value = serde_json::from_slice(&answer).map_err(|e| LaunchError::BadInput(format!("{}: {PROGRAM} --linearize: its answer: {e}", path.display())))?;
     let (x, y) = (list(&a["x"]), list(&a["y"]));
     let (phi, gb, ge, c) = (rows(&a["Phi"]), rows(&a["Gamma_B"]), rows(&a["Gamma_E"]), rows(&a["C"]));
     let file = req.fmu.file_name().map_or(String::new(), |f| f.to_string_lossy().into_owned());

@@ -137,3 +137,21 @@ def test_the_python_fmu_is_trimmed_linearised_and_its_scenario_runs_under_a_uio(
     e, ew = np.abs(X[tail] - Xh[tail]).max(), np.abs(W[tail] - Wh[tail]).max()
     print(f"three_tank from launcher linearize: tail max|x − x̂| {e:.3e} m, max|w − ŵ| {ew:.3e} m3/s (leak 5e-6)")
     assert np.abs(Xh[tail] - x_op).max() < 0.05 and e < 1e-3 and ew < 0.1 * 5e-6
+
+
+def test_a_scenario_name_that_is_not_a_file_stem_is_refused_before_anything_is_written(fmu_dir, tmp_path):
+    (tmp_path / "bad.toml").write_text(f"""name = "../../escaped"
+dt = 0.1
+[plant.operating_point]
+x = [0.0, 0.0, 0.0]
+[plant.fmu]
+path = "{os.path.join(fmu_dir, 'dc_motor_fmi2.fmu')}"
+inputs = ["u1"]
+disturbances = ["w1"]
+outputs = ["y1", "y2"]
+states = ["x1", "x2", "x3"]
+""")
+    done = linearize(tmp_path / "bad.toml", tmp_path / "out")
+    assert done.returncode == 2, done.stderr
+    assert "name" in done.stderr and "letters, digits" in done.stderr, done.stderr
+    assert not (tmp_path / "out").exists() and not (tmp_path.parent / "escaped.toml").exists()

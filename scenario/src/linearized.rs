@@ -14,7 +14,7 @@ use serde_json::json;
 
 use super::plant_file::Sizes;
 use super::raw::{RawFmu, RawOperatingPoint};
-use super::validate::{bad, finite, Bad};
+use super::validate::{bad, check_name, finite, Bad};
 use super::{untrusted, ScenarioError, MAX_SCENARIO_BYTES};
 
 /// What `fmu_plant --linearize` is asked.
@@ -50,6 +50,8 @@ pub fn request(path: &Path) -> Result<Request, ScenarioError> {
         return Err(err(bad("dt", format!("{dt}: must be finite and > 0"))));
     }
     let name = table.get("name").and_then(|v| v.as_str()).unwrap_or("linearized").to_string();
+    // It names the scenario file written: a name as a run's (letters, digits, '-', '_').
+    check_name("name", &name, "it names the scenario file written").map_err(err)?;
     let plant = table.get("plant").and_then(|v| v.as_table()).ok_or_else(|| err(bad("plant", "missing: [plant.fmu] names the FMU to linearise")))?;
     let fmu: RawFmu = plant.get("fmu").ok_or_else(|| err(bad("plant.fmu", "missing: `launcher linearize` makes the model of an FMU plant")))?.clone().try_into().map_err(|e: toml::de::Error| err(bad("plant.fmu", e.message().lines().next().unwrap_or("").to_string())))?;
     let op: Option<RawOperatingPoint> = match plant.get("operating_point") {
@@ -131,7 +133,7 @@ pub fn write(req: &Request, m: &Linearized, out: &Path) -> Result<PathBuf, Strin
         req.dt
     );
     let text = header + &toml::to_string(&table).map_err(|e| e.to_string())?;
-    let scenario = out.join(format!("{}.toml", req.name.replace(['/', '\\'], "_")));
+    let scenario = out.join(format!("{}.toml", req.name));
     files.push((scenario.clone(), text.into_bytes()));
     for (path, bytes) in &files {
         let tmp = path.with_extension("partial");

@@ -2,7 +2,6 @@
 //! and type its role needs; the result is the value references the plant exchanges.
 //! `fmu_plant --check` runs this alone (the launcher's pre-flight).
 
-use std::io::Read;
 use std::path::Path;
 
 use crate::archive::{self, Causality, Fmu, Type, Var};
@@ -110,17 +109,5 @@ pub fn resolve(p: &Params) -> Result<(Fmu, Map), String> {
 
 /// `fmu_plant --check`: the map (the plant's `params`) on stdin; exit 0, or 2 with one line.
 pub fn main() -> std::process::ExitCode {
-    let mut text = String::new();
-    let outcome = std::io::stdin()
-        .read_to_string(&mut text)
-        .map_err(|e| format!("stdin: {e}"))
-        .and_then(|_| serde_json::from_str::<Params>(&text).map_err(|e| format!("params: {e}")))
-        .and_then(|p| resolve(&p));
-    match outcome {
-        Ok(_) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("{e}");
-            std::process::ExitCode::from(2)
-        }
-    }
+    crate::request::answer(crate::request::read::<Params>("params").and_then(|p| resolve(&p)).map(|_| None))
 }

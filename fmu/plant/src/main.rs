@@ -14,6 +14,7 @@ mod log_capture;
 mod params;
 mod plant;
 mod python;
+mod request;
 mod slave;
 
 fn main() -> std::process::ExitCode {

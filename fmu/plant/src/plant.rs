@@ -20,7 +20,7 @@ use plant::{PlantConfig, Sensing};
 
 use crate::check::{resolve, Map};
 use crate::params::Params;
-use crate::slave::Slave;
+use crate::slave::{Archive, Slave};
 
 pub struct FmuPlant {
     slave: Slave,
@@ -69,7 +69,7 @@ impl Component for FmuPlant {
             return Err(format!("the map has {} states, {} outputs, {} inputs, {} disturbances; the model n = {}, p = {}, l = {}, q = {}", map.states.len(), map.outputs.len(), map.inputs.len(), map.disturbances.len(), lay.n, lay.p, lay.l, lay.q));
         }
         let file = std::path::Path::new(&p.path).file_name().map_or(p.path.clone(), |f| f.to_string_lossy().into_owned());
-        let slave = Slave::start(&p.path, fmu.version, &cfg.name, &map.parameters, &map.x0, map.python.as_ref()).map_err(|e| format!("{file}: {e}"))?;
+        let slave = Archive::open(&p.path, fmu.version, map.python.as_ref()).and_then(|a| a.start(&cfg.name, &map.parameters, &map.x0)).map_err(|e| format!("{file}: {e}"))?;
         Ok(FmuPlant {
             slave,
             map,

@@ -2,6 +2,8 @@
 //! makes: parameters before initialisation, Real/Float64 inputs and outputs, and doStep. Every
 //! failed call says which call, at what time, and what the FMU logged about it.
 
+use std::rc::Rc;
+
 use fmi::fmi2::import::Fmi2Import;
 use fmi::fmi3::import::Fmi3Import;
 use fmi::fmi3::instance::InstanceCS as Cs3;
@@ -12,12 +14,53 @@ use crate::check::Start;
 use crate::fmi2::Cs2;
 use crate::log_capture;
 
+/// An extracted FMU, its library ready to instantiate: extracted once however many instances
+/// are made of it (`launcher linearize` makes dozens).
+#[derive(Clone)]
+pub enum Archive {
+    Two(Rc<Fmi2Import>),
+    Three(Rc<Fmi3Import>),
+}
+
+impl Archive {
+    /// Extracts the FMU at `path`; an FMU whose library embeds Python gets `python` loaded
+    /// first.
+    pub fn open(path: &str, version: Version, python: Option<&crate::python::Python>) -> Result<Self, String> {
+        log_capture::install();
+        if let Some(py) = python {
+            crate::python::load(py)?;
+        }
+        let cannot = |e: fmi::Error| format!("cannot extract: {e}");
+        Ok(match version {
+            Version::Two => Archive::Two(Rc::new(fmi::import::from_path(path).map_err(cannot)?)),
+            Version::Three => Archive::Three(Rc::new(fmi::import::from_path(path).map_err(cannot)?)),
+        })
+    }
+
+    /// Instantiates the FMU for co-simulation, sets the parameters' and the states' start
+    /// values (`x0`, may be empty) and initialises it at t = 0.
+    pub fn start(&self, name: &str, parameters: &[(u32, Start)], x0: &[(u32, f64)]) -> Result<Slave, String> {
+        let mut s = match self {
+            Archive::Two(import) => Slave::Two { inst: Cs2::instantiate(import, name)?, _import: import.clone() },
+            Archive::Three(import) => {
+                let inst = import
+                    .instantiate_cs(name, false, true, false, false, &[])
+                    .map_err(|e| format!("fmi3InstantiateCoSimulation failed ({e}){}", log_capture::take()))?;
+                Slave::Three { inst, _import: import.clone() }
+            }
+        };
+        let starts: Vec<(u32, Start)> = parameters.iter().cloned().chain(x0.iter().map(|&(vr, x)| (vr, Start::Real(x)))).collect();
+        s.initialise(&starts)?;
+        Ok(s)
+    }
+}
+
 /// An instance; the import (the extracted archive) lives as long as it. Fields drop in order:
 /// the instance is freed before its library's folder goes.
 #[allow(clippy::large_enum_variant)] // one instance per process, never moved in the step loop
 pub enum Slave {
-    Two { inst: Cs2, _import: Fmi2Import },
-    Three { inst: Cs3, _import: Fmi3Import },
+    Two { inst: Cs2, _import: Rc<Fmi2Import> },
+    Three { inst: Cs3, _import: Rc<Fmi3Import> },
 }
 
 fn failed(call: &str, t: f64, status: impl std::fmt::Debug) -> String {
@@ -25,33 +68,6 @@ fn failed(call: &str, t: f64, status: impl std::fmt::Debug) -> String {
 }
 
 impl Slave {
-    /// Extracts and instantiates the FMU at `path` for co-simulation, sets the parameters'
-    /// and the states' start values (`x0`, may be empty) and initialises it at t = 0. An FMU
-    /// whose library embeds Python gets `python` loaded first.
-    pub fn start(path: &str, version: Version, name: &str, parameters: &[(u32, Start)], x0: &[(u32, f64)], python: Option<&crate::python::Python>) -> Result<Self, String> {
-        log_capture::install();
-        if let Some(py) = python {
-            crate::python::load(py)?;
-        }
-        let mut s = match version {
-            Version::Two => {
-                let import: Fmi2Import = fmi::import::from_path(path).map_err(|e| format!("cannot extract: {e}"))?;
-                let inst = Cs2::instantiate(&import, name)?;
-                Slave::Two { inst, _import: import }
-            }
-            Version::Three => {
-                let import: Fmi3Import = fmi::import::from_path(path).map_err(|e| format!("cannot extract: {e}"))?;
-                let inst = import
-                    .instantiate_cs(name, false, true, false, false, &[])
-                    .map_err(|e| format!("fmi3InstantiateCoSimulation failed ({e}){}", log_capture::take()))?;
-                Slave::Three { inst, _import: import }
-            }
-        };
-        let starts: Vec<(u32, Start)> = parameters.iter().cloned().chain(x0.iter().map(|&(vr, x)| (vr, Start::Real(x)))).collect();
-        s.initialise(&starts)?;
-        Ok(s)
-    }
-
     fn initialise(&mut self, parameters: &[(u32, Start)]) -> Result<(), String> {
         match self {
             Slave::Two { inst: i, .. } => {

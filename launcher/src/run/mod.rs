@@ -5,7 +5,7 @@ mod configs;
 mod envelope;
 pub mod interrupt;
 mod in_process;
-mod preflight;
+pub mod preflight;
 mod processes;
 mod progress;
 mod salvage;

@@ -38,26 +38,34 @@ pub fn replay(s: &Scenario) -> Result<Option<serde_json::Value>, LaunchError> {
 /// with `params` on stdin: its stdout, or its last line on stderr as bad input. `field` heads
 /// this function's own messages and the component's line.
 fn check(s: &Scenario, field: [&str; 2], program: &str, package: &str, params: &serde_json::Value) -> Result<Vec<u8>, LaunchError> {
+    sibling(&s.path, field, program, "--check", package, params)
+}
+
+/// `program flag` (a kit component built beside the launcher, of cargo package `package`) with
+/// `input` as JSON on stdin: its stdout, or its last line on stderr as bad input of `file`.
+/// `field` heads this function's own messages and the component's line. `--check` here, and
+/// `fmu_plant --linearize` for `launcher linearize`.
+pub fn sibling(file: &std::path::Path, field: [&str; 2], program: &str, flag: &str, package: &str, input: &serde_json::Value) -> Result<Vec<u8>, LaunchError> {
     let exe = std::env::current_exe().unwrap_or_else(|_| "launcher".into()).with_file_name(program);
     let path = if exe.is_file() { exe } else { program.into() };
-    let bad = |why: String| LaunchError::BadInput(format!("{}: {}{why}", s.path.display(), field[0]));
+    let bad = |why: String| LaunchError::BadInput(format!("{}: {}{why}", file.display(), field[0]));
     let mut child = Command::new(&path)
-        .arg("--check")
+        .arg(flag)
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .map_err(|e| bad(format!("cannot start {program} ({e}); it is built with `cargo build --release -p {package}`")))?;
-    let text = serde_json::to_string(params).expect("serialises");
-    child.stdin.take().expect("piped").write_all(text.as_bytes()).map_err(|e| bad(format!("{program} --check: {e}")))?;
-    let out = child.wait_with_output().map_err(|e| bad(format!("{program} --check: {e}")))?;
+    let text = serde_json::to_string(input).expect("serialises");
+    child.stdin.take().expect("piped").write_all(text.as_bytes()).map_err(|e| bad(format!("{program} {flag}: {e}")))?;
+    let out = child.wait_with_output().map_err(|e| bad(format!("{program} {flag}: {e}")))?;
     if out.status.success() {
         return Ok(out.stdout);
     }
     let said = String::from_utf8_lossy(&out.stderr);
     let line = said.lines().rfind(|l| !l.trim().is_empty()).unwrap_or("").trim().to_string();
     if line.is_empty() {
-        return Err(bad(format!("{program} --check failed ({})", out.status)));
+        return Err(bad(format!("{program} {flag} failed ({})", out.status)));
     }
-    Err(LaunchError::BadInput(format!("{}: {}{line}", s.path.display(), field[1])))
+    Err(LaunchError::BadInput(format!("{}: {}{line}", file.display(), field[1])))
 }

@@ -28,13 +28,11 @@
 mod difference;
 mod trim;
 
-use std::io::Read;
-
 use serde::{Deserialize, Serialize};
 
 use crate::check::{resolve, Map, Start};
 use crate::params::Params;
-use crate::slave::Slave;
+use crate::slave::Archive;
 
 /// What the launcher asks for, on stdin.
 #[derive(Debug, Deserialize)]
@@ -91,11 +89,11 @@ pub struct Answer {
     pub instances: usize,
 }
 
-/// One FMU, opened once per evaluation of F.
+/// One FMU, extracted once; a fresh instance per evaluation of F.
 pub struct OneSample<'a> {
     p: &'a Params,
     map: &'a Map,
-    version: crate::archive::Version,
+    archive: Archive,
     dt: f64,
     pub instances: usize,
 }
@@ -114,7 +112,7 @@ impl OneSample<'_> {
             .collect();
         let x0: Vec<(u32, f64)> = self.map.states.iter().zip(&z[..n]).map(|(&vr, &v)| (vr, v)).collect();
         self.instances += 1;
-        let mut s = Slave::start(&self.p.path, self.version, "linearize", &starts, &x0, self.map.python.as_ref())?;
+        let mut s = self.archive.start("linearize", &starts, &x0)?;
         let (mut x, mut y) = (vec![0.0; n], vec![0.0; self.map.outputs.len()]);
         s.get(&self.map.outputs, &mut y, 0.0)?;
         s.get(&self.map.states, &mut x, 0.0)?;
@@ -138,14 +136,13 @@ fn run(req: &Request) -> Result<Answer, String> {
     if !(req.dt > 0.0 && req.dt.is_finite()) {
         return Err(format!("dt = {}: must be finite and > 0", req.dt));
     }
-    let mut params = req.params.clone();
-    let x_start = match &params.x0 {
-        Some(x) => x.clone(),
-        None => return Err("x_op: the launcher gives the operating point's x (or the trim's first guess)".into()),
+    let params = &req.params;
+    let Some(x_start) = params.x0.clone() else {
+        return Err("x_op: the launcher gives the operating point's x (or the trim's first guess)".into());
     };
-    params.x0 = Some(x_start.clone());
-    let (fmu, map) = resolve(&params)?;
-    let mut f = OneSample { p: &params, map: &map, version: fmu.version, dt: req.dt, instances: 0 };
+    let (fmu, map) = resolve(params)?;
+    let archive = Archive::open(&params.path, fmu.version, map.python.as_ref())?;
+    let mut f = OneSample { p: params, map: &map, archive, dt: req.dt, instances: 0 };
     let (x, trim) = if req.trim {
         let t = trim::newton(&mut f, &x_start, &req.u, &req.w)?;
         (t.0, Some(t.1))
@@ -176,20 +173,6 @@ fn run(req: &Request) -> Result<Answer, String> {
 /// `fmu_plant --linearize`: the request on stdin, the answer (JSON) on stdout; exit 2 with one
 /// line for a request the FMU cannot answer.
 pub fn main() -> std::process::ExitCode {
-    let mut text = String::new();
-    let outcome = std::io::stdin()
-        .read_to_string(&mut text)
-        .map_err(|e| format!("stdin: {e}"))
-        .and_then(|_| serde_json::from_str::<Request>(&text).map_err(|e| format!("request: {e}")))
-        .and_then(|r| run(&r));
-    match outcome {
-        Ok(a) => {
-            println!("{}", serde_json::to_string(&a).expect("numbers serialise"));
-            crate::end(0)
-        }
-        Err(e) => {
-            eprintln!("{e}");
-            crate::end(2)
-        }
-    }
+    let answer = crate::request::read::<Request>("request").and_then(|r| run(&r));
+    crate::request::answer(answer.map(|a| Some(serde_json::to_string(&a).expect("numbers serialise"))))
 }
