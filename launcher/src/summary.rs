@@ -23,20 +23,34 @@ pub struct ObserverSummary {
     pub tail_max_abs_error: Option<f64>,
     /// max |y − Cx̂| over the last quarter of the steps completed.
     pub tail_max_abs_residual: Option<f64>,
-    /// max |x − x̂| over the run.
-    pub max_abs_error: f64,
+    /// max |x − x̂| over the run (null where the data holds no x: see `Summary::unmeasured`).
+    pub max_abs_error: Option<f64>,
     /// max |x − x̂| at the last step.
-    pub final_abs_error: f64,
+    pub final_abs_error: Option<f64>,
     /// max |w − ŵ| over the tail, for an observer that estimates the unknown inputs.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tail_max_abs_input_error: Option<f64>,
     /// In a run with faults, the figures before the first fault: its effect is in the run's tail.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub fault_free: Option<recording::write::FaultFree>,
+    pub fault_free: Option<FaultFree>,
     /// Continuous error-dynamics eigenvalues, [re, im].
     pub poles: Vec<[f64; 2]>,
     /// Sampled observer eigenvalues, [re, im].
     pub discrete_poles: Vec<[f64; 2]>,
+}
+
+/// An observer's figures over the fault-free stretch before the first fault
+/// ([`recording::write::FaultFree`]), the errors null where the data holds no x.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct FaultFree {
+    /// How long the stretch is, s.
+    pub until: f64,
+    /// max |x − x̂| over its last quarter.
+    pub tail_max_abs_error: Option<f64>,
+    /// max |y − Cx̂| over its last quarter.
+    pub tail_max_abs_residual: f64,
+    /// max |x − x̂| over the stretch.
+    pub max_abs_error: Option<f64>,
 }
 
 /// One `[expect]` entry, checked.
@@ -121,6 +135,10 @@ pub struct Summary {
     /// above is in the plant's own (absolute) units.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub operating_point: Option<lti::OperatingPoint>,
+    /// The figures a replay's data cannot give, each with why (a log without x has no
+    /// estimation error: x − x̂ would be −x̂); those figures are null and print as "—".
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub unmeasured: Vec<String>,
 }
 
 impl Summary {
@@ -137,10 +155,10 @@ impl Summary {
                 kind: o.kind().into(),
                 tail_max_abs_error: f.tail_max_abs_error,
                 tail_max_abs_residual: f.tail_max_abs_residual,
-                max_abs_error: f.max_abs_error,
-                final_abs_error: f.final_abs_error,
+                max_abs_error: Some(f.max_abs_error),
+                final_abs_error: Some(f.final_abs_error),
                 tail_max_abs_input_error: f.tail_max_abs_input_error,
-                fault_free: f.fault_free,
+                fault_free: f.fault_free.map(|f| FaultFree { until: f.until, tail_max_abs_error: Some(f.tail_max_abs_error), tail_max_abs_residual: f.tail_max_abs_residual, max_abs_error: Some(f.max_abs_error) }),
                 poles: d.as_ref().map_or_else(Vec::new, |d| lti::re_im(&d.report.poles)),
                 discrete_poles: d.as_ref().map_or_else(Vec::new, |d| lti::re_im(&d.report.discrete_poles)),
             })
@@ -177,9 +195,35 @@ impl Summary {
             replay: None,
             warnings: plan.warnings.clone(),
             operating_point: s.operating_point.clone(),
+            unmeasured: Vec::new(),
         };
         summary.expectations = summary.check(s, matches!(stop, Stop::Completed));
         summary
+    }
+
+    /// Takes a replay's facts (`replay_plant --check`): where its data holds no x (`states`
+    /// false) every state-error figure becomes null, where it holds no w (`disturbances` false)
+    /// every |w − ŵ|, each with its reason in `unmeasured`; the expectations are checked again.
+    pub fn with_replay(&mut self, s: &Scenario, facts: serde_json::Value, completed: bool) {
+        let has = |k: &str| facts.get(k).and_then(serde_json::Value::as_bool).unwrap_or(true);
+        let file = facts.get("file").and_then(serde_json::Value::as_str).unwrap_or("the data").to_string();
+        if !has("states") {
+            for o in &mut self.observers {
+                (o.tail_max_abs_error, o.max_abs_error, o.final_abs_error) = (None, None, None);
+                if let Some(f) = &mut o.fault_free {
+                    (f.tail_max_abs_error, f.max_abs_error) = (None, None);
+                }
+            }
+            self.unmeasured.push(format!("max|e|: {file} holds no states (plant.replay.states), so x − x̂ would be −x̂, not an estimation error"));
+        }
+        if !has("disturbances") && self.observers.iter().any(|o| o.tail_max_abs_input_error.is_some()) {
+            for o in &mut self.observers {
+                o.tail_max_abs_input_error = None;
+            }
+            self.unmeasured.push(format!("max|w − ŵ|: {file} holds no unknown inputs (plant.replay.disturbances), so w − ŵ would be −ŵ"));
+        }
+        self.replay = Some(facts);
+        self.expectations = self.check(s, completed);
     }
 
     fn observer(&self, name: &str) -> Option<&ObserverSummary> {
@@ -262,12 +306,16 @@ impl Summary {
         t += &format!("  {:<14} {:<16} {:>14} {:>14}   ({tail})\n", "observer", "kind", "tail max|e|", "tail max|r|");
         for o in &self.observers {
             t += &format!("  {:<14} {:<16} {:>14} {:>14}\n", o.name, o.kind, figure(o.tail_max_abs_error), figure(o.tail_max_abs_residual));
-            if let Some(w) = o.tail_max_abs_input_error {
-                t += &format!("  {:<31} {:>14}   (its unknown-input estimate)\n", "", format!("max|w − ŵ| {}", figure(Some(w))));
+            let unknown_w = self.unmeasured.iter().any(|u| u.starts_with("max|w"));
+            if o.tail_max_abs_input_error.is_some() || unknown_w {
+                t += &format!("  {:<31} {:>14}   (its unknown-input estimate)\n", "", format!("max|w − ŵ| {}", figure(o.tail_max_abs_input_error)));
             }
             if let Some(ff) = &o.fault_free {
-                t += &format!("  {:<31} {:>14} {:>14}   (tail of the fault-free {} s before the first fault)\n", "", figure(Some(ff.tail_max_abs_error)), figure(Some(ff.tail_max_abs_residual)), sig(ff.until));
+                t += &format!("  {:<31} {:>14} {:>14}   (tail of the fault-free {} s before the first fault)\n", "", figure(ff.tail_max_abs_error), figure(Some(ff.tail_max_abs_residual)), sig(ff.until));
             }
+        }
+        for why in &self.unmeasured {
+            t += &format!("  — {why}\n");
         }
         let p = &self.latency_ns.step;
         if p.max > 0 {

@@ -155,6 +155,23 @@ def test_mcap_equals_the_csv_bit_for_bit(exported):
     print(f"{compared} MCAP values equal the CSV's")
 
 
+def test_an_unknown_input_estimate_is_named_after_its_unknown_input(exported):
+    """ŵ_k's column is headed as w_k's (name and unit: `crosswind [N]`, `w1` where the scenario
+    names none) and its MCAP field is w_k's field, in every observer that estimates w; before,
+    the headers were the bare indices `1` and the fields `_1`."""
+    groups = exported["groups"]
+    w = groups["disturbance"]["headers"]
+    estimates = [stem for stem in groups if stem.startswith("observer_") and stem.endswith("_what")]
+    assert estimates, "the scenario has an observer that estimates w"
+    with open(exported["dir"] / "x.mcap", "rb") as f:
+        schemas = {c.topic.lstrip("/").replace("/", "_"): json.loads(s.data)["properties"] for s, c, _ in make_reader(f).iter_messages()}
+    w_fields = [k for k in schemas["disturbance"] if k not in ("step", "sim_time")]
+    for stem in estimates:
+        assert groups[stem]["headers"] == w, stem
+        assert [k for k in schemas[stem] if k not in ("step", "sim_time")] == w_fields, stem
+        assert not any(re.fullmatch(r"_?\d+", h) for h in groups[stem]["headers"] + w_fields)
+
+
 def test_every_format_together_and_alone_is_the_same_file(exported, tmp_path):
     """A format exported alone is byte for byte what the four-format export wrote — later:
     nothing of the clock gets in (zip entry times have a 2-second resolution)."""

@@ -266,6 +266,38 @@ def test_without_states_the_summary_says_so(motor, tmp_path):
     assert s["replay"]["states"] is False
     # The detection does not need x: the same figures as with it.
     assert s["diagnosis"]["faults"][0]["isolated_as"] == "volts1-bias"
+    # No error figure from a run without x: null in the JSON, "—" and the reason in the table
+    # (before, the table printed max|x̂| as the error).
+    uio = s["observers"][0]
+    assert [uio[k] for k in ("tail_max_abs_error", "max_abs_error", "final_abs_error")] == [None] * 3, uio
+    assert uio["fault_free"]["tail_max_abs_error"] is None and uio["fault_free"]["tail_max_abs_residual"] > 0
+    assert uio["tail_max_abs_residual"] > 0
+    assert any("holds no states" in u for u in s["unmeasured"]), s["unmeasured"]
+    line = next(l for l in p.stdout.splitlines() if l.strip().startswith("uio "))
+    assert line.split()[2] == "—", line
+    assert "x − x̂ would be −x̂" in p.stdout
+
+
+def test_without_disturbances_no_input_error_is_claimed(motor, tmp_path):
+    """A log without w columns: the run takes w = 0, so |w − ŵ| would be |ŵ|; the summary gives
+    none and says why, while the state errors (x is in the log) stay."""
+    folder, _ = motor
+    scen = motor_scenario(folder)
+    full = tmp_path / "full"
+    p = launch(tmp_path, "run", scen, "--out", full)
+    assert p.returncode == 0, p.stderr
+    with_w = json.loads((full / "motor-log.summary.json").read_text())["observers"][0]
+    assert with_w["tail_max_abs_input_error"] is not None, with_w
+    scen.write_text(re.sub(r"^disturbances = .*$", "", scen.read_text(), flags=re.M))
+    out = tmp_path / "out"
+    p = launch(tmp_path, "run", scen, "--out", out)
+    assert p.returncode == 0, p.stderr
+    s = json.loads((out / "motor-log.summary.json").read_text())
+    uio = s["observers"][0]
+    assert "tail_max_abs_input_error" not in uio and s["replay"]["disturbances"] is False
+    assert uio["tail_max_abs_error"] is not None
+    assert any("holds no unknown inputs" in u for u in s["unmeasured"]), s["unmeasured"]
+    assert "max|w − ŵ|              —" in p.stdout or re.search(r"max\|w − ŵ\| +—", p.stdout), p.stdout
 
 
 def compared(p):

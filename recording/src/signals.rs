@@ -89,7 +89,8 @@ pub fn log10_floored(v: f64) -> f64 {
 
 /// The name and unit of the signal at `path` in a run of `s`, for CSV headers and axis labels:
 /// a state estimate is named after its state, an error `e<i>` and a residual `r<j>` carry the
-/// unit of their state or output (as in the README: e = x − x̂, r = y − Cx̂). Without the
+/// unit of their state or output (as in the README: e = x − x̂, r = y − Cx̂), an unknown-input
+/// estimate ŵ_k the name and unit of w_k. Without the
 /// scenario, the default names (x1, y1, w1, …) and no unit. `None` for paths that are not a
 /// numbered signal (latency).
 pub fn named(s: Option<&Scenario>, path: &str) -> Option<Named> {
@@ -100,7 +101,7 @@ pub fn named(s: Option<&Scenario>, path: &str) -> Option<Named> {
         let letter = match kind {
             "/plant/x" | "xhat" => "x",
             "/plant/y" => "y",
-            "/disturbance" => "w",
+            "/disturbance" | "what" => "w",
             "/measurement_disturbance" => "v",
             "/input" | "residual" => "r",
             "/controller/u" => "u",
@@ -114,7 +115,8 @@ pub fn named(s: Option<&Scenario>, path: &str) -> Option<Named> {
     match kind {
         "/plant/x" | "xhat" => get(&n.state),
         "/plant/y" => get(&n.output),
-        "/disturbance" => get(&n.disturbance),
+        // ŵ_k is named after w_k, as x̂_i after x_i: its group tells them apart.
+        "/disturbance" | "what" => get(&n.disturbance),
         "/measurement_disturbance" => get(&n.measurement_disturbance),
         "/input" => get(&n.input),
         "/controller/u" => n.input.get(i).map(|r| Named { name: control_name(s, i), unit: r.unit.clone() }),

@@ -61,7 +61,7 @@ pub fn load(p: &Params) -> Result<Table, String> {
         }
         data.extend(u.iter().map(|s| if k == 0 { 0.0 } else { s.values[k - 1] }));
     }
-    let facts = Facts { file, rows: recorded as u64, samples: samples as u64, held_rows: 0, held_cells: 0, states: true };
+    let facts = Facts { file, rows: recorded as u64, samples: samples as u64, held_rows: 0, held_cells: 0, states: true, disturbances: true };
     Ok(Table { width, data, facts })
 }
 

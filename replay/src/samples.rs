@@ -109,7 +109,7 @@ pub fn table(p: &Params, file: String, m: Mapped, states: bool, name: &Naming<'_
             }
         }
     }
-    let facts = Facts { file, rows: rows as u64, samples: pick.len() as u64, held_rows, held_cells: m.held_cells, states };
+    let facts = Facts { file, rows: rows as u64, samples: pick.len() as u64, held_rows, held_cells: m.held_cells, states, disturbances: p.disturbances.is_some() };
     Ok(Table { width: out_w, data, facts })
 }
 

@@ -30,6 +30,9 @@ pub struct Facts {
     /// Whether the data carries the true state; without it x is 0 and the recorded errors are
     /// not estimation errors.
     pub states: bool,
+    /// Whether the data carries the unknown inputs w; without them w is 0 and |w − ŵ| is |ŵ|,
+    /// not an estimation error.
+    pub disturbances: bool,
 }
 
 impl Table {

@@ -241,7 +241,9 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
     let mut summary = Summary::new(s, plan, opts, &metrics, &latency, wall, &stop, rrd.as_deref(), diagnosis);
     summary.realtime = realtime;
     summary.recording_digest = digest;
-    summary.replay = replay;
+    if let Some(facts) = replay {
+        summary.with_replay(s, facts, matches!(stop, Stop::Completed));
+    }
     if let Some(path) = &summary_path {
         summary.write(path).map_err(LaunchError::Component)?;
     }
