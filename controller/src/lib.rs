@@ -59,10 +59,14 @@ impl ControllerConfig {
 /// leaves a steady-state error), else estimated, z_k = C_t x̂_k.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct IntegralConfig {
-    /// G_ξ, l×l.
+    /// G_ξ, l×l_t: one column per integrator.
     pub gi: MatData,
-    /// C_t (l×n, on x̂), or M (l×p, on the plant's y_k) when `y` is given.
+    /// C_t (l_t×n, on x̂), or M (l_t×p, on the plant's y_k) when `y` is given.
     pub ct: MatData,
+    /// The references (0-based) the integrators hold the tracked outputs at: the commanded
+    /// inputs' when some inputs are measured disturbances; empty: all l (l_t = l).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub references: Vec<usize>,
     /// [start, end) of y_k in the plant's sample, when z is measured.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub y: Option<[usize; 2]>,
@@ -108,6 +112,8 @@ pub struct Controller {
 #[derive(Debug, Clone)]
 struct Integral {
     gi: DMatrix<f64>,
+    /// Which of r each integrator compares with.
+    references: Vec<usize>,
     ct: DMatrix<f64>,
     y: Option<std::ops::Range<usize>>,
     xi: DVector<f64>,
@@ -141,10 +147,15 @@ impl Controller {
                 let (gi, ct): (DMatrix<f64>, DMatrix<f64>) = ((&i.gi).into(), (&i.ct).into());
                 let y = i.y.map(|[a, b]| a..b);
                 let cols = y.as_ref().map_or(nx, |y| y.len());
-                if gi.shape() != (l, l) || ct.shape() != (l, cols) {
-                    return Err(format!("integral: G_ξ is {}×{} and C_t {}×{}, must be {l}×{l} and {l}×{cols}", gi.nrows(), gi.ncols(), ct.nrows(), ct.ncols()));
+                let references = if i.references.is_empty() { (0..l).collect() } else { i.references.clone() };
+                let lt = references.len();
+                if gi.shape() != (l, lt) || ct.shape() != (lt, cols) {
+                    return Err(format!("integral: G_ξ is {}×{} and C_t {}×{}, must be {l}×{lt} and {lt}×{cols}", gi.nrows(), gi.ncols(), ct.nrows(), ct.ncols()));
                 }
-                Ok(Integral { gi, ct, y, xi: DVector::zeros(l), z: DVector::zeros(l) })
+                if references.iter().any(|&j| j >= l) {
+                    return Err(format!("integral: references must index the {l} references"));
+                }
+                Ok(Integral { gi, references, ct, y, xi: DVector::zeros(lt), z: DVector::zeros(lt) })
             })
             .transpose()?;
         let feedforward = cfg
@@ -196,8 +207,8 @@ impl Controller {
                 Some(y) => mul_into(i.z.as_mut_slice(), &i.ct, &plant[y.clone()]),
                 None => mul_into(i.z.as_mut_slice(), &i.ct, xhat),
             }
-            for ((xi, r), z) in i.xi.as_mut_slice().iter_mut().zip(r.iter()).zip(i.z.as_slice()) {
-                *xi += self.dt * (r - z);
+            for ((xi, &j), z) in i.xi.as_mut_slice().iter_mut().zip(&i.references).zip(i.z.as_slice()) {
+                *xi += self.dt * (r[j] - z);
             }
         }
         if let Some(f) = &mut self.feedforward {

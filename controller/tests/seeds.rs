@@ -10,7 +10,7 @@ use reader::{mat, seeds};
 
 /// The continuous placement (or a given gain) as the seed papers print it.
 fn design_c(model: &Model, spec: &FeedbackSpec, track: Option<&Mat>, dt: f64) -> Result<controller::design::FeedbackDesign, String> {
-    design(Some(model), &model.discretize(dt), spec, &Options { track, integral: false })
+    design(Some(model), &model.discretize(dt), spec, &Options { track, integral: false, measured: &[] })
 }
 
 #[test]

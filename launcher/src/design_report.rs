@@ -136,6 +136,13 @@ pub fn report(s: &Scenario) -> DesignReport {
                     let ff = if fb.feedforward.is_some() { " − M ŵ" } else { "" };
                     text += &format!("\ncontroller: {kind}, {law}{ff}, on '{}'\n  G {}\n", c.observer, fb.how);
                     text += &matrix_text("G", &fb.g);
+                    let measured: Vec<&str> = fb.measured.iter().map(|&j| s.names.input[j].name.as_str()).collect();
+                    if !measured.is_empty() {
+                        text += &format!(
+                            "  measured disturbances {}: not commanded, u = r (their [[input]] signals); G, R and the tracked outputs cover the other inputs (designed on their columns Γ_c of Γ_B)\n",
+                            measured.join(", ")
+                        );
+                    }
                     if let Some((gi, ct, m)) = &fb.integral {
                         text += &format!(
                             "  integral action on the tracked outputs z = C_t x, {} (designed on the augmented sampled plant):\n",
@@ -186,6 +193,7 @@ pub fn report(s: &Scenario) -> DesignReport {
                         "how": fb.how,
                         "integral": fb.integral.is_some(),
                         "feedforward": fb.feedforward.is_some(),
+                        "measured_disturbances": measured,
                         "matrices": matrices,
                         "closed_loop_poles": lti::re_im(&fb.closed_loop),
                         "discrete_closed_loop_poles": lti::re_im(&fb.discrete_closed_loop),

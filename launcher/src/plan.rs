@@ -98,7 +98,7 @@ pub fn complete(s: &Scenario, banks: Vec<Bank>, own: Vec<Option<Designed>>) -> R
     let feedback = match s.controller.as_ref().and_then(|c| c.spec.as_ref().map(|spec| (c, spec))) {
         Some((c, spec)) => {
             let model = (!s.discrete).then_some(&s.model);
-            let opts = Options { track: c.track.as_ref(), integral: c.integral };
+            let opts = Options { track: c.track.as_ref(), integral: c.integral, measured: &c.measured };
             let designed = design_feedback(model, &s.sampled_model(), spec, &opts);
             let mut fb = designed.map_err(|reason| {
                 let field = match spec {
@@ -135,8 +135,13 @@ pub fn complete(s: &Scenario, banks: Vec<Bank>, own: Vec<Option<Designed>>) -> R
 
 /// M ŵ's matrices (MW, MWCΦ, MWCΓ_B) for `feedforward = "what"`: w must enter through the
 /// inputs (Γ_E = Γ_B M), and the controller's observer must estimate it.
+///
+/// With measured disturbances only the commanded inputs cancel: M = [M_c; 0], Γ_c M_c = Γ_E.
 fn feedforward(s: &Scenario, c: &scenario::ControllerEntry, observers: &[(String, Option<Designed>)]) -> Result<[Mat; 3], String> {
-    let m = matched_gain(&s.sampled_model())?;
+    use controller::design::measured;
+    let dm = s.sampled_model();
+    let keep = measured::commanded(dm.b.ncols(), &c.measured);
+    let m = measured::rows(&matched_gain(&measured::sampled(&dm, &keep))?, dm.b.ncols(), &keep);
     let what = observers.iter().find(|(n, _)| *n == c.observer).and_then(|(_, d)| d.as_ref()).and_then(|d| d.what.as_ref());
     let what = what.ok_or_else(|| {
         format!(

@@ -186,6 +186,9 @@ pub struct ControllerEntry {
     pub integral: bool,
     /// Cancel the matched unknown input with the observer's ŵ (`feedforward = "what"`).
     pub feedforward: bool,
+    /// The measured disturbances: inputs (0-based, ascending) it does not command; they keep
+    /// their `[[input]]` signal (`controller::design::measured`).
+    pub measured: Vec<usize>,
     /// The external controller, for `kind = "process"`.
     pub process: Option<ProcessSpec>,
 }

@@ -331,6 +331,9 @@ pub struct RawController {
     pub integral: Option<bool>,
     /// "what": cancel the matched unknown input with the observer's ŵ.
     pub feedforward: Option<String>,
+    /// Known inputs (by name) the controller does not command: they keep their `[[input]]`
+    /// signal (the outdoor temperature of a building).
+    pub measured_disturbances: Option<Vec<String>>,
     /// `kind = "process"`: the command and its parameters.
     pub command: Option<Vec<String>>,
     pub params: Option<toml::Table>,

@@ -416,7 +416,7 @@ fn build(raw: RawScenario, dir: Option<&Path>) -> Result<Scenario, Bad> {
 
     observer_cap(raw.observer.len(), &observers, &remote)?;
 
-    let controller = raw.controller.as_ref().map(|c| controller_entry(c, &model, &seen)).transpose()?;
+    let controller = raw.controller.as_ref().map(|c| controller_entry(c, &model, &seen, &layout_names.input)).transpose()?;
     let expect = raw.expect.unwrap_or_default();
     check_expect(&expect, &seen)?;
     for (name, &v) in &expect.detection_delay {
@@ -679,7 +679,7 @@ pub(crate) fn plant_process(p: &Option<RawProcess>) -> Result<Option<ProcessSpec
     p.as_ref().map(|p| process_spec("plant.process", &Some(p.command.clone()), &p.params)).transpose()
 }
 
-fn controller_entry(c: &RawController, model: &Model, observers: &BTreeSet<String>) -> Result<ControllerEntry, Bad> {
+fn controller_entry(c: &RawController, model: &Model, observers: &BTreeSet<String>, inputs: &[Named]) -> Result<ControllerEntry, Bad> {
     const KINDS: [&str; 3] = ["state-feedback", "lqr", "process"];
     if !KINDS.contains(&c.kind.as_str()) {
         return Err(bad("controller.kind", format!("{} is not a controller kind ({}){}", quoted(&c.kind), KINDS.join(", "), crate::suggest::did_you_mean(&c.kind, KINDS))));
@@ -698,20 +698,25 @@ fn controller_entry(c: &RawController, model: &Model, observers: &BTreeSet<Strin
         ("track", c.track.is_some()),
         ("integral", c.integral.is_some()),
         ("feedforward", c.feedforward.is_some()),
+        ("measured_disturbances", c.measured_disturbances.is_some()),
     ];
     if c.kind == "process" {
         let process = process_spec("controller", &c.command, &c.params)?;
         if let Some((key, _)) = given.iter().find(|(_, g)| *g) {
             return Err(bad(format!("controller.{key}"), "a process controller takes no design keys (only command, observer and params)"));
         }
-        return Ok(ControllerEntry { observer: c.observer.clone(), spec: None, track: None, integral: false, feedforward: false, process: Some(process) });
+        return Ok(ControllerEntry { observer: c.observer.clone(), spec: None, track: None, integral: false, feedforward: false, measured: Vec::new(), process: Some(process) });
     }
     if c.command.is_some() || c.params.is_some() {
         return Err(bad("controller.command", "only kind = \"process\" takes command and params"));
     }
     let integral = c.integral.unwrap_or(false);
-    // With integral action G and Q also cover one integrator per input.
-    let size = model.n() + if integral { model.l() } else { 0 };
+    let measured = measured_disturbances(c.measured_disturbances.as_deref(), inputs)?;
+    // The inputs the controller commands: G, R and track have one row per commanded input.
+    let l = model.l() - measured.len();
+    let per = if measured.is_empty() { "input" } else { "commanded input (the inputs less the measured disturbances)" };
+    // With integral action G and Q also cover one integrator per commanded input.
+    let size = model.n() + if integral { l } else { 0 };
     let states = if integral { "one column per state, then one per integrator" } else { "one column per state" };
     let spec = if c.kind == "lqr" {
         for key in ["poles", "gain", "placement", "domain"] {
@@ -726,7 +731,7 @@ fn controller_entry(c: &RawController, model: &Model, observers: &BTreeSet<Strin
         });
         let r = c.r.as_ref().map(|r| {
             let field = "controller.R";
-            let m = matrix(field, r, (Some(model.l()), Some(model.l())), "one row and column per input")?;
+            let m = matrix(field, r, (Some(l), Some(l)), &format!("one row and column per {per}"))?;
             definite(field, "R", &m, lti::dare::Definite::Positive)
         });
         FeedbackSpec::Lqr { q: q.transpose()?, r: r.transpose()? }
@@ -748,13 +753,13 @@ fn controller_entry(c: &RawController, model: &Model, observers: &BTreeSet<Strin
                 if c.domain.is_some() || c.placement.is_some() {
                     return Err(bad(if c.domain.is_some() { "controller.domain" } else { "controller.placement" }, "a given gain is not placed: domain and placement go with poles"));
                 }
-                FeedbackSpec::Gain(matrix("controller.gain", g, (Some(model.l()), Some(size)), &format!("one row per input, {states}"))?)
+                FeedbackSpec::Gain(matrix("controller.gain", g, (Some(l), Some(size)), &format!("one row per {per}, {states}"))?)
             }
             (Some(_), Some(_)) => return Err(bad("controller.gain", "give poles or gain, not both")),
             (None, None) => return Err(bad("controller.poles", "a state-feedback controller needs poles = […] or gain = [[…]] (or kind = \"lqr\")")),
         }
     };
-    let track = c.track.as_ref().map(|t| matrix("controller.track", t, (Some(model.l()), Some(model.n())), "one row per input: the state combination that follows it")).transpose()?;
+    let track = c.track.as_ref().map(|t| matrix("controller.track", t, (Some(l), Some(model.n())), &format!("one row per {per}: the state combination that follows it"))).transpose()?;
     if integral && track.is_none() {
         return Err(bad("controller.integral", "integral action needs track = [[…]]: the state combinations (one per input) the integrators hold at r"));
     }
@@ -763,7 +768,29 @@ fn controller_entry(c: &RawController, model: &Model, observers: &BTreeSet<Strin
         Some("what") => true,
         Some(other) => return Err(bad("controller.feedforward", format!("{} is not a feedforward (what: cancel the matched unknown input with the observer's ŵ)", quoted(other)))),
     };
-    Ok(ControllerEntry { observer: c.observer.clone(), spec: Some(spec), track, integral, feedforward, process: None })
+    Ok(ControllerEntry { observer: c.observer.clone(), spec: Some(spec), track, integral, feedforward, measured, process: None })
+}
+
+/// `controller.measured_disturbances`: input names (`plant.input_names`, default r1, r2, …),
+/// each once, not every input; their 0-based indices, ascending.
+fn measured_disturbances(given: Option<&[String]>, inputs: &[Named]) -> Result<Vec<usize>, Bad> {
+    let field = "controller.measured_disturbances";
+    let mut out = Vec::new();
+    for name in given.unwrap_or_default() {
+        let Some(j) = inputs.iter().position(|r| &r.name == name) else {
+            let known: Vec<&str> = inputs.iter().map(|r| r.name.as_str()).collect();
+            return Err(bad(field, format!("{} is not an input (inputs: {}){}", quoted(name), known.join(", "), crate::suggest::did_you_mean(name, known.iter().copied()))));
+        };
+        if out.contains(&j) {
+            return Err(bad(field, format!("{} is given twice", quoted(name))));
+        }
+        out.push(j);
+    }
+    if !inputs.is_empty() && out.len() == inputs.len() {
+        return Err(bad(field, "every input is a measured disturbance: the controller would command none"));
+    }
+    out.sort_unstable();
+    Ok(out)
 }
 
 fn check_expect(e: &RawExpect, observers: &BTreeSet<String>) -> Result<(), Bad> {

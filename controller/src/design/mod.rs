@@ -19,6 +19,7 @@
 
 pub mod feedforward;
 pub mod integral;
+pub mod measured;
 
 use lti::dare::solve_dare;
 use lti::eig::{continuous_image, eigenvalues, format_list};
@@ -75,6 +76,9 @@ pub struct Options<'a> {
     pub track: Option<&'a Mat>,
     /// Integral action on the tracked outputs.
     pub integral: bool,
+    /// The measured disturbances: inputs (0-based) the controller does not command
+    /// ([`measured`]); `track`, the weights and a given gain then cover the commanded ones only.
+    pub measured: &'a [usize],
 }
 
 /// A designed state feedback.
@@ -82,10 +86,14 @@ pub struct Options<'a> {
 pub struct FeedbackDesign {
     /// G, l×n (the state part G_x with integral action).
     pub g: Mat,
-    /// With integral action: the integrators' gain G_ξ (l×l), C_t, and M when z = My is measured.
+    /// With integral action: the integrators' gain G_ξ (l×l_c), C_t, and M when z = My is
+    /// measured.
     pub integral: Option<(Mat, Mat, Option<Mat>)>,
-    /// The reference prefilter N, l×l (I without tracked outputs, 0 with integral action).
+    /// The reference prefilter N, l×l (I without tracked outputs, 0 with integral action; the
+    /// unit row of a measured disturbance).
     pub n: Mat,
+    /// The measured disturbances, inputs passed through from their references ([`measured`]).
+    pub measured: Vec<usize>,
     /// The continuous loop's poles: eig(A − BG) when placed in continuous time, else ln(z)/dt of
     /// the sampled loop's; sorted.
     pub closed_loop: Vec<C64>,
@@ -104,14 +112,18 @@ impl FeedbackDesign {
     /// c_u = u_op − N r_op + G x_op of this feedback designed in deviations from `op`
     /// ([`crate::ControllerConfig::offset`]): r_op = C_t x_op, the tracked outputs at the point
     /// (`track`), or u_op without tracked outputs (N = I: the references are then the inputs'
-    /// absolute levels).
+    /// absolute levels). A measured disturbance's reference is its absolute level u_op,m, so its
+    /// offset is 0: u_m = r_m.
     pub fn offset_at(&self, track: Option<&Mat>, op: &lti::OperatingPoint) -> Vec<f64> {
         let col = |v: &[f64]| Mat::from_column_slice(v.len(), 1, v);
         let x = col(&op.x);
-        let r_op = match track {
-            Some(ct) => ct * &x,
-            None => col(&op.u),
-        };
+        let mut r_op = col(&op.u);
+        if let Some(ct) = track {
+            let keep = measured::commanded(op.u.len(), &self.measured);
+            for (i, z) in (ct * &x).iter().enumerate() {
+                r_op[keep[i]] = *z;
+            }
+        }
         (col(&op.u) - &self.n * r_op + &self.g * x).iter().copied().collect()
     }
 
@@ -140,12 +152,40 @@ impl FeedbackDesign {
 
 /// Designs (or checks) G for the sampled plant `dm` — and its continuous `model`, when there is
 /// one (not for a discrete-time plant) — with the options' prefilter or integrators.
+///
+/// With measured disturbances ([`Options::measured`]) G is designed on the commanded inputs'
+/// columns and embedded in l rows ([`measured`]).
 pub fn design(model: Option<&Model>, dm: &Discrete, spec: &FeedbackSpec, opts: &Options) -> Result<FeedbackDesign, String> {
+    let l_all = dm.b.ncols();
+    if opts.measured.is_empty() {
+        return design_commanded(model, dm, spec, opts);
+    }
+    if let Some(&j) = opts.measured.iter().find(|&&j| j >= l_all) {
+        return Err(format!("measured disturbance {} is not an input (the plant has {l_all})", j + 1));
+    }
+    let keep = measured::commanded(l_all, opts.measured);
+    if keep.is_empty() {
+        return Err("every input is a measured disturbance: the controller commands none".into());
+    }
+    let model_c = model.map(|m| measured::continuous(m, &keep));
+    let mut d = design_commanded(model_c.as_ref(), &measured::sampled(dm, &keep), spec, opts)?;
+    d.g = measured::rows(&d.g, l_all, &keep);
+    d.n = measured::prefilter(&d.n, l_all, &keep);
+    if let Some((gi, _, _)) = &mut d.integral {
+        *gi = measured::rows(gi, l_all, &keep);
+    }
+    d.measured = opts.measured.to_vec();
+    Ok(d)
+}
+
+/// [`design`] on every column of Γ_B.
+fn design_commanded(model: Option<&Model>, dm: &Discrete, spec: &FeedbackSpec, opts: &Options) -> Result<FeedbackDesign, String> {
     let (n, l) = (dm.a.nrows(), dm.b.ncols());
+    let per = if opts.measured.is_empty() { "input" } else { "commanded input" };
     if let Some(ct) = opts.track
         && ct.shape() != (l, n)
     {
-        return Err(format!("track is {}×{}, must be {l}×{n} (one tracked output per input)", ct.nrows(), ct.ncols()));
+        return Err(format!("track is {}×{}, must be {l}×{n} (one tracked output per {per})", ct.nrows(), ct.ncols()));
     }
     // The pair G is designed on: the plant's, or the plant with the integrators (integral.rs).
     let ct = match (opts.integral, opts.track) {
@@ -193,7 +233,7 @@ pub fn design(model: Option<&Model>, dm: &Discrete, spec: &FeedbackSpec, opts: &
                 return Err(format!("Q is {}×{}, must be {size}×{size} ({states})", q.nrows(), q.ncols()));
             }
             if r.shape() != (l, l) {
-                return Err(format!("R is {}×{}, must be {l}×{l} (one row per input)", r.nrows(), r.ncols()));
+                return Err(format!("R is {}×{}, must be {l}×{l} (one row per {per})", r.nrows(), r.ncols()));
             }
             let dare = solve_dare(&phi, &gamma, &q, &r).map_err(|e| format!("LQR: {e}"))?;
             (dare.k, format!("LQR: X = DARE(Φ, Γ_B, Q, R), relative residual {:.1e}; G = (R + Γ_BᵀXΓ_B)⁻¹Γ_BᵀXΦ", dare.residual))
@@ -224,7 +264,7 @@ pub fn design(model: Option<&Model>, dm: &Discrete, spec: &FeedbackSpec, opts: &
             Err(e) => return Err(e),
         },
     };
-    Ok(FeedbackDesign { g, integral, n: prefilter, closed_loop, discrete_closed_loop, unstable, how, feedforward: None })
+    Ok(FeedbackDesign { g, integral, n: prefilter, measured: Vec::new(), closed_loop, discrete_closed_loop, unstable, how, feedforward: None })
 }
 
 /// N = (C_t (I − Φ + Γ_BG)⁻¹ Γ_B)⁻¹ (see the module documentation).

@@ -90,8 +90,8 @@ pub fn configs(s: &Scenario, plan: &Plan) -> Configs {
             dt: s.dt,
             observer: c.observer.clone(),
             integral: fb.integral.as_ref().map(|(gi, ct, m)| match m {
-                Some(m) => IntegralConfig { gi: gi.into(), ct: m.into(), y: Some([layout.y().start, layout.y().end]) },
-                None => IntegralConfig { gi: gi.into(), ct: ct.into(), y: None },
+                Some(m) => IntegralConfig { gi: gi.into(), ct: m.into(), y: Some([layout.y().start, layout.y().end]), references: integrated(fb) },
+                None => IntegralConfig { gi: gi.into(), ct: ct.into(), y: None, references: integrated(fb) },
             }),
             feedforward: fb.feedforward.as_ref().map(|[mw, a, b]| FeedforwardConfig {
                 mw: mw.into(),
@@ -109,4 +109,10 @@ pub fn configs(s: &Scenario, plan: &Plan) -> Configs {
         _ => None,
     };
     Configs { plant, followers, closed_loop: s.controller.is_some(), observers, processes: s.observer_processes(), controller, layout, pace_s: None }
+}
+
+/// The references the integrators compare with: the commanded inputs' (all, as an empty list,
+/// without measured disturbances).
+fn integrated(fb: &controller::design::FeedbackDesign) -> Vec<usize> {
+    if fb.measured.is_empty() { Vec::new() } else { controller::design::measured::commanded(fb.g.nrows(), &fb.measured) }
 }
