@@ -7,7 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
-use fmu_export::{Description, Fmi, ObserverResource, Signal};
+use fmu_export::{Description, Fmi, ObserverResource, OperatingPoint, Signal};
 use launcher::{plan, LaunchError, Scenario};
 
 /// The observer FMUs' shared library, as cargo names it in target/release.
@@ -28,15 +28,28 @@ pub fn export_fmu(s: &Scenario, observer: &str, out: &Path, fmi: Fmi) -> Result<
     let library = library()?;
     let d = plan::design_observer(s, o, spec).map_err(|e| bad(format!("observer '{}': {e}", o.name)))?;
     let lo = d.runtime;
-    if lo.offset.is_some() {
-        return Err(bad(format!("observer '{}': the scenario has a [plant.operating_point]: an observer FMU that adds its offsets is not built yet; export it from the scenario written in deviations", o.name)));
+    let offset = lo.offset.clone();
+    let mut res = ObserverResource::new(&o.name, s.dt, lo.f, lo.g, lo.k, lo.p, lo.q, (&s.model.c).into(), lo.xhat0).map_err(|e| bad(format!("observer '{}': {e}", o.name)))?;
+    // At an operating point the FMU takes the plant's absolute u and y and gives x̂ in the plant's
+    // units, with the run's own offsets.
+    if let (Some(op), Some(off)) = (&s.operating_point, offset) {
+        let point = OperatingPoint { u: op.u.clone(), y: op.y.clone(), c_z: off.z, c_x: off.x };
+        res = res.at_operating_point(point).map_err(|e| bad(format!("observer '{}': {e}", o.name)))?;
     }
-    let res = ObserverResource::new(&o.name, s.dt, lo.f, lo.g, lo.k, lo.p, lo.q, (&s.model.c).into(), lo.xhat0).map_err(|e| bad(format!("observer '{}': {e}", o.name)))?;
     let signals = |v: &[scenario::Named]| v.iter().map(|n| Signal { name: n.name.clone(), unit: n.unit.clone() }).collect();
     let desc = Description {
         model_identifier: fmu_export::identifier(&o.name),
         model_name: fmu_export::identifier(&format!("{}_{}", s.name, o.name)),
-        description: format!("{} observer '{}' of scenario {}, sampled at dt = {} s: z+ = F z + G u + K y, xhat = P z + Q y, r = y - C xhat", o.kind(), o.name, s.name, s.dt),
+        description: format!(
+            "{} observer '{}' of scenario {}, sampled at dt = {} s: z+ = F z + G u + K y{}, xhat = P z + Q y{}, r = y - C xhat{}",
+            o.kind(),
+            o.name,
+            s.name,
+            s.dt,
+            if res.operating_point.is_some() { " + c_z" } else { "" },
+            if res.operating_point.is_some() { " + c_x" } else { "" },
+            if res.operating_point.is_some() { "; designed in deviations from its operating point, fed and giving absolute signals (the inputs start there)" } else { "" }
+        ),
         states: signals(&s.names.state),
         outputs: signals(&s.names.output),
         inputs: signals(&s.names.input),

@@ -150,6 +150,88 @@ def test_the_fmu_reproduces_the_recorded_estimate_bit_for_bit(recordings, tmp_pa
         assert not np.allclose(xhat[0], table(csv_dir / "observer_cumming_xhat.csv")[0])
 
 
+def fmpy_input(md, u, y, dt):
+    """The recording's u and y as simulate_fmu's input table, at t_k = k·dt (the CSV's times)."""
+    names = [v.name for v in md.modelVariables if v.causality == "input"]
+    table = np.zeros(len(y), dtype=[("time", np.float64)] + [(n, np.float64) for n in names])
+    table["time"] = np.arange(len(y)) * dt
+    for i in range(u.shape[1]):
+        table[f"u_{i + 1}"] = u[:, i]
+    for j in range(y.shape[1]):
+        table[f"y_{j + 1}"] = y[:, j]
+    return table
+
+
+@pytest.mark.parametrize("fmi", [3, 2])
+@pytest.mark.parametrize("scenario,observer", CASES)
+def test_fmpy_simulate_fmu_gives_the_recorded_estimate(recordings, tmp_path, scenario, observer, fmi):
+    """FMPy's own simulate_fmu on the recording's u and y, output_interval = dt: every row is
+    the recording's x̂ bit for bit where x̂ has no direct feedthrough (Q = 0). simulate_fmu
+    samples the outputs right after doStep, before it sets the inputs of that point
+    (fmpy/simulation.py, simulateCS), so with Q ≠ 0 its row k holds P z_k + Q y_{k−1}: the
+    recording's x̂_k − Q(y_k − y_{k−1}), checked to 1e-12 of |x̂|'s scale. Its defaults (no
+    output_interval: the DefaultExperiment's or fixedInternalStepSize dt, doubled until at most
+    1000 rows) are accepted: steps of 2^j·dt, the inputs held."""
+    path, csv_dir = recordings[scenario]
+    data = tomllib.loads(path.read_text())
+    dt = data["dt"]
+    fmu = export(path, observer, tmp_path, fmi)
+    md = fmpy.read_model_description(str(fmu))
+    assert float(md.defaultExperiment.stepSize) == dt and float(md.defaultExperiment.stopTime) == data["duration"]
+    with zipfile.ZipFile(fmu) as z:
+        resource = json.loads(z.read("resources/observer.json"))
+    q = resource["q"]
+    Q = np.array(q["data"]).reshape(q["rows"], q["cols"])
+    y = table(csv_dir / "plant_y.csv")
+    u = table(csv_dir / ("controller_u.csv" if "controller" in data else "input.csv"))
+    xhat = table(csv_dir / f"observer_{observer}_xhat.csv")
+    n = xhat.shape[1]
+    inputs = fmpy_input(md, u, y, dt)
+    stop = (len(y) - 1) * dt
+    res = fmpy.simulate_fmu(str(fmu), input=inputs, output_interval=dt, stop_time=stop)
+    got = np.column_stack([res[f"xhat_{i + 1}"] for i in range(n)])
+    assert len(got) == len(xhat) and np.array_equal(res["time"], inputs["time"])
+    assert np.array_equal(got[0], xhat[0])
+    if not Q.any():
+        assert np.array_equal(got, xhat), np.abs(got - xhat).max()
+    else:
+        want = xhat[1:] - (y[1:] - y[:-1]) @ Q.T
+        gap = np.abs(got[1:] - want).max()
+        assert gap <= 1e-12 * np.abs(xhat).max(), gap
+        # Not the recording's x̂ at those rows: the feedthrough shows.
+        assert not np.array_equal(got, xhat)
+    # FMPy's defaults: every 2^j·dt up to 1000 rows, the inputs held over each step.
+    res = fmpy.simulate_fmu(str(fmu), input=inputs, stop_time=stop)
+    j = int(np.ceil(np.log2(stop / dt / 1000))) if stop / dt > 1000 else 0
+    assert len(res) == int(np.floor(stop / (dt * 2 ** j) + 1e-9)) + 1, (len(res), j)
+    assert np.array_equal(np.column_stack([res[f"xhat_{i + 1}"] for i in range(n)])[0], xhat[0])
+
+
+def test_an_observer_at_an_operating_point_takes_and_gives_absolute_signals(tmp_path):
+    """The two-zone building's UIO, designed in deviations from 20 °C / 5 °C and run on the
+    plant's absolute signals: its FMU (the point inside, the inputs starting there, units from
+    the scenario) gives the recording's absolute x̂ and r bit for bit."""
+    import test_operating_point_loop as building
+    scen = building.scenario(tmp_path / "building.toml")
+    run = tmp_path / "run"
+    done = subprocess.run([launcher(), "run", str(scen), "--mode", "in-process", "--out", str(run)], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    subprocess.run([launcher(), "export", "--csv", str(run / "csv"), str(next(run.glob("*.rrd")))], check=True, capture_output=True, timeout=300)
+    y, u = table(run / "csv" / "plant_y.csv"), table(run / "csv" / "controller_u.csv")
+    xhat, residual = table(run / "csv" / "observer_uio_xhat.csv"), table(run / "csv" / "observer_uio_residual.csv")
+    assert np.abs(xhat[0] - building.X_OP).max() < 1e-9  # it starts at the point, in °C
+    for fmi in (3, 2):
+        fmu = export(scen, "uio", tmp_path / f"fmi{fmi}", fmi)
+        assert validate_fmu(str(fmu)) == []
+        md = fmpy.read_model_description(str(fmu))
+        units = {v.name: (v.unit, v.start) for v in md.modelVariables}
+        assert units["u_1"] == ("kW", repr(float(building.U_OP[0]))) and units["u_3"][0] == "degC", units
+        assert units["y_1"][1] is not None and float(units["y_1"][1]) == 20.0
+        got_xhat, got_r = drive(fmu, u, y, building.DT)
+        assert np.array_equal(got_xhat, xhat), np.abs(got_xhat - xhat).max()
+        assert np.array_equal(got_r, residual), np.abs(got_r - residual).max()
+
+
 def test_a_step_of_another_size_and_garbled_resources_are_refused(tmp_path):
     fmu = export(SCENARIOS / "seed002-piecewise.toml", "uio", tmp_path, 3)
     unzip = Path(fmpy.extract(str(fmu)))
@@ -158,7 +240,7 @@ def test_a_step_of_another_size_and_garbled_resources_are_refused(tmp_path):
     slave3.exitInitializationMode()
     slave3.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.001)
     with pytest.raises(FMICallException):
-        slave3.doStep(currentCommunicationPoint=0.001, communicationStepSize=0.002)
+        slave3.doStep(currentCommunicationPoint=0.001, communicationStepSize=0.0015)
     slave3.freeInstance()
     (unzip / "resources" / "observer.json").write_text('{"format": 1, "token": ')
     with pytest.raises(Exception, match="[Ff]ailed to instantiate"):

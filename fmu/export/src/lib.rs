@@ -17,7 +17,7 @@ pub mod variables;
 use std::path::Path;
 
 pub use model_description::{Description, Fmi, Signal};
-pub use resource::ObserverResource;
+pub use resource::{ObserverResource, OperatingPoint};
 
 /// Writes the FMU of `res` to `path` (atomically), with the library read from `library`.
 pub fn export(res: &ObserverResource, d: &Description, fmi: Fmi, library: &Path, path: &Path) -> Result<(), String> {

@@ -85,13 +85,29 @@ pub fn model_description(res: &ObserverResource, d: &Description, fmi: Fmi) -> R
         Fmi::V2 => attr(&mut x, "canNotUseMemoryManagementFunctions", "true"),
         Fmi::V3 => attr(&mut x, "fixedInternalStepSize", &num(res.dt)),
     }
-    x += "/>\n  <DefaultExperiment";
+    x += "/>\n";
+    let units = units(d);
+    if !units.is_empty() {
+        x += "  <UnitDefinitions>\n";
+        for u in &units {
+            x += "    <Unit";
+            attr(&mut x, "name", u);
+            x += "/>\n";
+        }
+        x += "  </UnitDefinitions>\n";
+    }
+    x += "  <DefaultExperiment";
     attr(&mut x, "startTime", "0");
     attr(&mut x, "stopTime", &num(d.stop_time));
     attr(&mut x, "stepSize", &num(res.dt));
     x += "/>\n  <ModelVariables>\n";
     for role in lay.roles() {
-        variable(&mut x, &lay, role, describe(d, role), fmi);
+        let start = match (role, &res.operating_point) {
+            (Role::U(i), Some(op)) => op.u[i],
+            (Role::Y(j), Some(op)) => op.y[j],
+            _ => 0.0,
+        };
+        variable(&mut x, &lay, role, describe(d, role), unit(d, role), start, fmi);
     }
     x += "  </ModelVariables>\n  <ModelStructure>\n";
     let outputs: Vec<Role> = lay.roles().filter(|r| matches!(r, Role::Xhat(_) | Role::R(_))).collect();
@@ -121,7 +137,29 @@ pub fn model_description(res: &ObserverResource, d: &Description, fmi: Fmi) -> R
 }
 
 /// One `<ScalarVariable>` (FMI 2) or `<Float64>` (FMI 3).
-fn variable(x: &mut String, lay: &Layout, role: Role, description: String, fmi: Fmi) {
+/// Every unit the variables use, once, in order of first use.
+fn units(d: &Description) -> Vec<&str> {
+    let mut out: Vec<&str> = Vec::new();
+    for s in d.inputs.iter().chain(&d.outputs).chain(&d.states) {
+        if !s.unit.is_empty() && !out.contains(&s.unit.as_str()) {
+            out.push(&s.unit);
+        }
+    }
+    out
+}
+
+/// A variable's unit: its signal's (x̂ its state's, r its output's); "" for none.
+fn unit(d: &Description, role: Role) -> &str {
+    let (list, i) = match role {
+        Role::Time => return "",
+        Role::U(i) => (&d.inputs, i),
+        Role::Y(j) | Role::R(j) => (&d.outputs, j),
+        Role::Xhat(i) => (&d.states, i),
+    };
+    list.get(i).map_or("", |s| s.unit.as_str())
+}
+
+fn variable(x: &mut String, lay: &Layout, role: Role, description: String, unit: &str, start: f64, fmi: Fmi) {
     let (causality, extra) = match role {
         Role::Time => ("independent", ""),
         Role::U(_) | Role::Y(_) => ("input", ""),
@@ -139,15 +177,16 @@ fn variable(x: &mut String, lay: &Layout, role: Role, description: String, fmi: 
         attr(x, "initial", extra);
     }
     let input = causality == "input";
-    match fmi {
-        Fmi::V2 => *x += if input { "><Real start=\"0\"/></ScalarVariable>\n" } else { "><Real/></ScalarVariable>\n" },
-        Fmi::V3 => {
-            if input {
-                attr(x, "start", "0");
-            }
-            *x += "/>\n";
-        }
+    if fmi == Fmi::V2 {
+        *x += "><Real";
     }
+    if !unit.is_empty() {
+        attr(x, "unit", unit);
+    }
+    if input {
+        attr(x, "start", &num(start));
+    }
+    *x += if fmi == Fmi::V2 { "/></ScalarVariable>\n" } else { "/>\n" };
 }
 
 /// A variable's description, with the scenario's names and units.
@@ -155,8 +194,8 @@ fn describe(d: &Description, role: Role) -> String {
     let label = |v: &[Signal], i: usize| v.get(i).map_or(String::new(), Signal::label);
     match role {
         Role::Time => String::new(),
-        Role::U(i) => format!("known input {} held over [t_k, t_k + dt)", label(&d.inputs, i)),
-        Role::Y(j) => format!("measured output {} at t_k", label(&d.outputs, j)),
+        Role::U(i) => format!("the plant's known input {} as applied over [t_k, t_k + dt): in closed loop the controller's output u, not its reference", label(&d.inputs, i)),
+        Role::Y(j) => format!("the plant's measured output {} at t_k", label(&d.outputs, j)),
         Role::Xhat(i) => format!("estimate of {}", label(&d.states, i)),
         Role::R(j) => format!("residual y - C xhat of {}", label(&d.outputs, j)),
     }
@@ -251,7 +290,11 @@ mod tests {
         let x = model_description(&resource(true), &description(), Fmi::V2).unwrap();
         assert!(x.contains("fmiVersion=\"2.0\"") && x.contains("guid=\"{"));
         assert_eq!(count(&x, "<ScalarVariable "), 9);
-        assert_eq!(count(&x, "<Real start=\"0\"/>"), 3);
+        assert_eq!(count(&x, " start=\"0.0\"/>"), 3);
+        // Units from the scenario's: declared once each, on u, y, x̂ and r alike.
+        assert!(x.contains("<UnitDefinitions>\n    <Unit name=\"N\"/>\n    <Unit name=\"rad\"/>\n    <Unit name=\"m\"/>\n  </UnitDefinitions>"));
+        assert!(x.contains("<Real unit=\"N\" start=\"0.0\"/>") && x.contains("<Real unit=\"rad\" start=\"0.0\"/>"));
+        assert_eq!(count(&x, "<Real unit=\"rad\"/>"), 2); // x̂_3 (eta) and r_2 (eta)
         assert!(x.contains("canHandleVariableCommunicationStepSize=\"false\""));
         // With x̂₀ every output depends on both y (indices 3 and 4).
         assert_eq!(count(&x, "<Unknown index="), 10);

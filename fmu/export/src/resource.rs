@@ -10,6 +10,16 @@
 //! x̂₀ the pseudo-inverse P⁺ formed here with `lti::pinv::pinv`, so that the library does no
 //! decomposition and z_0 = P⁺(x̂₀ − Q y_0) has the bits of the run. serde_json with
 //! `float_roundtrip` writes and reads every f64 exactly.
+//!
+//! At an operating point (the design in deviations, the FMU fed the plant's absolute u and y)
+//! the runtime's two offsets come along ([`OperatingPoint`]):
+//!
+//! ```text
+//! z_{k+1} = F z_k + G u_k + K y_k + c_z,   x̂_k = P z_k + Q y_k + c_x,   z_0 = P⁺(x̂₀ − Q y_0 − c_x)
+//! ```
+//!
+//! with c_z = −(G u_op + K y_op) and c_x = x_op − Q y_op as `observer::LinearObserver` forms
+//! them, so the FMU's x̂ is the run's, in absolute units.
 
 use lti::MatData;
 use serde::{Deserialize, Serialize};
@@ -51,6 +61,25 @@ pub struct ObserverResource {
     /// P⁺ (r×n), given exactly when `xhat0` is.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub p_pinv: Option<MatData>,
+    /// The operating point's offsets, when the design is in deviations from one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub operating_point: Option<OperatingPoint>,
+}
+
+/// The operating point of an observer designed in deviations: the inputs' levels there (the
+/// FMU's start values) and the offsets c_z (r values) and c_x (n values) of the module
+/// documentation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OperatingPoint {
+    /// u_op, l values.
+    pub u: Vec<f64>,
+    /// y_op, p values.
+    pub y: Vec<f64>,
+    /// c_z = −(G u_op + K y_op).
+    pub c_z: Vec<f64>,
+    /// c_x = x_op − Q y_op.
+    pub c_x: Vec<f64>,
 }
 
 /// The dimensions (n, r, l, p) of a resource that conforms.
@@ -72,10 +101,19 @@ impl ObserverResource {
     #[allow(clippy::too_many_arguments)] // the observer form's five matrices, C, dt and x̂₀
     pub fn new(observer: &str, dt: f64, f: MatData, g: MatData, k: MatData, p: MatData, q: MatData, c: MatData, xhat0: Option<Vec<f64>>) -> Result<Self, String> {
         let p_pinv = xhat0.as_ref().map(|_| MatData::from(&lti::pinv::pinv(&(&p).into())));
-        let mut res = ObserverResource { format: FORMAT, token: String::new(), observer: observer.into(), dt, f, g, k, p, q, c, xhat0, p_pinv };
+        let mut res = ObserverResource { format: FORMAT, token: String::new(), observer: observer.into(), dt, f, g, k, p, q, c, xhat0, p_pinv, operating_point: None };
         res.dims()?;
         res.token = token(&res.to_json());
         Ok(res)
+    }
+
+    /// The same observer at an operating point (its offsets checked); the token follows.
+    pub fn at_operating_point(mut self, op: OperatingPoint) -> Result<Self, String> {
+        self.operating_point = Some(op);
+        self.dims()?;
+        self.token = String::new();
+        self.token = token(&self.to_json());
+        Ok(self)
     }
 
     /// Checks that the matrices conform and every number is finite; the dimensions.
@@ -95,6 +133,13 @@ impl ObserverResource {
             }
             if m.data.iter().any(|v| !v.is_finite()) {
                 return Err(format!("{name} has an entry that is not finite"));
+            }
+        }
+        if let Some(op) = &self.operating_point {
+            for (name, v, len) in [("u", &op.u, d.l), ("y", &op.y, d.p), ("c_z", &op.c_z, d.r), ("c_x", &op.c_x, d.n)] {
+                if v.len() != len || v.iter().any(|x| !x.is_finite()) {
+                    return Err(format!("operating_point.{name} must hold {len} finite values"));
+                }
             }
         }
         match (&self.xhat0, &self.p_pinv) {

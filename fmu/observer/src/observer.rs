@@ -6,7 +6,9 @@
 //! ```
 //!
 //! with z_0 = 0, or z_0 = P⁺(x̂₀ − Q y_0) from the y set at t_0 (formed again whenever outputs
-//! are read before the first step, so x̂_0 follows y_0 until the master commits to it).
+//! are read before the first step, so x̂_0 follows y_0 until the master commits to it). At an
+//! operating point c_z is added to z_{k+1} and c_x to x̂_k (subtracted in z_0), after the
+//! products, as the runtime adds them; the inputs start at u_op and y_op.
 //!
 //! The arithmetic is the runtime's, operation for operation, with the same skips (P = I: a
 //! copy; G = 0: no G u; Q = 0: no Q y) and `lti::kernel`'s products; the residual is the
@@ -44,6 +46,8 @@ pub struct Observer {
     pub y: Vec<f64>,
     xhat: Vec<f64>,
     r: Vec<f64>,
+    /// At an operating point: (u_op, y_op, c_z, c_x).
+    op: Option<[Vec<f64>; 4]>,
 }
 
 impl Observer {
@@ -53,7 +57,7 @@ impl Observer {
         let zero = |d: &lti::MatData| d.data.iter().all(|&x| x == 0.0);
         let p = m(&res.p);
         let (n, r, l, outputs) = (res.p.rows, res.f.rows, res.g.cols, res.k.cols);
-        Observer {
+        let mut o = Observer {
             p_identity: p.is_square() && p == DMatrix::identity(p.nrows(), p.ncols()),
             g_zero: zero(&res.g),
             q_zero: zero(&res.q),
@@ -71,15 +75,31 @@ impl Observer {
             y: vec![0.0; outputs],
             xhat: vec![0.0; n],
             r: vec![0.0; outputs],
+            op: res.operating_point.as_ref().map(|o| [o.u.clone(), o.y.clone(), o.c_z.clone(), o.c_x.clone()]),
+        };
+        o.start_inputs();
+        o
+    }
+
+    /// The inputs at their start values: the operating point's u and y, else 0.
+    fn start_inputs(&mut self) {
+        match &self.op {
+            Some([u, y, ..]) => {
+                self.u.copy_from_slice(u);
+                self.y.copy_from_slice(y);
+            }
+            None => {
+                self.u.fill(0.0);
+                self.y.fill(0.0);
+            }
         }
     }
 
-    /// Back to the instantiated state: z_0 not formed, inputs at their start value 0.
+    /// Back to the instantiated state: z_0 not formed, inputs at their start values.
     pub fn reset(&mut self) {
         self.z.fill(0.0);
         self.first = true;
-        self.u.fill(0.0);
-        self.y.fill(0.0);
+        self.start_inputs();
     }
 
     /// z_0 = P⁺(x̂₀ − Q y_0), with x̂ as the scratch vector (as the runtime forms it); z_0 = 0
@@ -89,6 +109,11 @@ impl Observer {
             mul_into(&mut self.xhat, &self.q, &self.y);
             for (v, x) in self.xhat.iter_mut().zip(x0) {
                 *v = x - *v;
+            }
+            if let Some([.., c_x]) = &self.op {
+                for (v, c) in self.xhat.iter_mut().zip(c_x) {
+                    *v -= c;
+                }
             }
             mul_into(&mut self.z, p_pinv, &self.xhat);
         }
@@ -106,6 +131,11 @@ impl Observer {
         }
         if !self.q_zero {
             mul_acc(&mut self.xhat, &self.q, &self.y);
+        }
+        if let Some([.., c_x]) = &self.op {
+            for (v, c) in self.xhat.iter_mut().zip(c_x) {
+                *v += c;
+            }
         }
         mul_into(&mut self.r, &self.c, &self.xhat);
         for (r, &y) in self.r.iter_mut().zip(&self.y) {
@@ -134,6 +164,11 @@ impl Observer {
             mul_acc(&mut self.z_next, &self.g, &self.u);
         }
         mul_acc(&mut self.z_next, &self.k, &self.y);
+        if let Some([_, _, c_z, _]) = &self.op {
+            for (z, c) in self.z_next.iter_mut().zip(c_z) {
+                *z += c;
+            }
+        }
         std::mem::swap(&mut self.z, &mut self.z_next);
     }
 }
