@@ -33,7 +33,9 @@ pub fn export_fmu(s: &Scenario, observer: &str, out: &Path, fmi: Fmi) -> Result<
     // At an operating point the FMU takes the plant's absolute u and y and gives x̂ in the plant's
     // units, with the run's own offsets.
     if let (Some(op), Some(off)) = (&s.operating_point, offset) {
-        let point = OperatingPoint { u: op.u.clone(), y: op.y.clone(), c_z: off.z, c_x: off.x };
+        let c_r = op.output_offset(&s.model.c);
+        let c_r = if c_r.iter().any(|&v| v != 0.0) { c_r } else { Vec::new() };
+        let point = OperatingPoint { u: op.u.clone(), y: op.y.clone(), c_z: off.z, c_x: off.x, c_r };
         res = res.at_operating_point(point).map_err(|e| bad(format!("observer '{}': {e}", o.name)))?;
     }
     let signals = |v: &[scenario::Named]| v.iter().map(|n| Signal { name: n.name.clone(), unit: n.unit.clone() }).collect();

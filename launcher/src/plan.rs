@@ -161,7 +161,15 @@ pub fn banks(s: &Scenario) -> Result<Vec<Bank>, PlanError> {
         .iter()
         .enumerate()
         .map(|(i, d)| {
-            design_bank(d, &s.model, &s.ff, s.dt, noise).map_err(|e| {
+            let mut bank = design_bank(d, &s.model, &s.ff, s.dt, noise);
+            // At an operating point every member runs on the plant's absolute signals, as the
+            // scenario's own observers do; its residual is formed in deviations (Metrics).
+            if let (Ok(b), Some(op)) = (&mut bank, &s.operating_point) {
+                for m in &mut b.members {
+                    m.designed.runtime.at_operating_point(op);
+                }
+            }
+            bank.map_err(|e| {
                 let field = if e.key.is_empty() { format!("diagnoser[{}]", i + 1) } else { format!("diagnoser[{}].{}", i + 1, e.key) };
                 let labels = diagnosis::bank::channel_labels(d.channels, &s.model, &s.ff);
                 let who = e.member.map_or(String::new(), |m| format!("member {} ({}): ", m + 1, diagnosis::bank::role(d, &labels, m)));

@@ -46,6 +46,16 @@ impl OperatingPoint {
             .all(|v| v.iter().all(|&x| x == 0.0))
     }
 
+    /// c_r = y_op − C x_op: what a residual of absolute signals, y − C x̂, carries at this point
+    /// beyond the deviation residual δy − C δx̂ (0 where the output map is linear, as for the
+    /// built-in plant; an FMU's trimmed outputs need not be).
+    ///
+    /// Preconditions: `c` p×n, and the point's sizes n and p.
+    pub fn output_offset(&self, c: &Mat) -> Vec<f64> {
+        let cx = c * Mat::from_column_slice(self.x.len(), 1, &self.x);
+        self.y.iter().zip(cx.iter()).map(|(y, cx)| y - cx).collect()
+    }
+
     /// The equilibrium residual of the model at this point: A x + B u + E w (continuous,
     /// `discrete` false) or Φ x + Γ_B u + Γ_E w − x, and the scale it is judged against,
     /// max_i Σ_j (|A_ij||x_j| + |B_ij||u_j| + |E_ij||w_j|) (+ |x_i| when discrete): rounding of

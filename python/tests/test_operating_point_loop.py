@@ -67,8 +67,32 @@ U_OP = np.array([*Q_OP, 5.0])
 STEPS_AT = {"T_out": 86400.0, "w1": 129600.0}
 
 
-def scenario(path, shift=None, measured=True):
-    """The loop at its operating point; with `shift`, the same loop in deviations by hand."""
+# A diagnoser bank on the two air-temperature sensors, and a 0.5 K bias of sensor 1 from 2.5 d.
+BANK = """
+[[fault]]
+name = "Ta1-bias"
+target = "sensor"
+channel = 1
+kind = "bias"
+value = 0.5
+start = 216000.0
+
+[[diagnoser]]
+name = "dos"
+scheme = "dedicated"
+faults = "sensor"
+observer = "luenberger"
+poles = [-0.002, -0.0025, -0.003, -0.0035]
+evaluation = "norm"
+threshold = 0.05
+persistence = 3
+ignore_before = 3600.0
+"""
+
+
+def scenario(path, shift=None, measured=True, bank=False):
+    """The loop at its operating point; with `shift`, the same loop in deviations by hand;
+    with `bank`, the sensor-fault bank and its fault too."""
     x_op, u_op = (X_OP, U_OP) if shift else (np.zeros(4), np.zeros(3))
     op = "" if shift else f"""
 [plant.operating_point]
@@ -130,7 +154,7 @@ track = [[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]]
 integral = true
 R = [[100.0, 0.0], [0.0, 100.0]]   # 1 kW costs as 10 K: heaters that move gently
 {'measured_disturbances = ["T_out"]' if measured else ""}
-""")
+{BANK if bank else ""}""")
     return path
 
 
@@ -212,6 +236,31 @@ def test_the_loop_written_in_deviations_by_hand_is_the_same_loop(loop):
         gap = np.abs(s[name] - op - d[name]).max()
         print(f"{name}: max |absolute − op − by hand| = {gap:.2e}")
         assert gap < 1e-9 * scale, (name, gap)
+
+
+def test_a_diagnoser_bank_at_the_operating_point_is_the_bank_in_deviations(tmp_path):
+    """Bank members run on the absolute signals like the scenario's own observers: their
+    residuals, evaluations and decisions equal those of the loop written in deviations by hand
+    (residuals to rounding, the detection and isolation of the sensor bias the same)."""
+    runs = {}
+    for name, shift in (("at-op", None), ("by-hand", True)):
+        scen = scenario(tmp_path / f"{name}.toml", shift=shift, bank=True)
+        out = tmp_path / f"{name}-out"
+        p, _ = run(scen, out, tmp_path / "runs")
+        assert p.returncode == 0, p.stderr_text
+        csv_dir = export_csv(next(out.glob("*.rrd")), tmp_path / f"{name}-csv")
+        residuals = sorted(csv_dir.glob("diagnoser_dos_residual*.csv"))
+        assert residuals, sorted(x.name for x in csv_dir.iterdir())
+        summary = __import__("json").loads(next(out.glob("*.summary.json")).read_text())
+        runs[name] = ({f.name: np.column_stack([v for v in list(columns(f).values())[2:]]) for f in residuals}, summary["diagnosis"])
+    (at_op, d_op), (by_hand, d_hand) = runs["at-op"], runs["by-hand"]
+    assert at_op.keys() == by_hand.keys()
+    for f in at_op:
+        gap = np.abs(at_op[f] - by_hand[f]).max()
+        assert gap <= 1e-9 * max(np.abs(by_hand[f]).max(), 1.0), (f, gap)
+    fault = d_op["faults"][0]
+    assert fault["isolated_as"] == "Ta1-bias" and fault["delay"] is not None, fault
+    assert d_op["faults"] == d_hand["faults"] and d_op.get("false_alarms") == d_hand.get("false_alarms"), (d_op, d_hand)
 
 
 @pytest.mark.parametrize("given, says", [('["T_in"]', "not an input"), ('["Qh1", "Qh2", "T_out"]', "command none"),

@@ -357,9 +357,6 @@ fn build(raw: RawScenario, dir: Option<&Path>) -> Result<Scenario, Bad> {
     let builtin = p.process.is_none() && p.fmu.is_none() && p.replay.is_none();
     let operating_point = super::operating_point::operating_point(&p.operating_point, &model, discrete, builtin, &layout_names)?;
     let replay = super::replay_plant::plant_replay(&p.replay, dir, &sizes, model.d.ncols(), dt, steps, operating_point.as_ref().map(|op| &op.u[..]))?;
-    if operating_point.as_ref().is_some_and(|op| !op.is_origin()) && !raw.diagnoser.is_empty() {
-        return Err(bad("diagnoser[1]", "diagnosis banks at an operating point are not built yet: their residuals are formed in the model's coordinates (write the scenario in deviations, or leave [plant.operating_point] out)"));
-    }
 
     // Observers.
     let mut seen = BTreeSet::new();

@@ -19,7 +19,8 @@
 //! ```
 //!
 //! with c_z = −(G u_op + K y_op) and c_x = x_op − Q y_op as `observer::LinearObserver` forms
-//! them, so the FMU's x̂ is the run's, in absolute units.
+//! them, so the FMU's x̂ is the run's, in absolute units; r = y − C x̂ − c_r with
+//! c_r = y_op − C x_op where that is not 0, as the run's recorder forms it.
 
 use lti::MatData;
 use serde::{Deserialize, Serialize};
@@ -80,6 +81,10 @@ pub struct OperatingPoint {
     pub c_z: Vec<f64>,
     /// c_x = x_op − Q y_op.
     pub c_x: Vec<f64>,
+    /// c_r = y_op − C x_op when not zero (an output map that is not linear at the point): the
+    /// residual is then y − C x̂ − c_r, in deviations, as the run records it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub c_r: Vec<f64>,
 }
 
 /// The dimensions (n, r, l, p) of a resource that conforms.
@@ -136,7 +141,8 @@ impl ObserverResource {
             }
         }
         if let Some(op) = &self.operating_point {
-            for (name, v, len) in [("u", &op.u, d.l), ("y", &op.y, d.p), ("c_z", &op.c_z, d.r), ("c_x", &op.c_x, d.n)] {
+            let c_r_len = if op.c_r.is_empty() { 0 } else { d.p };
+            for (name, v, len) in [("u", &op.u, d.l), ("y", &op.y, d.p), ("c_z", &op.c_z, d.r), ("c_x", &op.c_x, d.n), ("c_r", &op.c_r, c_r_len)] {
                 if v.len() != len || v.iter().any(|x| !x.is_finite()) {
                     return Err(format!("operating_point.{name} must hold {len} finite values"));
                 }

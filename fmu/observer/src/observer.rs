@@ -46,8 +46,8 @@ pub struct Observer {
     pub y: Vec<f64>,
     xhat: Vec<f64>,
     r: Vec<f64>,
-    /// At an operating point: (u_op, y_op, c_z, c_x).
-    op: Option<[Vec<f64>; 4]>,
+    /// At an operating point: (u_op, y_op, c_z, c_x, c_r), c_r empty where it is 0.
+    op: Option<[Vec<f64>; 5]>,
 }
 
 impl Observer {
@@ -75,7 +75,7 @@ impl Observer {
             y: vec![0.0; outputs],
             xhat: vec![0.0; n],
             r: vec![0.0; outputs],
-            op: res.operating_point.as_ref().map(|o| [o.u.clone(), o.y.clone(), o.c_z.clone(), o.c_x.clone()]),
+            op: res.operating_point.as_ref().map(|o| [o.u.clone(), o.y.clone(), o.c_z.clone(), o.c_x.clone(), o.c_r.clone()]),
         };
         o.start_inputs();
         o
@@ -110,7 +110,7 @@ impl Observer {
             for (v, x) in self.xhat.iter_mut().zip(x0) {
                 *v = x - *v;
             }
-            if let Some([.., c_x]) = &self.op {
+            if let Some([_, _, _, c_x, _]) = &self.op {
                 for (v, c) in self.xhat.iter_mut().zip(c_x) {
                     *v -= c;
                 }
@@ -132,7 +132,7 @@ impl Observer {
         if !self.q_zero {
             mul_acc(&mut self.xhat, &self.q, &self.y);
         }
-        if let Some([.., c_x]) = &self.op {
+        if let Some([_, _, _, c_x, _]) = &self.op {
             for (v, c) in self.xhat.iter_mut().zip(c_x) {
                 *v += c;
             }
@@ -140,6 +140,11 @@ impl Observer {
         mul_into(&mut self.r, &self.c, &self.xhat);
         for (r, &y) in self.r.iter_mut().zip(&self.y) {
             *r = y - *r;
+        }
+        if let Some([.., c_r]) = &self.op {
+            for (r, c) in self.r.iter_mut().zip(c_r) {
+                *r -= c;
+            }
         }
     }
 
@@ -164,7 +169,7 @@ impl Observer {
             mul_acc(&mut self.z_next, &self.g, &self.u);
         }
         mul_acc(&mut self.z_next, &self.k, &self.y);
-        if let Some([_, _, c_z, _]) = &self.op {
+        if let Some([_, _, c_z, _, _]) = &self.op {
             for (z, c) in self.z_next.iter_mut().zip(c_z) {
                 *z += c;
             }

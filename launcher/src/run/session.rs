@@ -303,6 +303,9 @@ impl Session {
             None => None,
         };
         let mut metrics = Metrics::new(layout, s.model.c.clone(), s.observers.len(), s.steps);
+        if let Some(op) = &s.operating_point {
+            metrics.residual_offset(op.output_offset(&s.model.c));
+        }
         if let Some(first) = s.faults.iter().flat_map(|f| f.active_steps(s.dt)).map(|(on, _)| on).min() {
             metrics.fault_free_until(first, s.dt);
         }
@@ -535,3 +538,4 @@ impl Session {
         Ok(Finished { metrics: self.metrics, latency: self.latency, digest, diagnosis, realtime })
     }
 }
+

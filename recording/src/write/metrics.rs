@@ -77,6 +77,8 @@ pub struct Metrics {
     /// The first step a fault acts in, its time, and per observer [tail max|e|, tail max|r|,
     /// max|e|] over the steps before it ([`FaultFree`]).
     fault_free: Option<(u64, f64, Vec<[f64; 3]>)>,
+    /// c_r = y_op − C x_op where it is not zero ([`Metrics::residual_offset`]).
+    c_r: Option<Vec<f64>>,
 }
 
 impl Metrics {
@@ -102,7 +104,15 @@ impl Metrics {
             residual: vec![vec![0.0; layout.p]; observers],
             what: vec![None; observers],
             fault_free: None,
+            c_r: None,
         }
+    }
+
+    /// At an operating point whose y_op is not C x_op (an output map that is not linear), the
+    /// residual is formed in deviations, r = (y − y_op) − C(x̂ − x_op) = y − C x̂ − c_r with
+    /// c_r = y_op − C x_op; a zero c_r changes nothing.
+    pub fn residual_offset(&mut self, c_r: Vec<f64>) {
+        self.c_r = c_r.iter().any(|&v| v != 0.0).then_some(c_r);
     }
 
     /// The run's first fault acts from step `first` (of period dt): figures are kept for the
@@ -165,6 +175,13 @@ impl Metrics {
             mul_into(res, &self.c, xhat);
             for (r, &yj) in res.iter_mut().zip(y) {
                 *r = yj - *r;
+            }
+            if let Some(c_r) = &self.c_r {
+                for (r, c) in res.iter_mut().zip(c_r) {
+                    *r -= c;
+                }
+            }
+            for r in res.iter() {
                 rmax = nan_max(rmax, r.abs());
             }
             if let Some(what) = what {
@@ -200,5 +217,35 @@ impl Metrics {
     pub fn difference(&self, a: usize, b: usize) -> Option<f64> {
         let key = (a.min(b), a.max(b));
         self.differences.iter().find(|(p, _)| *p == key).map(|(_, d)| *d)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::write::StepRow;
+
+    #[test]
+    fn a_residual_at_an_operating_point_is_formed_in_deviations() {
+        // n = 1, p = 1: y = 2.5 at x = 1 where C = 2 gives 2, so c_r = y_op − C x_op = 0.5 for a
+        // point (x_op, y_op) = (1, 2.5); x̂ = 1 at y = 2.5 is then no residual at all.
+        let layout = PlantLayout { n: 1, p: 1, q: 0, r: 0, l: 0, f: 0 };
+        let c = Mat::from_element(1, 1, 2.0);
+        let op = lti::OperatingPoint { x: vec![1.0], u: vec![], w: vec![], y: vec![2.5] };
+        let mut row = StepRow::new(layout, 1, false);
+        row.plant[layout.x()][0] = 1.0;
+        row.plant[layout.y()][0] = 2.5;
+        row.xhat[0][0] = 1.0;
+        let mut without = Metrics::new(layout, c.clone(), 1, 4);
+        without.push(&row);
+        assert_eq!(without.residual[0], [0.5]);
+        let mut with = Metrics::new(layout, c.clone(), 1, 4);
+        with.residual_offset(op.output_offset(&c));
+        with.push(&row);
+        assert_eq!(with.residual[0], [0.0]);
+        // A linear output map leaves y − C x̂ untouched (c_r = 0 is not applied).
+        let mut linear = Metrics::new(layout, c, 1, 4);
+        linear.residual_offset(vec![0.0]);
+        assert!(linear.c_r.is_none());
     }
 }
