@@ -216,6 +216,10 @@ enum Command {
         /// End of the time window, s.
         #[arg(long, value_name = "T", allow_negative_numbers = true)]
         to: Option<f64>,
+        /// A run at an operating point in deviations from it (x − x_op, u − u_op, …) instead of
+        /// the plant's own units.
+        #[arg(long)]
+        deviations: bool,
     },
     /// Export a recording's signals for other tools: CSV, MCAP, NumPy .npz, MATLAB .mat (one or more).
     #[command(group(clap::ArgGroup::new("format").required(true).multiple(true).args(["csv", "mcap", "npz", "mat"])))]
@@ -234,6 +238,10 @@ enum Command {
         /// MATLAB level-5 .mat file: the arrays of --npz.
         #[arg(long, value_name = "FILE")]
         mat: Option<PathBuf>,
+        /// A run at an operating point in deviations from it (x − x_op, u − u_op, …) instead of
+        /// the plant's own units.
+        #[arg(long)]
+        deviations: bool,
     },
     /// Write one of a scenario's observers as an FMI co-simulation FMU, DIR/<observer>_fmi<2|3>.fmu.
     ExportFmu {
@@ -530,12 +538,12 @@ fn main() -> ExitCode {
                 }
             }
         }
-        Command::Plot { recording, out, signals, from, to } => {
+        Command::Plot { recording, out, signals, from, to, deviations } => {
             let selection = recording::plot::PlotSelection { signals, from, to };
             if let Err(e) = selection.validate() {
                 return fail(&LaunchError::BadInput(e));
             }
-            let r = match read_recording(&recording) {
+            let r = match read_recording(&recording).and_then(|r| shifted(&recording, r, deviations)) {
                 Ok(r) => r,
                 Err(code) => return code,
             };
@@ -552,8 +560,8 @@ fn main() -> ExitCode {
                 Err(e) => fail(&LaunchError::BadInput(format!("{}: {e}", recording.display()))),
             }
         }
-        Command::Export { recording, csv, mcap, npz, mat } => {
-            let r = match read_recording(&recording) {
+        Command::Export { recording, csv, mcap, npz, mat, deviations } => {
+            let r = match read_recording(&recording).and_then(|r| shifted(&recording, r, deviations)) {
                 Ok(r) => r,
                 Err(code) => return code,
             };
@@ -616,6 +624,14 @@ fn read_recording(path: &Path) -> Result<recording::Recording, ExitCode> {
         return Err(fail(&LaunchError::Damaged(format!("{}: damaged: {why}", path.display()))));
     }
     Ok(r)
+}
+
+/// `r` in deviations from its operating point when asked (`--deviations`), else as recorded.
+fn shifted(path: &Path, r: recording::Recording, deviations: bool) -> Result<recording::Recording, ExitCode> {
+    if !deviations {
+        return Ok(r);
+    }
+    recording::deviations::in_deviations(&r).map_err(|e| fail(&LaunchError::BadInput(format!("{}: --deviations: {e}", path.display()))))
 }
 
 /// Runs a component's shell in this process (the fallback when its binary is not installed).

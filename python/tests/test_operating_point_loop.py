@@ -10,7 +10,9 @@ with integral action on the UIO's estimate.
   and no sample more than 1 kW outside those two balances (the issue's first try drove them to
   −20 kW and commanded T_out to −4.3 °C).
 * The same loop written in deviations by hand (no operating point, every signal shifted by hand)
-  gives the same observer estimate, controller output and plant state, to rounding.
+  gives the same observer estimate, controller output and plant state, to rounding; and
+  `launcher export --deviations` of the run at the point gives the by-hand run's signals.
+* A diagnoser bank at the point is the bank of the loop in deviations.
 * A measured disturbance that is not an input, or every input declared measured, is refused
   (exit 2, the field named).
 """
@@ -165,7 +167,8 @@ def signals(tmp_path, scen):
     c = columns(export_csv(next(out.glob("*.rrd")), tmp_path / f"{scen.stem}-csv") / "controller_u.csv")
     u = np.column_stack([c[h] for h in list(c)[2:]])
     cols = lambda f: (lambda c: np.column_stack([c[h] for h in list(c)[2:]]))(columns(tmp_path / f"{scen.stem}-csv" / f))
-    return {"u": u, "r": cols("input.csv"), "x": cols("plant_x.csv"), "xhat": cols("observer_uio_xhat.csv"), "stdout": p.stdout_text}
+    return {"u": u, "r": cols("input.csv"), "x": cols("plant_x.csv"), "xhat": cols("observer_uio_xhat.csv"), "stdout": p.stdout_text,
+            "rrd": next(out.glob("*.rrd"))}
 
 
 @pytest.fixture(scope="module")
@@ -236,6 +239,22 @@ def test_the_loop_written_in_deviations_by_hand_is_the_same_loop(loop):
         gap = np.abs(s[name] - op - d[name]).max()
         print(f"{name}: max |absolute − op − by hand| = {gap:.2e}")
         assert gap < 1e-9 * scale, (name, gap)
+    # `launcher export --deviations` of the run at the point is the run written by hand: states,
+    # estimates, inputs and references (the thermostats' r_op = C_t x_op, T_out's u_op).
+    dev = tmp / "deviations-csv"
+    p = subprocess.run([launcher(), "export", "--deviations", "--csv", str(dev), str(s["rrd"])], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, p.stderr
+    hand = tmp / "by-hand-csv"
+    for f in ("plant_x.csv", "observer_uio_xhat.csv", "controller_u.csv", "input.csv", "plant_y.csv", "observer_uio_error.csv"):
+        a, b = columns(dev / f), columns(hand / f)
+        assert list(a) == list(b), f
+        gap = max(np.abs(np.asarray(a[h]) - np.asarray(b[h])).max() for h in list(a)[2:])
+        assert gap < 1e-9 * scale, (f, gap)
+    p = subprocess.run([launcher(), "plot", "--deviations", "--out", str(tmp / "plots"), str(s["rrd"])], capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0 and list((tmp / "plots").glob("*.png")), p.stderr
+    # A recording without a point has nothing to subtract: exit 2, the reason named.
+    p = subprocess.run([launcher(), "export", "--deviations", "--csv", str(tmp / "none"), str(d["rrd"])], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 2 and "no [plant.operating_point]" in p.stderr and not (tmp / "none").exists(), p.stderr
 
 
 def test_a_diagnoser_bank_at_the_operating_point_is_the_bank_in_deviations(tmp_path):

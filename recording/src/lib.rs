@@ -4,6 +4,7 @@
 //! [`signals`] names every entity and [`palette`] colours it, for the writer and readers alike.
 
 pub mod compare;
+pub mod deviations;
 pub mod digest;
 pub mod export;
 mod globs;
