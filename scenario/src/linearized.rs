@@ -124,13 +124,20 @@ pub fn write(req: &Request, m: &Linearized, out: &Path) -> Result<PathBuf, Strin
         }
     }
     plant.insert("operating_point".into(), toml::Value::Table(op));
+    // Without an x0 of its own the run would start from the FMU's start values, away from the
+    // point it is linearised at: it starts at rest there instead.
+    let at_rest = !plant.contains_key("x0");
+    if at_rest {
+        plant.insert("x0".into(), list(m.x));
+    }
     if let Some(fmu) = plant.get_mut("fmu").and_then(|f| f.as_table_mut()) {
         fmu.insert("path".into(), req.fmu.display().to_string().into());
     }
     let header = format!(
-        "# Made by `launcher linearize` from the FMU {}: the sampled model at dt = {} in deviations\n# from [plant.operating_point] (Phi, Gamma_B, Gamma_E, C beside this file, as .npy).\n",
+        "# Made by `launcher linearize` from the FMU {}: the sampled model at dt = {} in deviations\n# from [plant.operating_point] (Phi, Gamma_B, Gamma_E, C beside this file, as .npy).\n{}",
         req.fmu.display(),
-        req.dt
+        req.dt,
+        if at_rest { "# [plant] x0 is the operating point's x (the scenario gave none): the run starts at rest there.\n" } else { "" }
     );
     let text = header + &toml::to_string(&table).map_err(|e| e.to_string())?;
     let scenario = out.join(format!("{}.toml", req.name));
