@@ -281,11 +281,10 @@ impl Summary {
         self.expectations.iter().all(|e| e.ok)
     }
 
-    /// Writes the JSON atomically (a temporary file renamed into place).
+    /// Writes the JSON atomically (a temporary file renamed into place, `outputs::write`).
     pub fn write(&self, path: &Path) -> Result<(), String> {
-        let tmp = path.with_extension("json.tmp");
         let text = serde_json::to_string_pretty(self).expect("summary serialises");
-        std::fs::write(&tmp, text + "\n").and_then(|_| std::fs::rename(&tmp, path)).map_err(|e| format!("{}: cannot write: {e}", path.display()))
+        outputs::write_bytes(path, (text + "\n").as_bytes())
     }
 
     /// The table printed after a run.

@@ -16,8 +16,14 @@ use crate::tools::recorded_scenario;
 /// `r` with its signals shifted to deviations from the recorded scenario's operating point; an
 /// error when the recording holds no scenario or its scenario no point.
 pub fn in_deviations(r: &Recording) -> Result<Recording, String> {
-    let s = recorded_scenario(r).ok_or("the recording holds no scenario that can be read, so no operating point to subtract")?;
-    let op = s.operating_point.as_ref().filter(|op| !op.is_origin()).ok_or("its scenario has no [plant.operating_point]: its signals are deviations already")?;
+    let s = recorded_scenario(r).ok_or(
+        "the recording holds no scenario that can be read, so no operating point to subtract",
+    )?;
+    let op = s
+        .operating_point
+        .as_ref()
+        .filter(|op| !op.is_origin())
+        .ok_or("its scenario has no [plant.operating_point]: its signals are deviations already")?;
     let references = reference_levels(&s, op);
     let mut out = r.clone();
     for (path, series) in &mut out.series {
@@ -34,7 +40,11 @@ pub fn in_deviations(r: &Recording) -> Result<Recording, String> {
 /// u_op (the input's own level).
 fn reference_levels(s: &scenario::Scenario, op: &lti::OperatingPoint) -> Vec<f64> {
     let mut levels = op.u.clone();
-    if let Some(ct) = s.controller.as_ref().and_then(|c| c.track.as_ref().map(|t| (c, t))) {
+    if let Some(ct) = s
+        .controller
+        .as_ref()
+        .and_then(|c| c.track.as_ref().map(|t| (c, t)))
+    {
         let (c, ct) = ct;
         let z = ct * lti::Mat::from_column_slice(op.x.len(), 1, &op.x);
         let commanded = (0..op.u.len()).filter(|j| !c.measured.contains(j));
@@ -49,7 +59,10 @@ fn reference_levels(s: &scenario::Scenario, op: &lti::OperatingPoint) -> Vec<f64
 fn level(path: &str, op: &lti::OperatingPoint, references: &[f64]) -> Option<f64> {
     let (group, index) = path.rsplit_once('/')?;
     let i = index.parse::<usize>().ok()?.checked_sub(1)?;
-    let kind = group.strip_prefix("/observer/").and_then(|g| g.split_once('/')).map_or(group, |(_, kind)| kind);
+    let kind = group
+        .strip_prefix("/observer/")
+        .and_then(|g| g.split_once('/'))
+        .map_or(group, |(_, kind)| kind);
     match kind {
         "/plant/x" | "xhat" => op.x.get(i).copied(),
         "/plant/y" => op.y.get(i).copied(),
@@ -66,7 +79,12 @@ mod tests {
 
     #[test]
     fn each_signal_takes_its_own_level_and_differences_none() {
-        let op = lti::OperatingPoint { x: vec![1.0, 2.0], u: vec![3.0], w: vec![4.0], y: vec![5.0] };
+        let op = lti::OperatingPoint {
+            x: vec![1.0, 2.0],
+            u: vec![3.0],
+            w: vec![4.0],
+            y: vec![5.0],
+        };
         let refs = [6.0];
         assert_eq!(level("/plant/x/2", &op, &refs), Some(2.0));
         assert_eq!(level("/observer/uio/xhat/1", &op, &refs), Some(1.0));
@@ -74,7 +92,13 @@ mod tests {
         assert_eq!(level("/plant/y/1", &op, &refs), Some(5.0));
         assert_eq!(level("/controller/u/1", &op, &refs), Some(3.0));
         assert_eq!(level("/input/1", &op, &refs), Some(6.0));
-        for path in ["/observer/uio/error/1", "/observer/uio/residual/1", "/diagnoser/b/residual/1/1", "/fault/f/value", "/latency/step"] {
+        for path in [
+            "/observer/uio/error/1",
+            "/observer/uio/residual/1",
+            "/diagnoser/b/residual/1/1",
+            "/fault/f/value",
+            "/latency/step",
+        ] {
             assert_eq!(level(path, &op, &refs), None, "{path}");
         }
     }

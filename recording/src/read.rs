@@ -284,10 +284,13 @@ fn has_stream_footer(file: &mut File, len: u64) -> bool {
 }
 
 /// Writes series to a new `.rrd` (timeline `step` only) with their digest, e.g. to make a test
-/// recording.
+/// recording; a file already at `path` is replaced (a link there removed, not followed).
 pub fn write(path: &Path, rec: &Recording) -> Result<(), String> {
     use rerun::time::Timeline;
     use rerun::TimeColumn;
+    if std::fs::symlink_metadata(path).is_ok() {
+        std::fs::remove_file(path).map_err(|e| format!("{}: cannot replace: {e}", path.display()))?;
+    }
     let sink = crate::write::UncompressedFileSink::create(path)?;
     let stream = rerun::RecordingStreamBuilder::new("uio-observers").buffered().map_err(|e| e.to_string())?;
     stream.set_sink(Box::new(sink));

@@ -6,6 +6,7 @@
 //! line: file, where, why.
 
 use scenario::suggest::did_you_mean;
+use scenario::untrusted::{quoted, quoted_list};
 
 use crate::samples::{self, Mapped, Naming};
 use crate::table::Table;
@@ -24,7 +25,7 @@ pub fn load(p: &Params) -> Result<Table, String> {
     // The mapped columns, in sample order: x, y, w, u; the time column apart.
     let find = |key: &str, i: usize, name: &str| -> Result<usize, String> {
         names.iter().position(|h| h == name).ok_or_else(|| {
-            format!("{file}: no column {name:?} (plant.replay.{key}[{}]){}; the header has {}", i + 1, did_you_mean(name, names.iter().map(String::as_str)), names.join(", "))
+            format!("{file}: no column {} (plant.replay.{key}[{}]){}; the header has {}", quoted(name), i + 1, did_you_mean(name, names.iter().map(String::as_str)), quoted_list(names.iter().map(String::as_str)))
         })
     };
     let group = |key: &str, list: &[String]| -> Result<Vec<usize>, String> { list.iter().enumerate().map(|(i, n)| find(key, i, n)).collect() };
@@ -34,7 +35,7 @@ pub fn load(p: &Params) -> Result<Table, String> {
     let w = group("disturbances", p.disturbances.as_deref().unwrap_or_default())?;
     let u = group("inputs", &p.inputs)?;
     let time = match &p.time {
-        Some(t) => Some(names.iter().position(|h| h == t).ok_or_else(|| format!("{file}: no time column {t:?} (plant.replay.time){}; the header has {}", did_you_mean(t, names.iter().map(String::as_str)), names.join(", ")))?),
+        Some(t) => Some(names.iter().position(|h| h == t).ok_or_else(|| format!("{file}: no time column {} (plant.replay.time){}; the header has {}", quoted(t), did_you_mean(t, names.iter().map(String::as_str)), quoted_list(names.iter().map(String::as_str))))?),
         None => None,
     };
     let cols: Vec<usize> = time.iter().chain(&x).chain(&y).chain(&w).chain(&u).copied().collect();

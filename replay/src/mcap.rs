@@ -19,6 +19,7 @@ use ::mcap::MessageStream;
 use serde_json::{Map, Value};
 
 use scenario::suggest::did_you_mean;
+use scenario::untrusted::{quoted, quoted_list};
 
 use crate::samples::{self, Mapped, Naming};
 use crate::table::Table;
@@ -62,7 +63,7 @@ pub fn load(p: &Params) -> Result<Table, String> {
         }
         let known: Vec<String> = chans.iter().flat_map(|c| keys_in_order(&c.data[0]).into_iter().map(move |k| if multi { format!("{}.{k}", c.topic) } else { k })).collect();
         let topics: Vec<&str> = chans.iter().map(|c| c.topic.as_str()).collect();
-        Err(format!("{file}: no field {name:?} ({key}) in the first message of {}{}; it has {}", topics.join(", "), did_you_mean(name, known.iter().map(String::as_str)), known.join(", ")))
+        Err(format!("{file}: no field {} ({key}) in the first message of {}{}; it has {}", quoted(name), quoted_list(topics.iter().copied()), did_you_mean(name, known.iter().map(String::as_str)), quoted_list(known.iter().map(String::as_str))))
     };
     let group = |key: &str, list: &[String]| -> Result<Vec<(usize, String)>, String> { list.iter().enumerate().map(|(i, n)| find(&format!("plant.replay.{key}[{}]", i + 1), n)).collect() };
     let time = p.time.as_deref().map(|t| find("plant.replay.time", t)).transpose()?;
@@ -137,9 +138,8 @@ fn messages(file: &str, bytes: &[u8], topics: &[String]) -> Result<Vec<Channel>,
     }
     for c in &chans {
         if !all.contains_key(&c.topic) {
-            let have: Vec<String> = all.iter().map(|(t, e)| format!("{t:?} ({e})")).collect();
-            let have = if have.is_empty() { "none".to_string() } else { have.join(", ") };
-            return Err(format!("{file}: no channel {:?} (plant.replay.channel){}; the file has {have}", c.topic, did_you_mean(&c.topic, all.keys().map(String::as_str))));
+            let have = quoted_list(all.keys().map(String::as_str));
+            return Err(format!("{file}: no channel {} (plant.replay.channel){}; the file has {have}", quoted(&c.topic), did_you_mean(&c.topic, all.keys().map(String::as_str))));
         }
         if c.times.is_empty() {
             return Err(format!("{file}: channel {:?} has no messages", c.topic));

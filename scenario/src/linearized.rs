@@ -142,12 +142,15 @@ pub fn write(req: &Request, m: &Linearized, out: &Path) -> Result<PathBuf, Strin
     let text = header + &toml::to_string(&table).map_err(|e| e.to_string())?;
     let scenario = out.join(format!("{}.toml", req.name));
     files.push((scenario.clone(), text.into_bytes()));
+    // Every file staged before any is renamed into place: a failure leaves none half-written.
+    let mut staged = Vec::with_capacity(files.len());
     for (path, bytes) in &files {
-        let tmp = path.with_extension("partial");
-        std::fs::write(&tmp, bytes).map_err(|e| format!("{}: {e}", tmp.display()))?;
+        let (s, mut w) = outputs::Staged::create(path)?;
+        std::io::Write::write_all(&mut w, bytes).map_err(|e| outputs::cannot_write(path, &e))?;
+        staged.push((s, w));
     }
-    for (path, _) in &files {
-        std::fs::rename(path.with_extension("partial"), path).map_err(|e| format!("{}: {e}", path.display()))?;
+    for (s, w) in staged {
+        s.commit(w)?;
     }
     Ok(scenario)
 }

@@ -7,12 +7,24 @@ pub fn did_you_mean<'a>(word: &str, known: impl IntoIterator<Item = &'a str>) ->
     closest(word, known).map_or(String::new(), |k| format!(" (did you mean {}?)", crate::untrusted::quoted(k)))
 }
 
-/// The closest known word within the limit, ties to the first.
+/// Words longer than this get no suggestion, and candidates longer than this are skipped: the
+/// distance table is (|a| + 1)(|b| + 1) cells, and a hostile file's 20 MiB field name must not
+/// cost gigabytes (issue 32).
+pub const MAX_WORD: usize = 64;
+
+/// At most this many candidates are compared.
+pub const MAX_CANDIDATES: usize = 1000;
+
+/// The closest known word within the limit, ties to the first; none for a word longer than
+/// [`MAX_WORD`] characters.
 pub fn closest<'a>(word: &str, known: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+    if word.chars().nth(MAX_WORD).is_some() {
+        return None;
+    }
     let w = word.to_lowercase();
     let mut best: Option<(usize, &str)> = None;
-    for k in known {
-        if k == word {
+    for k in known.into_iter().take(MAX_CANDIDATES) {
+        if k == word || k.chars().nth(MAX_WORD).is_some() {
             continue;
         }
         let d = distance(&w, &k.to_lowercase());
@@ -58,6 +70,10 @@ mod tests {
         assert_eq!(closest("Phi", ["A", "B", "Phi2"]), Some("Phi2"));
         assert_eq!(closest("zzz", ["poles", "gain"]), None);
         assert_eq!(did_you_mean("xyz", ["poles"]), "");
+        // A word or candidate over MAX_WORD characters is not compared (no n² table).
+        let long = "p".repeat(MAX_WORD + 1);
+        assert_eq!(closest(&long, [long.as_str(), "poles"]), None);
+        assert_eq!(closest("poles1", [long.as_str()]), None);
         assert_eq!(did_you_mean("gian", ["gain"]), " (did you mean 'gain'?)");
     }
 }

@@ -15,6 +15,31 @@ pub const MAX_SCENARIO_BYTES: u64 = 1 << 20;
 /// Longest untrusted text quoted whole in a message, in characters; longer text is cut.
 const QUOTE_CHARS: usize = 80;
 
+/// Longest list of untrusted names shown in a message, in characters (issue 32: a 20 MiB
+/// header made a 99 MB message line).
+const LIST_CHARS: usize = 300;
+
+/// `'a', 'b', …` — each name [`quoted`], the list cut after [`LIST_CHARS`] characters with how
+/// many more there are; "none" for an empty list.
+pub fn quoted_list<'a>(names: impl IntoIterator<Item = &'a str>) -> String {
+    let mut out = String::new();
+    let mut more = 0usize;
+    for name in names {
+        if more > 0 || out.chars().count() > LIST_CHARS {
+            more += 1;
+            continue;
+        }
+        if !out.is_empty() {
+            out += ", ";
+        }
+        out += &quoted(name);
+    }
+    if more > 0 {
+        out += &format!(", … ({more} more)");
+    }
+    if out.is_empty() { "none".into() } else { out }
+}
+
 /// `'text'` with every control or otherwise unprintable character escaped as Rust does
 /// (`\n`, `\u{1b}`), cut after 80 characters: for echoing a name or key the user gave.
 pub fn quoted(text: &str) -> String {

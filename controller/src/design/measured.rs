@@ -30,12 +30,18 @@ fn columns(b: &Mat, keep: &[usize]) -> Mat {
 
 /// The sampled plant with only the commanded inputs: Γ_c in place of Γ_B.
 pub fn sampled(dm: &Discrete, keep: &[usize]) -> Discrete {
-    Discrete { b: columns(&dm.b, keep), ..dm.clone() }
+    Discrete {
+        b: columns(&dm.b, keep),
+        ..dm.clone()
+    }
 }
 
 /// The continuous plant with only the commanded inputs: B_c in place of B.
 pub fn continuous(m: &Model, keep: &[usize]) -> Model {
-    Model { b: columns(&m.b, keep), ..m.clone() }
+    Model {
+        b: columns(&m.b, keep),
+        ..m.clone()
+    }
 }
 
 /// `x` (l_c rows, one per commanded input) as l rows: row `keep[i]` is x's row i, the measured
@@ -73,8 +79,14 @@ mod tests {
         let keep = commanded(3, &[1]);
         assert_eq!(keep, vec![0, 2]);
         let g = Mat::from_row_slice(2, 2, &[1.0, 2.0, 3.0, 4.0]);
-        assert_eq!(rows(&g, 3, &keep), Mat::from_row_slice(3, 2, &[1.0, 2.0, 0.0, 0.0, 3.0, 4.0]));
+        assert_eq!(
+            rows(&g, 3, &keep),
+            Mat::from_row_slice(3, 2, &[1.0, 2.0, 0.0, 0.0, 3.0, 4.0])
+        );
         let n = prefilter(&g, 3, &keep);
-        assert_eq!(n, Mat::from_row_slice(3, 3, &[1.0, 0.0, 2.0, 0.0, 1.0, 0.0, 3.0, 0.0, 4.0]));
+        assert_eq!(
+            n,
+            Mat::from_row_slice(3, 3, &[1.0, 0.0, 2.0, 0.0, 1.0, 0.0, 3.0, 0.0, 4.0])
+        );
     }
 }

@@ -3,8 +3,8 @@
 //! place, so a failed export leaves nothing behind.
 
 use std::fs::File;
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::io::{BufWriter, Write};
+use std::path::Path;
 
 use zip::write::SimpleFileOptions;
 use zip::{CompressionMethod, DateTime, ZipWriter};
@@ -26,26 +26,15 @@ pub struct Contents<'a> {
     pub fmi: Fmi,
 }
 
-/// Writes `path` atomically (a temporary file in the same folder, renamed over it).
+/// Writes `path` atomically (`outputs::write`: a new file at an unpredictable name in the same
+/// folder, renamed over it).
 pub fn write(path: &Path, c: &Contents) -> Result<(), String> {
-    let tmp = temporary(path);
-    let done = write_zip(&tmp, c).and_then(|()| std::fs::rename(&tmp, path).map_err(|e| format!("{}: cannot rename into place: {e}", path.display())));
-    if done.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    done
+    outputs::write(path, |w| write_zip(w, path, c))
 }
 
-/// `.<name>.<pid>.partial` beside `path`.
-fn temporary(path: &Path) -> PathBuf {
-    let name = path.file_name().map_or_else(|| "fmu".into(), |n| n.to_string_lossy().into_owned());
-    path.with_file_name(format!(".{name}.{}.partial", std::process::id()))
-}
-
-fn write_zip(tmp: &Path, c: &Contents) -> Result<(), String> {
-    let err = |e: &dyn std::fmt::Display| format!("{}: {e}", tmp.display());
-    let file = File::create(tmp).map_err(|e| err(&e))?;
-    let mut zip = ZipWriter::new(file);
+fn write_zip(w: &mut BufWriter<File>, path: &Path, c: &Contents) -> Result<(), String> {
+    let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+    let mut zip = ZipWriter::new(&mut *w);
     // A fixed timestamp: the same export gives the same bytes.
     let opts = SimpleFileOptions::default().compression_method(CompressionMethod::Deflated).last_modified_time(DateTime::default());
     let library = format!("binaries/{}/{}.so", c.fmi.platform(), c.model_identifier);
@@ -58,8 +47,8 @@ fn write_zip(tmp: &Path, c: &Contents) -> Result<(), String> {
         zip.start_file(name, opts.unix_permissions(mode)).map_err(|e| err(&e))?;
         zip.write_all(bytes).map_err(|e| err(&e))?;
     }
-    let file = zip.finish().map_err(|e| err(&e))?;
-    file.sync_all().map_err(|e| err(&e))
+    zip.finish().map_err(|e| err(&e))?;
+    Ok(())
 }
 
 #[cfg(test)]

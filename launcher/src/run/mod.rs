@@ -124,9 +124,7 @@ pub fn output_paths(out: &Path, name: &str) -> (PathBuf, PathBuf) {
 /// Makes sure the outputs can be written, before anything runs.
 fn prepare_output(out: &Path, name: &str, force: bool) -> Result<(PathBuf, PathBuf), LaunchError> {
     fs::create_dir_all(out).map_err(|e| LaunchError::BadInput(format!("{}: cannot create the output directory: {e}", out.display())))?;
-    let probe = out.join(format!(".{name}.write-test"));
-    fs::write(&probe, b"").map_err(|e| LaunchError::BadInput(format!("{}: output directory is not writable: {e}", out.display())))?;
-    let _ = fs::remove_file(&probe);
+    outputs::probe(out).map_err(|e| LaunchError::BadInput(format!("{}: output directory is not writable: {e}", out.display())))?;
     let (rrd, summary) = output_paths(out, name);
     for p in [&rrd, &summary] {
         if p.exists() {
@@ -137,6 +135,12 @@ fn prepare_output(out: &Path, name: &str, force: bool) -> Result<(PathBuf, PathB
             // previous run's outputs looking like its own.
             fs::remove_file(p).map_err(|e| LaunchError::BadInput(format!("{}: cannot overwrite: {e}", p.display())))?;
         }
+    }
+    // What a killed launcher left, or anything planted at that name (a link is removed, never
+    // followed): the recording is then made there as a new file (`outputs::create_new`).
+    let partial = rrd.with_extension("rrd.partial");
+    if fs::symlink_metadata(&partial).is_ok() {
+        fs::remove_file(&partial).map_err(|e| LaunchError::BadInput(format!("{}: cannot replace: {e}", partial.display())))?;
     }
     Ok((rrd, summary))
 }

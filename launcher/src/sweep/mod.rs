@@ -328,9 +328,8 @@ impl SweepSummary {
     /// Writes `<out>/<name>.sweep.json` (atomically).
     pub fn write(&self, out: &Path) -> Result<PathBuf, String> {
         let path = out.join(format!("{}.sweep.json", self.scenario));
-        let tmp = path.with_extension("json.tmp");
         let text = serde_json::to_string_pretty(self).expect("serialises");
-        std::fs::write(&tmp, text + "\n").and_then(|_| std::fs::rename(&tmp, &path)).map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+        outputs::write_bytes(&path, (text + "\n").as_bytes())?;
         Ok(path)
     }
 

@@ -4,7 +4,6 @@
 
 use std::path::Path;
 
-use plotters::backend::DrawingBackend;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
@@ -178,9 +177,12 @@ pub fn draw(path: &Path, fig: &Figure) -> Result<bool, String> {
             polyline(&mut canvas, legend_clip, &piece, c.line.color, c.line.width as f64 + 0.5);
         }
     }
-    let mut out = BitMapBackend::new(path, SIZE);
-    out.blit_bitmap((0, 0), SIZE, &buf).map_err(|e| e.to_string())?;
-    out.present().map_err(|e| e.to_string())?;
+    // Encoded here and written staged (`outputs`): plotters' file backend would create the path
+    // itself, through any link planted there.
+    outputs::write(path, |w| {
+        use image::ImageEncoder;
+        image::codecs::png::PngEncoder::new(w).write_image(&buf, SIZE.0, SIZE.1, image::ColorType::Rgb8).map_err(|e| e.to_string())
+    })?;
     Ok(true)
 }
 

@@ -26,14 +26,15 @@ pub struct UncompressedFileSink {
 }
 
 impl UncompressedFileSink {
-    /// Creates (truncates) the file and writes the stream header.
+    /// Creates the file — a new regular file ([`outputs::create_new`]: nothing planted at its
+    /// name is followed or truncated) — and writes the stream header.
     pub fn create(path: &Path) -> Result<Self, String> {
         Self::create_with(path, false)
     }
 
     /// The same, its chunks LZ4-compressed as Rerun's own sink writes them when `lz4`.
     pub fn create_with(path: &Path, lz4: bool) -> Result<Self, String> {
-        let file = File::create(path).map_err(|e| format!("{}: cannot create: {e}", path.display()))?;
+        let file = outputs::create_new(path).map_err(|e| format!("{}: cannot create: {e}", path.display()))?;
         let options = if lz4 { EncodingOptions::PROTOBUF_COMPRESSED } else { EncodingOptions::PROTOBUF_UNCOMPRESSED };
         let encoder = Encoder::new_eager(re_build_info::CrateVersion::LOCAL, options, BufWriter::with_capacity(1 << 20, file))
             .map_err(|e| format!("{}: {e}", path.display()))?;
