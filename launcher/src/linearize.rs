@@ -30,7 +30,7 @@ fn fmt(v: &[f64]) -> String {
 /// Runs `launcher linearize`; the scenario written.
 pub fn linearize(path: &Path, trim: bool, out: &Path) -> Result<PathBuf, LaunchError> {
     let req = linearized::request(path)?;
-    let answer = launcher::run::preflight::sibling(path, ["plant.fmu: "; 2], PROGRAM, "--linearize", "fmu-plant", &req.json(trim))?;
+    let answer = launcher::run::preflight::sibling(path, ["plant.fmu: "; 2], PROGRAM, "--linearize", "fmu-plant", &req.json(trim), launcher::run::preflight::LINEARIZE_TIMEOUT)?;
     let a: Value = serde_json::from_slice(&answer).map_err(|e| LaunchError::BadInput(format!("{}: {PROGRAM} --linearize: its answer: {e}", path.display())))?;
     let (x, y) = (list(&a["x"]), list(&a["y"]));
     let (phi, gb, ge, c) = (rows(&a["Phi"]), rows(&a["Gamma_B"]), rows(&a["Gamma_E"]), rows(&a["C"]));

@@ -180,7 +180,7 @@ def test_csv_log_of_a_nonlinear_plant_fault_detected(motor, tmp_path):
     p = launch(tmp_path, "run", scen, "--out", out)
     assert p.returncode == 0, p.stderr
     s = json.loads((out / "motor-log.summary.json").read_text())
-    assert s["replay"] == {"file": "motor.csv", "rows": len(t), "samples": len(t), "held_rows": 0, "held_cells": 0, "states": True}
+    assert s["replay"] == {"file": "motor.csv", "rows": len(t), "samples": len(t), "held_rows": 0, "held_cells": 0, "states": True, "disturbances": True}
     (fault,) = s["diagnosis"]["faults"]
     assert fault["detected_at"] is not None and FAULT_START <= fault["detected_at"] < FAULT_START + 0.1, fault
     assert 0 <= fault["delay"] < 0.1
@@ -419,7 +419,7 @@ def test_mcap_log_replays_as_the_csv_bit_for_bit(motor, tmp_path, time_field):
     p = launch(tmp_path, "run", mcap_scenario(tmp_path, time_field=time_field), "--out", mcap_out)
     assert p.returncode == 0, p.stderr
     s = json.loads((mcap_out / "motor-log.summary.json").read_text())
-    assert s["replay"] == {"file": "motor.mcap", "rows": len(t), "samples": len(t), "held_rows": 0, "held_cells": 0, "states": True}
+    assert s["replay"] == {"file": "motor.mcap", "rows": len(t), "samples": len(t), "held_rows": 0, "held_cells": 0, "states": True, "disturbances": True}
     values, signals = compared(launch(tmp_path, "compare", csv_out / "motor-log.rrd", mcap_out / "motor-log.rrd"))
     print(f"\nMCAP replay ({'time field' if time_field else 'log_time'}): {values} values of {signals} signals equal the CSV replay's bit for bit")
     assert signals > 30 and values > 8000 * 30

@@ -106,6 +106,35 @@ pub fn load(p: &Params) -> Result<Table, String> {
     samples::table(p, file, m, states, &Naming { row: &row, time: &time_name, rows: "messages" })
 }
 
+/// Largest chunk a log may declare, uncompressed (64 MiB; our exporter's are under 1 MiB): a
+/// chunk is decompressed whole, so a 1.7 KB file declaring 2^62 bytes must be refused before.
+pub const MAX_CHUNK: u64 = 64 << 20;
+
+/// Largest sum of the chunks' uncompressed sizes (1 GiB): the messages are held in memory.
+pub const MAX_UNCOMPRESSED: u64 = 1 << 30;
+
+/// Refuses a log whose chunks declare more than [`MAX_CHUNK`] each or [`MAX_UNCOMPRESSED`] in
+/// all, from their headers alone (nothing is decompressed here; the reader then stops at each
+/// declared size). A record the scan cannot read is left for the reader to report.
+fn bounded(file: &str, bytes: &[u8]) -> Result<(), String> {
+    let Ok(records) = ::mcap::read::LinearReader::new(bytes) else { return Ok(()) };
+    let mut total = 0u64;
+    for (i, record) in records.enumerate() {
+        let Ok(record) = record else { return Ok(()) };
+        if let ::mcap::records::Record::Chunk { header, .. } = record {
+            let size = header.uncompressed_size;
+            if size > MAX_CHUNK {
+                return Err(format!("{file}: chunk {} declares {size} bytes uncompressed, more than the {} MiB a chunk may hold here", i + 1, MAX_CHUNK >> 20));
+            }
+            total = total.saturating_add(size);
+            if total > MAX_UNCOMPRESSED {
+                return Err(format!("{file}: its chunks declare more than {} GiB uncompressed in all, more than a replay holds in memory", MAX_UNCOMPRESSED >> 30));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The messages of the listed channels, in file order; refuses a file without one of them
 /// (naming the channels it has), a channel not JSON-encoded, or one without messages.
 fn messages(file: &str, bytes: &[u8], topics: &[String]) -> Result<Vec<Channel>, String> {
@@ -113,6 +142,7 @@ fn messages(file: &str, bytes: &[u8], topics: &[String]) -> Result<Vec<Channel>,
     let mut chans: Vec<Channel> = topics.iter().map(|t| Channel { topic: t.clone(), times: Vec::new(), data: Vec::new() }).collect();
     // Every channel the file declares (topic → encoding), for the messages below.
     let mut all: BTreeMap<String, String> = BTreeMap::new();
+    bounded(file, bytes)?;
     if let Ok(Some(summary)) = ::mcap::Summary::read(bytes) {
         all.extend(summary.channels.values().map(|c| (c.topic.clone(), c.message_encoding.clone())));
     }

@@ -11,8 +11,9 @@
 //!   `.rrd` of another plant. What it says of the data (rows, held rows, whether x is in it)
 //!   goes to the summary.
 
-use std::io::Write;
+use std::io::{Read, Write};
 use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
 
 use scenario::{Scenario, FMU_PLANT_PROGRAM, REPLAY_PLANT_PROGRAM};
 
@@ -34,38 +35,127 @@ pub fn replay(s: &Scenario) -> Result<Option<serde_json::Value>, LaunchError> {
     Ok(Some(facts))
 }
 
+/// How long a `--check` may take: reading a file against a map is seconds even for the largest
+/// logs the caps allow; a hostile file must not hold the launcher longer.
+pub const CHECK_TIMEOUT: Duration = Duration::from_secs(120);
+
+/// How long `fmu_plant --linearize` may take (2(n + l + q) + 1 FMU simulations of one sample
+/// each, twice for Richardson's extrapolation, and the trim's Newton steps).
+pub const LINEARIZE_TIMEOUT: Duration = Duration::from_secs(1800);
+
+/// The address space a sibling may map (8 GiB of the machine's 24): an allocation a hostile
+/// file asks for fails in the child instead of taking the machine's memory.
+pub const SIBLING_ADDRESS_SPACE: u64 = 8 << 30;
+
+/// The most a sibling's stdout or stderr is read (beyond: discarded): a report, not a log.
+const SIBLING_OUTPUT: u64 = 16 << 20;
+
 /// `program --check` (a kit component built beside the launcher, of cargo package `package`)
 /// with `params` on stdin: its stdout, or its last line on stderr as bad input. `field` heads
 /// this function's own messages and the component's line.
 fn check(s: &Scenario, field: [&str; 2], program: &str, package: &str, params: &serde_json::Value) -> Result<Vec<u8>, LaunchError> {
-    sibling(&s.path, field, program, "--check", package, params)
+    sibling(&s.path, field, program, "--check", package, params, CHECK_TIMEOUT)
 }
 
 /// `program flag` (a kit component built beside the launcher, of cargo package `package`) with
-/// `input` as JSON on stdin: its stdout, or its last line on stderr as bad input of `file`.
+/// `input` as JSON on stdin: its stdout, or its reason on stderr as bad input of `file`.
 /// `field` heads this function's own messages and the component's line. `--check` here, and
 /// `fmu_plant --linearize` for `launcher linearize`.
-pub fn sibling(file: &std::path::Path, field: [&str; 2], program: &str, flag: &str, package: &str, input: &serde_json::Value) -> Result<Vec<u8>, LaunchError> {
+///
+/// The child runs in a process group of its own with its address space capped
+/// ([`SIBLING_ADDRESS_SPACE`]); past `timeout`, or on SIGINT/SIGTERM/SIGHUP/SIGQUIT to the
+/// launcher, the whole group is killed and waited for, so nothing is left spinning.
+pub fn sibling(file: &std::path::Path, field: [&str; 2], program: &str, flag: &str, package: &str, input: &serde_json::Value, timeout: Duration) -> Result<Vec<u8>, LaunchError> {
+    use std::os::unix::process::CommandExt;
     let exe = std::env::current_exe().unwrap_or_else(|_| "launcher".into()).with_file_name(program);
     let path = if exe.is_file() { exe } else { program.into() };
     let bad = |why: String| LaunchError::BadInput(format!("{}: {}{why}", file.display(), field[0]));
-    let mut child = Command::new(&path)
-        .arg(flag)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .map_err(|e| bad(format!("cannot start {program} ({e}); it is built with `cargo build --release -p {package}`")))?;
+    super::interrupt::install();
+    let mut command = Command::new(&path);
+    command.arg(flag).stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped()).process_group(0);
+    // SAFETY: setrlimit is async-signal-safe; nothing else runs between fork and exec.
+    unsafe {
+        command.pre_exec(|| {
+            let limit = libc::rlimit { rlim_cur: SIBLING_ADDRESS_SPACE, rlim_max: SIBLING_ADDRESS_SPACE };
+            libc::setrlimit(libc::RLIMIT_AS, &limit);
+            Ok(())
+        });
+    }
+    let mut child = command.spawn().map_err(|e| bad(format!("cannot start {program} ({e}); it is built with `cargo build --release -p {package}`")))?;
     let text = serde_json::to_string(input).expect("serialises");
-    child.stdin.take().expect("piped").write_all(text.as_bytes()).map_err(|e| bad(format!("{program} {flag}: {e}")))?;
-    let out = child.wait_with_output().map_err(|e| bad(format!("{program} {flag}: {e}")))?;
-    if out.status.success() {
-        return Ok(out.stdout);
+    let mut stdin = child.stdin.take().expect("piped");
+    let drain = |pipe: Option<Box<dyn Read + Send>>| {
+        std::thread::spawn(move || {
+            let mut out = Vec::new();
+            if let Some(p) = pipe {
+                let mut p = p.take(SIBLING_OUTPUT);
+                let _ = p.read_to_end(&mut out);
+                let _ = std::io::copy(&mut p.into_inner(), &mut std::io::sink());
+            }
+            out
+        })
+    };
+    let stdout = drain(child.stdout.take().map(|p| Box::new(p) as Box<dyn Read + Send>));
+    let stderr = drain(child.stderr.take().map(|p| Box::new(p) as Box<dyn Read + Send>));
+    let writer = std::thread::spawn(move || stdin.write_all(text.as_bytes()));
+    let start = Instant::now();
+    let stopped = loop {
+        match child.try_wait() {
+            Ok(Some(status)) => break Ok(status),
+            Ok(None) => {}
+            Err(e) => break Err(bad(format!("{program} {flag}: {e}"))),
+        }
+        let why = if let Some(sig) = super::interrupt::received() {
+            Some(LaunchError::Interrupted(format!("{}: interrupted by {sig} during {program} {flag}; it was stopped", file.display())))
+        } else if start.elapsed() > timeout {
+            Some(bad(format!("{program} {flag} did not answer within {} s; it was stopped", timeout.as_secs())))
+        } else {
+            None
+        };
+        if let Some(why) = why {
+            // SAFETY: the child leads its own group (process_group(0)); kill it whole.
+            unsafe { libc::kill(-(child.id() as i32), libc::SIGKILL) };
+            let _ = child.wait();
+            break Err(why);
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let _ = writer.join();
+    let (out, err) = (stdout.join().unwrap_or_default(), stderr.join().unwrap_or_default());
+    let status = stopped?;
+    if status.success() {
+        return Ok(out);
     }
-    let said = String::from_utf8_lossy(&out.stderr);
-    let line = said.lines().rfind(|l| !l.trim().is_empty()).unwrap_or("").trim().to_string();
-    if line.is_empty() {
-        return Err(bad(format!("{program} {flag} failed ({})", out.status)));
+    let said = String::from_utf8_lossy(&err);
+    match reason(&said) {
+        Some(line) => Err(LaunchError::BadInput(format!("{}: {}{line}", file.display(), field[1]))),
+        None => Err(bad(format!("{program} {flag} failed ({status})"))),
     }
-    Err(LaunchError::BadInput(format!("{}: {}{line}", file.display(), field[1])))
+}
+
+/// What a failed sibling said: the reason of a panic (the line after "panicked at", not the
+/// backtrace note that ends it), an allocation that failed, or its last line.
+fn reason(stderr: &str) -> Option<String> {
+    let lines: Vec<&str> = stderr.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
+    if let Some(i) = lines.iter().position(|l| l.contains("panicked at")) {
+        return Some(format!("{} crashed: {}", lines[i].split(" panicked").next().unwrap_or("it"), lines.get(i + 1).copied().unwrap_or(lines[i])));
+    }
+    if let Some(l) = lines.iter().find(|l| l.starts_with("memory allocation of")) {
+        return Some(format!("{l} (its address space is capped at {} GiB)", SIBLING_ADDRESS_SPACE >> 30));
+    }
+    lines.last().map(|l| l.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::reason;
+
+    #[test]
+    fn a_panic_is_reported_by_its_reason_not_the_backtrace_note() {
+        let said = "thread 'main' (12) panicked at replay/src/mcap.rs:10:5:\nindex out of bounds\nnote: run with `RUST_BACKTRACE=1` environment variable to display a backtrace\n";
+        assert_eq!(reason(said).unwrap(), "thread 'main' (12) crashed: index out of bounds");
+        assert!(reason("memory allocation of 1099511627785 bytes failed\n").unwrap().contains("capped at 8 GiB"));
+        assert_eq!(reason("a\nplant.replay: no column 'x'\n\n").unwrap(), "plant.replay: no column 'x'");
+        assert_eq!(reason(""), None);
+    }
 }
