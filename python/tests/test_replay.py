@@ -217,7 +217,7 @@ def test_bad_csv_exits_2_before_anything_runs(motor, tmp_path, case):
     extra, want = "", None
     if case == "missing column":
         lines[0] = lines[0].replace("theta2_meas", "theta2_mea")
-        want = ['bad.csv: no column "theta2_meas" (plant.replay.outputs[6])', "did you mean", "the header has t, volts1"]
+        want = ["bad.csv: no column 'theta2_meas' (plant.replay.outputs[6])", "did you mean", "the header has 't', 'volts1'"]
     elif case == "non-finite cell":
         lines[101] = re.sub(r",[^,]*$", ",nan", lines[101])
         want = ['bad.csv: line 102 (row 101), column "theta2_meas"', "not finite"]
@@ -498,12 +498,12 @@ def swap_stamps(k0):
 
 
 BAD_MCAP = {
-    "no such channel": (dict(topic="/motors"), ["bad.mcap: no channel \"/motor\" (plant.replay.channel) (did you mean '/motors'?); the file has \"/motors\" (json), \"/notes\" (json)"]),
+    "no such channel": (dict(topic="/motors"), ["bad.mcap: no channel '/motor' (plant.replay.channel) (did you mean '/motors'?); the file has '/motors', '/notes'"]),
     "not json": (dict(encoding="cdr"), ['bad.mcap: channel "/motor" is encoded as "cdr"', 'only JSON channels']),
     "not an object": (dict(edit=lambda k, f, s: (b"[1, 2]", s) if k == 50 else None), ['bad.mcap: row 51 of "/motor": a JSON array, not an object']),
     "field missing": (dict(edit=drop_at(50, "volts1")), ['bad.mcap: row 51, field "volts1": not in the message', 'missing = "hold"']),
     "no such field": (dict(edit=lambda k, f, s: (json.dumps({("theta2_mea" if n == "theta2_meas" else n): v for n, v in f.items()}).encode(), s)),
-                      ['bad.mcap: no field "theta2_meas" (plant.replay.outputs[6]) in the first message of /motor (did you mean', "it has t, volts1, volts2, load1"]),
+                      ["bad.mcap: no field 'theta2_meas' (plant.replay.outputs[6]) in the first message of '/motor' (did you mean", "it has 't', 'volts1', 'volts2', 'load1'"]),
     "non-finite": (dict(edit=nan_at(100, "theta2_meas")), ['bad.mcap: row 101, field "theta2_meas": NaN is not finite']),
     "null": (dict(edit=lambda k, f, s: (json.dumps({**f, "omega1": None}).encode(), s) if k == 70 else None), ['bad.mcap: row 71, field "omega1": null is not finite']),
     "time goes back": (dict(edit=swap_stamps(200)), ["bad.mcap: row 202, log_time (s after the first message): t = 0.2 after t = 0.201: time stamps must increase"]),

@@ -11,6 +11,7 @@ use fmi::schema::fmi2::{Causality as C2, Fmi2ModelDescription, ScalarVariableEle
 use fmi::schema::fmi3::{AbstractVariableTrait, ArrayableVariableTrait, Causality as C3, Fmi3ModelDescription, Initial as I3, InitializableVariableTrait, Variable};
 use fmi::schema::minimal::MinModelDescription;
 use fmi::schema::traits::FmiModelDescription;
+use scenario::untrusted::quoted;
 
 /// FMI 2.0 or 3.0.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -114,15 +115,42 @@ pub const MAX_UNPACKED: u64 = 4 << 30;
 /// The longest `modelDescription.xml` read, bytes (a large model's is a few MB).
 pub const MAX_DESCRIPTION: u64 = 64 << 20;
 
-/// Reads and checks the archive at `path`.
+/// The most entries an FMU's archive may hold (a large FMU has hundreds).
+pub const MAX_ENTRIES: usize = 10_000;
+
+/// Reads and checks the archive at `path`. What the run extracts is checked here first (the run
+/// reads the archive with this before it extracts): at most [`MAX_ENTRIES`] entries, no symbolic
+/// link (a link at the library's path would load a host file) and no setuid/setgid mode, and
+/// the bytes the entries actually inflate to — counted, not their declared sizes — at most
+/// [`MAX_UNPACKED`].
 pub fn read(path: &Path) -> Result<Fmu, String> {
     let at = |why: String| format!("{}: {why}", path.display());
     let file = std::fs::File::open(path).map_err(|e| at(format!("cannot open: {e}")))?;
     let mut zip = zip::ZipArchive::new(file).map_err(|e| at(format!("not an FMU: not a zip archive ({e})")))?;
-    // The run extracts the whole archive: what it would unpack to is bounded before anything is.
-    let unpacked: u64 = (0..zip.len()).filter_map(|i| zip.by_index_raw(i).ok().map(|f| f.size())).sum();
-    if unpacked > MAX_UNPACKED {
-        return Err(at(format!("unpacks to {unpacked} bytes, more than the {MAX_UNPACKED} an FMU plant may")));
+    if zip.len() > MAX_ENTRIES {
+        return Err(at(format!("holds {} entries, more than the {MAX_ENTRIES} an FMU plant may", zip.len())));
+    }
+    for i in 0..zip.len() {
+        let f = zip.by_index_raw(i).map_err(|e| at(format!("entry {}: {e}", i + 1)))?;
+        let mode = f.unix_mode().unwrap_or(0);
+        if mode & 0o170000 == 0o120000 {
+            return Err(at(format!("entry {} is a symbolic link: an FMU plant's archive holds files only", quoted(f.name()))));
+        }
+        if mode & 0o6000 != 0 {
+            return Err(at(format!("entry {} has the setuid or setgid bit ({mode:o}): refused", quoted(f.name()))));
+        }
+    }
+    // The run extracts the whole archive: what it unpacks to is bounded before anything is, by
+    // inflating every entry here (a declared size can lie; the CRC does not bound it).
+    let mut unpacked = 0u64;
+    for i in 0..zip.len() {
+        let mut f = zip.by_index(i).map_err(|e| at(format!("entry {}: {e}", i + 1)))?;
+        let left = MAX_UNPACKED - unpacked;
+        let n = std::io::copy(&mut (&mut f).take(left + 1), &mut std::io::sink()).map_err(|e| at(format!("entry {}: {e}", quoted(f.name()))))?;
+        unpacked += n;
+        if n > left {
+            return Err(at(format!("unpacks to more than the {MAX_UNPACKED} bytes an FMU plant may (entry {} alone inflates past it)", quoted(f.name()))));
+        }
     }
     let mut xml = String::new();
     zip.by_name("modelDescription.xml")
@@ -143,6 +171,12 @@ pub fn read(path: &Path) -> Result<Fmu, String> {
         Version::Two => from_fmi2(&xml).map_err(at)?,
         Version::Three => from_fmi3(&xml).map_err(at)?,
     };
+    // The library is binaries/<platform>/<modelIdentifier>.so inside the extraction: the
+    // identifier must be a plain file name, so the path cannot leave it.
+    let id = &fmu.model_identifier;
+    if id.is_empty() || id.starts_with('.') || !id.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-' || c == '.') {
+        return Err(at(format!("modelIdentifier {} is not a plain file name (letters, digits, _ - .): refused", quoted(id))));
+    }
     let binary = binary_path(version, &fmu.model_identifier);
     if zip.index_for_name(&binary).is_none() {
         let present: Vec<String> = zip.file_names().filter(|n| n.starts_with("binaries/") && !n.ends_with('/')).map(str::to_string).collect();

@@ -36,7 +36,7 @@ pub fn resolve(p: &Params) -> Result<(Fmu, Map), String> {
     let find = |field: String, name: &str, ok: &[Causality], role: &str| -> Result<&Var, String> {
         let Some(v) = fmu.vars.get(name) else {
             let hint = scenario::suggest::did_you_mean(name, fmu.vars.keys().map(String::as_str));
-            return Err(format!("{field}: {} has no variable named {}{hint}", scenario::untrusted::quoted(&file), scenario::untrusted::quoted(name)));
+            return Err(format!("{field}: {file} has no variable named {}{hint}", scenario::untrusted::quoted(name)));
         };
         if !ok.contains(&v.causality) {
             return Err(format!("{field}: '{name}' of {file} is {}, not {role}", v.causality.name()));

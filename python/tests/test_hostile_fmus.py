@@ -1,0 +1,128 @@
+"""FMU archives contained (issue 32, item 3): hostile FMUs made here from this repository's
+DC-motor FMU, each refused by the pre-flight check (exit 2, one line naming the entry or the
+identifier) before anything is extracted or loaded:
+
+* the library entry `binaries/linux64/dc_motor.so` replaced by a symbolic link to a host library
+  (before: passed `--check`, and the run dlopened the host file);
+* a `modelIdentifier` that is a path (`../../../tmp/evil`, `/usr/lib/…/libm`);
+* the library with the setuid bit;
+* more entries than an FMU may hold.
+"""
+
+import os
+import re
+import shutil
+import stat
+import subprocess
+import zipfile
+
+import pytest
+
+from test_diagnosis_scipy import launcher
+from test_fmu_testfmus import fmu_dir  # noqa: F401 (fixture)
+
+LIBRARY = "binaries/linux64/dc_motor.so"
+
+
+def rebuild(src, dst, edit):
+    """Copies the archive entry by entry; `edit(info, data)` returns the entries to write
+    instead of each (a list of (ZipInfo, bytes))."""
+    with zipfile.ZipFile(src) as zin, zipfile.ZipFile(dst, "w", zipfile.ZIP_DEFLATED) as zout:
+        for info in zin.infolist():
+            for new, data in edit(info, zin.read(info)):
+                zout.writestr(new, data)
+
+
+def scenario(tmp_path, fmu):
+    s = tmp_path / "s.toml"
+    s.write_text(f"""name = "hostile"
+dt = 0.01
+duration = 0.1
+[plant]
+A = [[-4.0, -0.2, 0.0], [5.0, -2.5, 0.0], [0.0, 1.0, 0.0]]
+B = [[2.0], [0.0], [0.0]]
+C = [[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+E = [[0.0], [-50.0], [0.0]]
+x0 = [0.0, 0.0, 0.0]
+[plant.fmu]
+path = "{fmu}"
+inputs = ["u1"]
+disturbances = ["w1"]
+outputs = ["y1", "y2"]
+states = ["x1", "x2", "x3"]
+[[input]]
+kind = "constant"
+value = 1.0
+[[disturbance]]
+kind = "constant"
+value = 0.0
+[[observer]]
+name = "luenberger"
+kind = "luenberger"
+poles = [-5.0, -6.0, -7.0]
+""")
+    return s
+
+
+def refused(tmp_path, fmu, says):
+    p = subprocess.run([launcher(), "run", str(scenario(tmp_path, fmu)), "--out", str(tmp_path / "out")], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 2 and says in p.stderr and len(p.stderr.strip().splitlines()) == 1, p.stderr
+    assert not (tmp_path / "out").exists() or list((tmp_path / "out").iterdir()) == []
+    print(p.stderr.strip())
+
+
+def test_the_untouched_fmu_runs(fmu_dir, tmp_path):  # noqa: F811
+    """The control case: the archive these tests edit passes and runs."""
+    p = subprocess.run([launcher(), "run", str(scenario(tmp_path, os.path.join(fmu_dir, "dc_motor_fmi2.fmu"))), "--out", str(tmp_path / "out")],
+                       capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+
+
+def test_a_library_that_is_a_symbolic_link_is_refused(fmu_dir, tmp_path):  # noqa: F811
+    bad = tmp_path / "link.fmu"
+
+    def edit(info, data):
+        if info.filename != LIBRARY:
+            return [(info, data)]
+        link = zipfile.ZipInfo(LIBRARY)
+        link.create_system = 3
+        link.external_attr = (stat.S_IFLNK | 0o777) << 16
+        return [(link, b"/lib/x86_64-linux-gnu/libm.so.6")]
+
+    rebuild(os.path.join(fmu_dir, "dc_motor_fmi2.fmu"), bad, edit)
+    refused(tmp_path, bad, f"entry '{LIBRARY}' is a symbolic link")
+
+
+@pytest.mark.parametrize("identifier", ["../../../tmp/evil", "/usr/lib/x86_64-linux-gnu/libm"])
+def test_a_model_identifier_that_is_a_path_is_refused(fmu_dir, tmp_path, identifier):  # noqa: F811
+    bad = tmp_path / "path.fmu"
+
+    def edit(info, data):
+        if info.filename == "modelDescription.xml":
+            return [(info, re.sub(rb'modelIdentifier="[^"]*"', f'modelIdentifier="{identifier}"'.encode(), data))]
+        return [(info, data)]
+
+    rebuild(os.path.join(fmu_dir, "dc_motor_fmi2.fmu"), bad, edit)
+    refused(tmp_path, bad, "is not a plain file name")
+
+
+def test_a_setuid_library_is_refused(fmu_dir, tmp_path):  # noqa: F811
+    bad = tmp_path / "setuid.fmu"
+
+    def edit(info, data):
+        if info.filename == LIBRARY:
+            info.create_system = 3
+            info.external_attr = (stat.S_IFREG | stat.S_ISUID | 0o755) << 16
+        return [(info, data)]
+
+    rebuild(os.path.join(fmu_dir, "dc_motor_fmi2.fmu"), bad, edit)
+    refused(tmp_path, bad, "setuid or setgid")
+
+
+def test_an_archive_of_too_many_entries_is_refused(fmu_dir, tmp_path):  # noqa: F811
+    bad = tmp_path / "many.fmu"
+    shutil.copy(os.path.join(fmu_dir, "dc_motor_fmi2.fmu"), bad)
+    with zipfile.ZipFile(bad, "a") as z:
+        for i in range(10_001):
+            z.writestr(f"resources/empty{i}", b"")
+    refused(tmp_path, bad, "more than the 10000")
