@@ -2,7 +2,7 @@
 //! component configurations, all removed when the run ends.
 //!
 //! Layout: `$UIO_RUNS_DIR/<id>/` (default `$XDG_RUNTIME_DIR/uio-observers/<id>/`, else
-//! `/tmp/uio-observers/<id>/`, mode 0700) holds `owner.pid` (the launcher's pid), one
+//! `/tmp/uio-observers-<uid>/<id>/`, mode 0700) holds `owner.pid` (the launcher's pid), one
 //! `<component>.json` per component, and `iox2/`, the iceoryx2 root path; shared memory lives in
 //! `/dev/shm/uio<id>_*`. The runs directory is used only when it is private (see
 //! [`crate::run_dir`]), and nothing is removed that is not provably a dead run of ours.
@@ -27,18 +27,22 @@ const SHM_DIR: &str = "/dev/shm";
 
 /// Where a run's iceoryx2 root goes when `<run dir>/iox2/` is too long: iceoryx2 names the
 /// unix sockets of its event services (the `block`, `waitset` and `spin-then-block` waits)
-/// after the root, and a socket's path holds at most 108 bytes.
-const SHORT_ROOTS: &str = "/tmp/uio-iox2";
+/// after the root, and a socket's path holds at most 108 bytes. One per user,
+/// `/tmp/uio-iox2-<uid>`: a folder of fixed name belongs to whoever makes it first, and would
+/// lock every other user out (issue 32).
+fn short_roots() -> PathBuf {
+    PathBuf::from(format!("/tmp/uio-iox2-{}", crate::run_dir::euid()))
+}
 
 /// The longest root that leaves room for iceoryx2's socket names (measured: a 62-byte root
 /// fails, a 57-byte one works).
 const MAX_ROOT: usize = 56;
 
-/// The iceoryx2 root of run `id` in `dir`: `<dir>/iox2/`, or `/tmp/uio-iox2/<id>/` when that is
+/// The iceoryx2 root of run `id` in `dir`: `<dir>/iox2/`, or `/tmp/uio-iox2-<uid>/<id>/` when that is
 /// too long (a deep `UIO_RUNS_DIR`). A function of the two, so every process finds the same.
 pub fn iox2_root(dir: &Path, id: &str) -> PathBuf {
     let inside = dir.join("iox2");
-    if inside.as_os_str().len() < MAX_ROOT { inside } else { Path::new(SHORT_ROOTS).join(id) }
+    if inside.as_os_str().len() < MAX_ROOT { inside } else { short_roots().join(id) }
 }
 
 /// A run's identity and its iceoryx2 configuration.
@@ -71,7 +75,7 @@ pub fn prepare_runs_dir() -> Result<PathBuf, LockstepError> {
     // The longest id this process can make: its pid, a counter below 10⁶, a six-digit nonce.
     let longest = format!("{}x999999x999999", std::process::id());
     if !iox2_root(&base.join(&longest), &longest).starts_with(&base) {
-        ensure_private(ROOTS, Path::new(SHORT_ROOTS))?;
+        ensure_private(ROOTS, &short_roots())?;
     }
     Ok(base)
 }
@@ -114,7 +118,7 @@ impl RunSpace {
         let dir = base.join(&id);
         let root = iox2_root(&dir, &id);
         if !root.starts_with(&dir) {
-            let roots = ensure_private(ROOTS, Path::new(SHORT_ROOTS))?;
+            let roots = ensure_private(ROOTS, &short_roots())?;
             roots.mkdir(OsStr::new(&id)).map_err(|e| io("cannot create", &root, e))?;
         }
         fs::rename(&tmp, &dir).map_err(|e| io("cannot create", &dir, e))?;
@@ -232,7 +236,7 @@ impl RunSpace {
         {
             let _ = runs.remove_tree(OsStr::new(&self.id));
         }
-        if let Ok(roots) = open_private(ROOTS, Path::new(SHORT_ROOTS)) {
+        if let Ok(roots) = open_private(ROOTS, &short_roots()) {
             let _ = roots.remove_tree(OsStr::new(&self.id));
         }
     }
@@ -302,7 +306,7 @@ pub fn cleanup_dead_runs() -> usize {
             let _ = runs.remove_tree(&name);
             if !building {
                 remove_shm_with_prefix(&format!("uio{id}_"));
-                if let Ok(roots) = open_private(ROOTS, Path::new(SHORT_ROOTS)) {
+                if let Ok(roots) = open_private(ROOTS, &short_roots()) {
                     let _ = roots.remove_tree(OsStr::new(&id));
                 }
                 cleaned += 1;
@@ -310,7 +314,7 @@ pub fn cleanup_dead_runs() -> usize {
         }
     }
     // Short iceoryx2 roots are named after their run id, <launcher pid>x…: the owner is in the name.
-    if let Ok(roots) = open_private(ROOTS, Path::new(SHORT_ROOTS)) {
+    if let Ok(roots) = open_private(ROOTS, &short_roots()) {
         for name in roots.names().unwrap_or_default() {
             let Some(pid) = name.to_str().and_then(id_pid) else { continue };
             let ours = roots.stat_at(&name).is_ok_and(|s| s.is_dir() && s.is_ours());
@@ -343,6 +347,6 @@ mod tests {
         let id = format!("{}x0x123456", std::process::id());
         assert!(is_run_id(&id));
         let root = iox2_root(&Path::new("/a/very/long/runs/directory/that/is/far/too/long/for").join(&id), &id);
-        assert_eq!(root, Path::new(SHORT_ROOTS).join(&id));
+        assert_eq!(root, short_roots().join(&id));
     }
 }

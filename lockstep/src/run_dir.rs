@@ -285,14 +285,15 @@ pub(crate) fn ensure_private(what: &str, path: &Path) -> Result<Dir, LockstepErr
 
 /// The default runs directory: `$XDG_RUNTIME_DIR/uio-observers` when `xdg` (that variable) is
 /// an absolute path to a real directory of ours — per user and on tmpfs — else
-/// `/tmp/uio-observers`.
+/// `/tmp/uio-observers-<uid>`, one per user (a shared name belongs to whoever makes it first and
+/// would lock every other user out).
 pub(crate) fn default_runs_dir(xdg: Option<&OsStr>) -> PathBuf {
     let usable = xdg.map(Path::new).filter(|p| p.is_absolute()).is_some_and(|p| {
         std::fs::symlink_metadata(p).is_ok_and(|m| m.file_type().is_dir() && m.uid() == euid())
     });
     match xdg {
         Some(x) if usable => Path::new(x).join("uio-observers"),
-        _ => PathBuf::from("/tmp/uio-observers"),
+        _ => PathBuf::from(format!("/tmp/uio-observers-{}", euid())),
     }
 }
 
@@ -393,9 +394,9 @@ mod tests {
         std::os::unix::fs::symlink(&s, s.join("link")).unwrap();
         assert_eq!(default_runs_dir(Some(s.as_os_str())), s.join("uio-observers"));
         for bad in [s.join("link"), s.join("missing"), PathBuf::from("relative")] {
-            assert_eq!(default_runs_dir(Some(bad.as_os_str())), Path::new("/tmp/uio-observers"), "{}", bad.display());
+            assert_eq!(default_runs_dir(Some(bad.as_os_str())), Path::new(&format!("/tmp/uio-observers-{}", euid())), "{}", bad.display());
         }
-        assert_eq!(default_runs_dir(None), Path::new("/tmp/uio-observers"));
+        assert_eq!(default_runs_dir(None), Path::new(&format!("/tmp/uio-observers-{}", euid())));
         std::fs::remove_dir_all(&s).unwrap();
     }
 

@@ -31,8 +31,8 @@ EXIT_FAILED = 3
 EXIT_DIVERGED = 4
 
 #: Where run directories live when `$UIO_RUNS_DIR` is not set and there is no usable
-#: `$XDG_RUNTIME_DIR` (the launcher's rule: see `default_runs_dir`).
-DEFAULT_RUNS_DIR = "/tmp/uio-observers"
+#: `$XDG_RUNTIME_DIR` (the launcher's rule: see `default_runs_dir`): one per user.
+DEFAULT_RUNS_DIR = f"/tmp/uio-observers-{os.geteuid()}"
 
 
 def default_runs_dir(env):

@@ -268,7 +268,7 @@ fn the_default_runs_directory_is_a_private_one_in_xdg_runtime_dir() {
         return;
     }
     let s = Scratch::new("rd-xdg");
-    // Deep enough that the iceoryx2 root moves to /tmp/uio-iox2/<run>.
+    // Deep enough that the iceoryx2 root moves to /tmp/uio-iox2-<uid>/<run>.
     let xdg = s.join("xdg");
     private_dir(&xdg);
     let (o, pid) = run_launcher(&s, &scenario_of(&s), None, &[("XDG_RUNTIME_DIR", &xdg)]);
@@ -278,7 +278,7 @@ fn the_default_runs_directory_is_a_private_one_in_xdg_runtime_dir() {
     assert!(m.is_dir() && m.uid() == 0 && m.mode() & 0o777 == 0o700, "mode {:o}, uid {}", m.mode(), m.uid());
     let left: Vec<_> = fs::read_dir(&runs).unwrap().flatten().map(|e| e.path()).collect();
     assert!(left.is_empty(), "run directories left: {left:?}");
-    let short: Vec<_> = fs::read_dir("/tmp/uio-iox2")
+    let short: Vec<_> = fs::read_dir("/tmp/uio-iox2-0")
         .map(|d| d.flatten().map(|e| e.file_name()).filter(|n| n.to_string_lossy().starts_with(&format!("{pid}x"))).collect())
         .unwrap_or_default();
     assert!(short.is_empty(), "short iceoryx2 roots left: {short:?}");
