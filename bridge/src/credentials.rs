@@ -102,7 +102,17 @@ pub fn init(dir: &Path, force: bool) -> Result<(), String> {
         return Err(format!("{} already holds credentials (--force replaces them, and every host then needs the new ones)", dir.display()));
     }
     fs::DirBuilder::new().recursive(true).mode(0o700).create(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    fs::set_permissions(dir, fs::Permissions::from_mode(0o700)).map_err(|e| format!("{}: {e}", dir.display()))?;
+    // Opened without following a link and checked as ours before its mode is set: a link or a
+    // folder of another user planted at `dir` must not get root's chmod or root's keys.
+    let opened = fs::OpenOptions::new().read(true).custom_flags(libc::O_NOFOLLOW | libc::O_DIRECTORY).open(dir);
+    let folder = opened.map_err(|e| format!("{}: not a real directory ({e}); refusing to write credentials there", dir.display()))?;
+    // SAFETY: geteuid has no preconditions.
+    let me = unsafe { libc::geteuid() };
+    let owner = folder.metadata().map_err(|e| format!("{}: {e}", dir.display()))?.uid();
+    if owner != me {
+        return Err(format!("{}: belongs to uid {owner}, not to this user ({me}); refusing to write credentials there", dir.display()));
+    }
+    folder.set_permissions(fs::Permissions::from_mode(0o700)).map_err(|e| format!("{}: {e}", dir.display()))?;
 
     let mut ca = CertificateParams::new(Vec::<String>::new()).map_err(err)?;
     ca.distinguished_name.push(DnType::CommonName, "uio-observers CA");
@@ -143,6 +153,26 @@ fn write(path: &Path, text: &str, mode: u32) -> Result<(), String> {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn init_refuses_a_link_and_a_folder_of_another_user() {
+        let base = std::env::temp_dir().join(format!("creds-planted-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&base);
+        std::fs::create_dir_all(base.join("target")).unwrap();
+        std::os::unix::fs::symlink(base.join("target"), base.join("link")).unwrap();
+        let e = super::init(&base.join("link"), false).unwrap_err();
+        assert!(e.contains("not a real directory"), "{e}");
+        assert!(!base.join("target/ca.pem").exists());
+        if unsafe { libc::geteuid() } == 0 {
+            let other = base.join("other");
+            std::fs::create_dir(&other).unwrap();
+            std::os::unix::fs::chown(&other, Some(65534), Some(65534)).unwrap();
+            let e = super::init(&other, false).unwrap_err();
+            assert!(e.contains("belongs to uid 65534"), "{e}");
+            assert!(!other.join("ca.pem").exists());
+        }
+        std::fs::remove_dir_all(&base).unwrap();
+    }
+
     use super::*;
 
     #[test]
