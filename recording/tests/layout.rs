@@ -25,6 +25,8 @@ fn scratch(tag: &str) -> PathBuf {
 /// an input estimate one step late), `steps` rows of values no two alike.
 fn write_layout_2(path: &std::path::Path, steps: u64, every: u64, compress: bool) -> (BTreeMap<String, Series>, usize) {
     let select = recording::write::Selection::new(every, &[]).unwrap().compressed(compress);
+    // The sink makes its file new (crate outputs): the previous case's file goes first.
+    let _ = std::fs::remove_file(path);
     let mut sink = RrdSink::create(path, "layout", empty_blueprint, "name = \"layout\"", select).unwrap();
     let (now, late) = (sink.group("signals"), sink.group("what"));
     let mut paths: Vec<String> = (1..=3).map(|i| format!("/plant/x/{i}")).chain((1..=2).map(|j| format!("/plant/y/{j}"))).chain(["/disturbance/1".into(), "/input/1".into(), "/input/2".into()]).collect();
