@@ -73,11 +73,14 @@ pub fn sibling(file: &std::path::Path, field: [&str; 2], program: &str, flag: &s
     super::interrupt::install();
     let mut command = Command::new(&path);
     command.arg(flag).stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped()).process_group(0);
-    // SAFETY: setrlimit is async-signal-safe; nothing else runs between fork and exec.
+    // SAFETY: setrlimit and prctl are async-signal-safe; nothing else runs between fork and
+    // exec. Out of the terminal's process group, the child dies with the launcher instead
+    // (PR_SET_PDEATHSIG), as the run's components do.
     unsafe {
         command.pre_exec(|| {
             let limit = libc::rlimit { rlim_cur: SIBLING_ADDRESS_SPACE, rlim_max: SIBLING_ADDRESS_SPACE };
             libc::setrlimit(libc::RLIMIT_AS, &limit);
+            libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL);
             Ok(())
         });
     }
