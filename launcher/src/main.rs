@@ -561,6 +561,10 @@ fn main() -> ExitCode {
             }
         }
         Command::Export { recording, csv, mcap, npz, mat, deviations } => {
+            // An export written over its own recording would replace the data it was made from.
+            if let Some(p) = [&mcap, &npz, &mat].into_iter().flatten().find(|p| same_file(p, &recording)) {
+                return fail(&LaunchError::BadInput(format!("{}: is the recording being exported ({}); refusing to write over it", p.display(), recording.display())));
+            }
             let r = match read_recording(&recording).and_then(|r| shifted(&recording, r, deviations)) {
                 Ok(r) => r,
                 Err(code) => return code,
@@ -624,6 +628,15 @@ fn read_recording(path: &Path) -> Result<recording::Recording, ExitCode> {
         return Err(fail(&LaunchError::Damaged(format!("{}: damaged: {why}", path.display()))));
     }
     Ok(r)
+}
+
+/// Whether `a` and `b` name one existing file (the same device and inode: links and `..` alike).
+fn same_file(a: &Path, b: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (std::fs::metadata(a), std::fs::metadata(b)) {
+        (Ok(x), Ok(y)) => x.dev() == y.dev() && x.ino() == y.ino(),
+        _ => false,
+    }
 }
 
 /// `r` in deviations from its operating point when asked (`--deviations`), else as recorded.

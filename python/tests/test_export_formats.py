@@ -240,6 +240,17 @@ def test_a_damaged_recording_writes_nothing(exported, tmp_path):
     assert csv_exit(bad, tmp_path) == 6 and not left_behind(tmp_path)
 
 
+@pytest.mark.parametrize("flag", ["--mcap", "--npz", "--mat"])
+def test_an_export_over_its_own_recording_is_refused(exported, tmp_path, flag):
+    """Before, `export x.rrd --mcap x.rrd` replaced the recording with its own export."""
+    rrd = tmp_path / "copy.rrd"
+    shutil.copy(exported["rrd"], rrd)
+    before = rrd.read_bytes()
+    done = export(rrd, flag, tmp_path / "." / "copy.rrd")
+    assert done.returncode == 2 and "is the recording being exported" in done.stderr, done.stderr
+    assert rrd.read_bytes() == before
+
+
 def test_no_format_is_a_usage_error(exported):
     done = export(exported["rrd"])
     assert done.returncode == 2 and "--mcap" in done.stderr
