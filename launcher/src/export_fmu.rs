@@ -38,6 +38,7 @@ pub fn export_fmu(s: &Scenario, observer: &str, out: &Path, fmi: Fmi) -> Result<
         let point = OperatingPoint { u: op.u.clone(), y: op.y.clone(), c_z: off.z, c_x: off.x, c_r };
         res = res.at_operating_point(point).map_err(|e| bad(format!("observer '{}': {e}", o.name)))?;
     }
+    let at_point = res.operating_point.is_some();
     let signals = |v: &[scenario::Named]| v.iter().map(|n| Signal { name: n.name.clone(), unit: n.unit.clone() }).collect();
     let desc = Description {
         model_identifier: fmu_export::identifier(&o.name),
@@ -48,9 +49,9 @@ pub fn export_fmu(s: &Scenario, observer: &str, out: &Path, fmi: Fmi) -> Result<
             o.name,
             s.name,
             s.dt,
-            if res.operating_point.is_some() { " + c_z" } else { "" },
-            if res.operating_point.is_some() { " + c_x" } else { "" },
-            if res.operating_point.is_some() { "; designed in deviations from its operating point, fed and giving absolute signals (the inputs start there)" } else { "" }
+            if at_point { " + c_z" } else { "" },
+            if at_point { " + c_x" } else { "" },
+            if at_point { "; designed in deviations from its operating point, fed and giving absolute signals (the inputs start there)" } else { "" }
         ),
         states: signals(&s.names.state),
         outputs: signals(&s.names.output),

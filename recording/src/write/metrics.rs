@@ -173,15 +173,12 @@ impl Metrics {
             }
             let mut rmax: f64 = 0.0;
             mul_into(res, &self.c, xhat);
-            for (r, &yj) in res.iter_mut().zip(y) {
+            // One pass: r = y − Cx̂ (− c_r at a point whose output map is not linear).
+            for (j, (r, &yj)) in res.iter_mut().zip(y).enumerate() {
                 *r = yj - *r;
-            }
-            if let Some(c_r) = &self.c_r {
-                for (r, c) in res.iter_mut().zip(c_r) {
-                    *r -= c;
+                if let Some(c_r) = &self.c_r {
+                    *r -= c_r[j];
                 }
-            }
-            for r in res.iter() {
                 rmax = nan_max(rmax, r.abs());
             }
             if let Some(what) = what {
