@@ -189,7 +189,9 @@ fn solve(a: &Mat, b: &Mat, q: &Mat, r: &Mat, words: Words) -> Result<Dare> {
         // (quadratic convergence from ~10⁻¹² … 10⁻⁸ off). In a critical case the Stein operator is
         // singular (A − BK has a mode on the circle): the steps fail, and the radius check below
         // names the cause.
-        if let Ok((refined, steps, _)) = newton_steps(a, b, &q, &r, x.clone(), MAX_REFINE)
+        if n > DD_MAX {
+            (x, newton) = refine_large(a, b, &q, &r, x);
+        } else if let Ok((refined, steps, _)) = newton_steps(a, b, &q, &r, x.clone(), MAX_REFINE)
             && let (Ok((new, _)), Ok((old, _))) =
                 (residual(a, b, &q, &r, &refined), residual(a, b, &q, &r, &x))
             && new <= old
@@ -264,7 +266,7 @@ pub fn steady_state_kalman(a: &Mat, c: &Mat, qd: &Mat, r: &Mat) -> Result<Kalman
         .ok_or(LtiError::Singular("the innovation covariance"))?;
     let gain = chol.solve(&(c * &pm)).transpose();
     let i_lc = Mat::identity(n, n) - &gain * c;
-    let p_updated = sym(&(&i_lc * &pm * i_lc.transpose() + &gain * &r * gain.transpose()));
+    let p_updated = sym(&(mul(&mul(&i_lc, &pm), &i_lc.transpose()) + &gain * &r * gain.transpose()));
     Ok(Kalman {
         predictor_gain: a * &gain,
         p: pm,
@@ -350,10 +352,46 @@ fn newton_steps(
     Ok((x, max, false))
 }
 
+/// Newton refinement above [`DD_MAX`] states, where the residual is formed in double: one step
+/// at a time, kept while it lowers the relative residual, stopped once that is at rounding
+/// ([`REFINED`]). Each step is a Stein equation (Smith's doubling, ~log₂(36/(1 − ρ)) products
+/// of n × n); on the 1000-state model of BENCHMARKS.md SDA's X scored 5.4e-10, one step
+/// 1.2e-15, and the next five moved X only by its rounding (corrections 1.9e-7 … 1.7e-7 on
+/// ‖X‖₁ = 2.2e5) at 4–5 s each — the stopping rule of [`newton_steps`], made for
+/// double-double residuals, never fired.
+fn refine_large(a: &Mat, b: &Mat, q: &Mat, r: &Mat, mut x: Mat) -> (Mat, usize) {
+    let Ok((mut score, _)) = residual(a, b, q, r, &x) else {
+        return (x, 0);
+    };
+    let mut kept = 0;
+    while kept < MAX_REFINE && score > REFINED {
+        let Ok((next, 1, _)) = newton_steps(a, b, q, r, x.clone(), 1) else {
+            break;
+        };
+        match residual(a, b, q, r, &next) {
+            Ok((s, _)) if s < score => (x, score, kept) = (next, s, kept + 1),
+            _ => break,
+        }
+    }
+    (x, kept)
+}
+
+/// The relative residual (as [`Dare::residual`]) at which a large model's refinement stops:
+/// a few hundred ε, where a double-precision Newton step no longer improves X (1.2e-15 after
+/// one step on the 1000-state model, then 5.4e-16 … 5.8e-16).
+const REFINED: f64 = 64.0 * f64::EPSILON;
+
 /// K = (R + BᵀXB)⁻¹BᵀXA and A − BK.
 fn gain(a: &Mat, b: &Mat, r: &Mat, x: &Mat) -> Result<(Mat, Mat)> {
-    let s = sym(&(r + b.transpose() * x * b));
-    let rhs = b.transpose() * x * a;
+    // From 96 states on through faer's products (the n × n ones dominate); nalgebra's below,
+    // in the same order: the reference designs' bits.
+    let bt = b.transpose();
+    let (s, rhs) = if a.nrows() < product::LARGE {
+        (sym(&(r + &bt * x * b)), &bt * x * a)
+    } else {
+        let btx = mul(&bt, x);
+        (sym(&(r + mul(&btx, b))), mul(&btx, a))
+    };
     let k = match s.clone().cholesky() {
         Some(ch) => ch.solve(&rhs),
         // R + BᵀXB ≻ 0 for X ⪰ 0; an iterate slightly indefinite by rounding still solves.
@@ -376,7 +414,8 @@ fn gain(a: &Mat, b: &Mat, r: &Mat, x: &Mat) -> Result<(Mat, Mat)> {
 fn riccati_residual(a: &Mat, b: &Mat, q: &Mat, r: &Mat, x: &Mat, k: &Mat) -> Mat {
     if a.nrows() > DD_MAX {
         let ac = a - b * k;
-        return sym(&(q + ac.transpose() * x * &ac + k.transpose() * r * k - x));
+        let acxac = mul(&mul(&ac.transpose(), x), &ac);
+        return sym(&(q + acxac + k.transpose() * r * k - x));
     }
     let [a, b, q, r, x, k] = [a, b, q, r, x, k].map(DdMatrix::from_f64);
     let ac = a.add(&b.mul(&k), -1.0);
@@ -391,7 +430,7 @@ fn residual(a: &Mat, b: &Mat, q: &Mat, r: &Mat, x: &Mat) -> Result<(f64, Mat)> {
     let (k, ac) = gain(a, b, r, x)?;
     let res = one_norm(&riccati_residual(a, b, q, r, x, &k));
     let scale = one_norm(q)
-        + one_norm(&(ac.transpose() * x * &ac))
+        + one_norm(&mul(&mul(&ac.transpose(), x), &ac))
         + one_norm(&(k.transpose() * r * &k))
         + one_norm(x);
     Ok((if scale > 0.0 { res / scale } else { res }, k))
