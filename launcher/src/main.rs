@@ -315,6 +315,12 @@ fn main() -> ExitCode {
         speed: None,
         stall_timeout: None,
     });
+    if matches!(command, Command::Run { .. } | Command::Sweep { .. } | Command::Bench { .. } | Command::Agent { .. }) {
+        // Dead runs of ours in the machine's /dev/shm go first; then this process and all it
+        // starts move to a /dev/shm of their own, before any thread or segment exists (issue 32).
+        lockstep::cleanup_dead_runs();
+        let _ = lockstep::private_shm::enter();
+    }
     match command {
         Command::Run { scenario, out, mode, wait, force, allow_unstable, pin, record_every, record, compress, seed, realtime, speed, stall_timeout } => {
             let speed = speed.unwrap_or(1.0);

@@ -32,6 +32,7 @@ mod error;
 mod handshake;
 mod layout;
 mod port;
+pub mod private_shm;
 mod quiet;
 mod run;
 mod run_dir;

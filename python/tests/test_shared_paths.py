@@ -3,6 +3,10 @@
 * Two users side by side: root and `nobody` run at the same time with the default runs and
   iceoryx2 folders (no `UIO_RUNS_DIR`, no `XDG_RUNTIME_DIR`). Before, `/tmp/uio-observers`
   belonged to whoever made it first and the other user was refused (exit 2).
+* The node-counter race: root's runs while `nobody` watches /dev/shm for iceoryx2's node-counter
+  segments (`…global_mgmt`, set to 0666 by iceoryx2 itself) and writes into any it can open.
+  Before, such a watcher broke 20 of 20 runs (`UnableToGenerateUniqueNodeId`, exit 3); the
+  launcher now runs in a /dev/shm of its own that no other process can see.
 
 Runs only as root with `runuser` and a `nobody` account (skipped otherwise, and said so).
 """
@@ -12,6 +16,7 @@ import pwd
 import shutil
 import subprocess
 import tempfile
+import time
 from pathlib import Path
 
 import pytest
@@ -75,3 +80,47 @@ def test_two_users_run_side_by_side_with_the_default_folders(public):
     for who, path in ((0, "/tmp/uio-observers-0"), (uid, f"/tmp/uio-observers-{uid}")):
         st = os.lstat(path)
         assert st.st_uid == who and st.st_mode & 0o777 == 0o700, (path, oct(st.st_mode))
+
+
+WATCHER = r"""
+import os, sys, time
+stop = time.monotonic() + float(sys.argv[1])
+seen, written = set(), 0
+while time.monotonic() < stop and not os.path.exists(sys.argv[2]):
+    for name in os.listdir("/dev/shm"):
+        if name.startswith("uio"):
+            seen.add(name)
+            if name.endswith("global_mgmt"):
+                try:
+                    with open("/dev/shm/" + name, "r+b") as f:
+                        f.write(b"\xff" * 16)
+                    written += 1
+                except OSError:
+                    pass
+print(len(seen), written)
+"""
+
+
+def test_a_watcher_as_nobody_neither_sees_nor_breaks_twenty_runs(public):
+    """20 runs as root while a `nobody` process scans /dev/shm without pause for the runs'
+    segments: every run ends with exit 0, and the watcher never saw a file of theirs."""
+    (public / "watcher.py").write_text(WATCHER)
+    (public / "watcher.py").chmod(0o644)
+    done = public / "done"
+    watcher = subprocess.Popen(["runuser", "-u", "nobody", "--", "/usr/bin/python3", str(public / "watcher.py"), "300", str(done)],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        time.sleep(0.5)
+        failed = []
+        for i in range(20):
+            run = subprocess.run([launcher(), "run", str(public / "shared.toml"), "--out", str(public / f"out{i}")],
+                                 capture_output=True, text=True, env=clean_env(), timeout=120)
+            if run.returncode != 0:
+                failed.append((i, run.returncode, run.stderr.strip().splitlines()[-1:]))
+    finally:
+        done.write_text("")
+        out, err = watcher.communicate(timeout=60)
+    assert watcher.returncode == 0, err
+    seen, written = map(int, out.split())
+    assert failed == [], failed
+    assert (seen, written) == (0, 0), f"the watcher saw {seen} run file(s) in /dev/shm and wrote into {written}"
