@@ -6,7 +6,11 @@ identifier) before anything is extracted or loaded:
   (before: passed `--check`, and the run dlopened the host file);
 * a `modelIdentifier` that is a path (`../../../tmp/evil`, `/usr/lib/…/libm`);
 * the library with the setuid bit;
-* more entries than an FMU may hold.
+* more entries than an FMU may hold;
+* a library that exports no FMI function (before: it loaded, and the first call panicked the
+  plant, exit 101, "run with RUST_BACKTRACE");
+* a library for another architecture (before: "cannot open shared object file: No such file or
+  directory" about a file that exists).
 """
 
 import os
@@ -126,3 +130,38 @@ def test_an_archive_of_too_many_entries_is_refused(fmu_dir, tmp_path):  # noqa: 
         for i in range(10_001):
             z.writestr(f"resources/empty{i}", b"")
     refused(tmp_path, bad, "more than the 10000")
+
+
+def empty_library(tmp_path):
+    """A real x86-64 shared library with one function and no FMI symbol, built here."""
+    src = tmp_path / "empty.c"
+    src.write_text("int nothing(void) { return 0; }\n")
+    out = tmp_path / "empty.so"
+    subprocess.run(["cc", "-shared", "-fPIC", "-o", str(out), str(src)], check=True)
+    return out.read_bytes()
+
+
+def with_library(fmu_dir, tmp_path, name, library):
+    bad = tmp_path / name
+    rebuild(os.path.join(fmu_dir, "dc_motor_fmi2.fmu"), bad, lambda info, data: [(info, library if info.filename == LIBRARY else data)])
+    return bad
+
+
+@pytest.mark.skipif(shutil.which("cc") is None, reason="needs a C compiler to build the library")
+def test_a_library_without_the_fmi_functions_is_refused_before_it_loads(fmu_dir, tmp_path):  # noqa: F811
+    bad = with_library(fmu_dir, tmp_path, "nosym.fmu", empty_library(tmp_path))
+    refused(tmp_path, bad, f"{LIBRARY} does not export fmi2Instantiate, fmi2FreeInstance, fmi2SetupExperiment and 7 more: not an FMI 2.0 co-simulation library")
+
+
+@pytest.mark.skipif(shutil.which("cc") is None, reason="needs a C compiler to build the library")
+def test_a_library_for_another_architecture_is_named_as_such(fmu_dir, tmp_path):  # noqa: F811
+    arm = bytearray(empty_library(tmp_path))
+    assert arm[:4] == b"\x7fELF" and arm[18:20] == (62).to_bytes(2, "little")  # EM_X86_64
+    arm[18:20] = (183).to_bytes(2, "little")  # EM_AARCH64
+    bad = with_library(fmu_dir, tmp_path, "arm.fmu", bytes(arm))
+    refused(tmp_path, bad, f"{LIBRARY} is built for Aarch64 (64-bit), not for this machine (X86_64)")
+
+
+def test_bytes_that_are_no_library_are_named_as_such(fmu_dir, tmp_path):  # noqa: F811
+    bad = with_library(fmu_dir, tmp_path, "text.fmu", b"#!/bin/sh\necho not a library\n")
+    refused(tmp_path, bad, f"{LIBRARY} is not an ELF shared library")

@@ -191,6 +191,9 @@ pub fn read(path: &Path) -> Result<Fmu, String> {
     zip.by_name(&binary)
         .and_then(|f| f.take(MAX_UNPACKED).read_to_end(&mut library).map_err(Into::into))
         .map_err(|e| at(format!("{binary}: {e}")))?;
+    if let Some(why) = crate::library::problem(&binary, &library, version) {
+        return Err(at(why));
+    }
     Ok(Fmu {
         python: crate::python::needs(&library),
         ..fmu

@@ -9,6 +9,7 @@
 mod archive;
 mod check;
 mod fmi2;
+mod library;
 mod linearize;
 mod log_capture;
 mod params;
