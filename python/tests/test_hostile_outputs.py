@@ -15,6 +15,7 @@ Runs only as root with `runuser` and a `nobody` account (skipped otherwise, and 
 import os
 import pwd
 import shutil
+import stat
 import subprocess
 import tempfile
 from pathlib import Path
@@ -130,3 +131,23 @@ states = ["x1", "x2", "x3"]
     p = launch("linearize", tmp_path / "lti.toml", "--out", out)
     assert p.returncode == 0, p.stderr
     intact(victim, out, "Phi.npy", "C.npy", "lti.toml")
+
+
+def test_fifos_planted_at_output_names_neither_hang_nor_are_opened(folder, tmp_path):
+    """FIFOs (named pipes) made by nobody at a run's and a plot's outputs: before, opening one
+    for writing blocked `run` and `plot` forever. Now nothing is opened at an output's name —
+    a run refuses ("already exists") or, with --force, renames its file over the FIFO, and so
+    does plot; each within the timeout, the FIFO replaced by a regular file of root's."""
+    out, _, _ = folder
+    fifos = [f"{SCENARIO}.rrd", f"{SCENARIO}.summary.json", "outputs.png", "inputs.png"]
+    for name in fifos:
+        subprocess.run(["runuser", "-u", "nobody", "--", "mkfifo", str(out / name)], check=True)
+    p = subprocess.run([launcher(), "run", SCENARIO, "--mode", "in-process", "--out", str(out)], capture_output=True, text=True, timeout=60)
+    assert p.returncode == 2 and "already exists" in p.stderr, p.stderr
+    p = subprocess.run([launcher(), "run", SCENARIO, "--out", str(out), "--force"], capture_output=True, text=True, timeout=60)
+    assert p.returncode == 0, p.stderr
+    p = subprocess.run([launcher(), "plot", str(out / f"{SCENARIO}.rrd"), "--out", str(out)], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, p.stderr
+    for name in fifos:
+        st = (out / name).lstat()
+        assert stat.S_ISREG(st.st_mode) and st.st_uid == 0 and st.st_size > 0, (name, oct(st.st_mode))
