@@ -165,3 +165,55 @@ def test_a_library_for_another_architecture_is_named_as_such(fmu_dir, tmp_path):
 def test_bytes_that_are_no_library_are_named_as_such(fmu_dir, tmp_path):  # noqa: F811
     bad = with_library(fmu_dir, tmp_path, "text.fmu", b"#!/bin/sh\necho not a library\n")
     refused(tmp_path, bad, f"{LIBRARY} is not an ELF shared library")
+
+
+def lying_archive(src, dst, name="resources/zeros.bin", gib=5, declared=1000):
+    """The archive `src` re-written by hand (every entry stored) plus `name`: `gib` GiB of zeros,
+    deflated to ~5 MB, its headers declaring `declared` bytes and carrying the CRC of the true
+    content. The deflate stream is one 64 MiB block flushed with Z_FULL_FLUSH, repeated: after a
+    full flush the compressor forgets its history, so every repeat compresses to the same bytes."""
+    import struct
+    import zlib
+
+    chunk = bytes(64 << 20)
+    co = zlib.compressobj(9, zlib.DEFLATED, -15)
+    block = co.compress(chunk) + co.flush(zlib.Z_FULL_FLUSH)
+    repeats = (gib << 30) // len(chunk)
+    crc = 0
+    for _ in range(repeats):
+        crc = zlib.crc32(chunk, crc)
+    entries = []
+    with zipfile.ZipFile(src) as z:
+        for info in z.infolist():
+            data = z.read(info)
+            entries.append((info.filename, 0, zlib.crc32(data), data, len(data)))
+    entries.append((name, 8, crc, None, declared))
+    out, central = bytearray(), bytearray()
+    with open(dst, "wb") as f:
+        for fname, method, c, data, size in entries:
+            offset = f.tell()
+            comp = len(data) if data is not None else len(block) * repeats + 2
+            n = fname.encode()
+            f.write(struct.pack("<IHHHHHIIIHH", 0x04034B50, 20, 0, method, 0, 0x21, c, comp, size, len(n), 0) + n)
+            if data is not None:
+                f.write(data)
+            else:
+                for _ in range(repeats):
+                    f.write(block)
+                f.write(b"\x03\x00")  # the final, empty fixed-Huffman block
+            central += struct.pack("<IHHHHHHIIIHHHHHII", 0x02014B50, 20, 20, 0, method, 0, 0x21, c, comp, size, len(n), 0, 0, 0, 0, 0, offset) + n
+        start = f.tell()
+        f.write(central)
+        f.write(struct.pack("<IHHHHIIH", 0x06054B50, 0, 0, len(entries), len(entries), len(central), start, 0))
+    return dst
+
+
+def test_an_entry_that_inflates_far_past_its_declared_size_is_refused(fmu_dir, tmp_path):  # noqa: F811
+    """5 GiB of zeros declared as 1 000 bytes, with a correct CRC (before: extracted, 5.1 GB on
+    disk, and run). The check counts the bytes it inflates and stops at 4 GiB."""
+    bad = lying_archive(os.path.join(fmu_dir, "dc_motor_fmi2.fmu"), tmp_path / "bomb.fmu")
+    assert bad.stat().st_size < 8 << 20
+    with zipfile.ZipFile(bad) as z:  # a valid archive, its lie intact
+        assert z.getinfo("resources/zeros.bin").file_size == 1000
+    refused(tmp_path, bad, "unpacks to more than the 4294967296 bytes an FMU plant may (entry 'resources/zeros.bin' alone inflates past it)")
+    assert not list(tmp_path.glob("**/zeros.bin"))
