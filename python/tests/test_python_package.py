@@ -108,3 +108,17 @@ def test_run_and_read_give_the_recordings_values(tmp_path):
         uo.read(tmp_path / "nothing.rrd")
     with pytest.raises(ValueError, match="did you mean"):
         uo.run("seed002-piecewse", tmp_path / "out2")
+
+
+def test_a_run_without_out_leaves_no_folder_behind(tmp_path, monkeypatch):
+    """Before, every `uo.run()` without `out` left a `uio-run-*` folder with its recording in the
+    temporary directory. Now the folder goes once the signals are read; the values stay."""
+    monkeypatch.setenv("TMPDIR", str(tmp_path))
+    import tempfile
+    monkeypatch.setattr(tempfile, "tempdir", None)  # re-read TMPDIR
+    r = uo.run("seed002-piecewise")
+    assert r.ok and r.path is None and len(r.step) == 20000
+    assert list(tmp_path.iterdir()) == []
+    kept = uo.run("seed002-piecewise", tmp_path / "out")
+    for g in ("/plant/x", "/observer/uio/xhat", "/controller/u"):  # not the latencies: timing
+        assert np.array_equal(kept.groups[g], r.groups[g], equal_nan=True), g

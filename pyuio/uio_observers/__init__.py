@@ -197,8 +197,15 @@ class RunResult(Recording):
 
 def run(scenario, out=None, force=True):
     """Runs a scenario (a file, or a shipped scenario's name) in this process, recording it to
-    `out` (default: a new temporary folder); returns a RunResult. External components
-    (`kind = "process"`, `[plant.process]`, an FMU plant) need `launcher run` across processes."""
-    out = out or tempfile.mkdtemp(prefix="uio-run-")
-    rrd, summary, ok = _native.run(os.fspath(scenario), os.fspath(out), force)
-    return RunResult(rrd, summary, ok)
+    `out`; returns a RunResult. Without `out` the recording goes to a temporary folder that is
+    removed once its signals are read (the result's `path` is then None: pass `out` to keep the
+    `.rrd`). External components (`kind = "process"`, `[plant.process]`, an FMU plant) need
+    `launcher run` across processes."""
+    if out is not None:
+        rrd, summary, ok = _native.run(os.fspath(scenario), os.fspath(out), force)
+        return RunResult(rrd, summary, ok)
+    with tempfile.TemporaryDirectory(prefix="uio-run-") as tmp:
+        rrd, summary, ok = _native.run(os.fspath(scenario), tmp, force)
+        result = RunResult(rrd, summary, ok)
+    result.path = None
+    return result

@@ -20,7 +20,12 @@ pub(crate) fn path(field: &str, dir: Option<&Path>, written: &str) -> Result<Pat
     let Some(dir) = dir else { return Ok(PathBuf::from(written)) };
     let path = dir.join(written);
     if !path.is_file() {
-        return Err(bad(field, format!("{}: no such file", quoted(&path.display().to_string()))));
+        // There, but not a regular file (a FIFO would block the reader): say what it is.
+        let why = match std::fs::metadata(&path) {
+            Ok(_) => crate::untrusted::open_regular(&path).err().unwrap_or_else(|| "not a regular file".into()),
+            Err(_) => "no such file".into(),
+        };
+        return Err(bad(field, format!("{}: {why}", quoted(&path.display().to_string()))));
     }
     std::fs::canonicalize(&path).map_err(|e| bad(field, format!("{}: {e}", path.display())))
 }
