@@ -88,9 +88,16 @@ fn common_unit(what: &str, units: &[String]) -> String {
     }
 }
 
+/// A name as part of a file name: ASCII letters, digits, `-` and `_`, at most [`NAME_IN_FILE`]
+/// characters (a file name holds at most 255 bytes: a 250-character state name made `plot`
+/// write nothing, "File name too long"). The files stay distinct by their index or by names
+/// that are distinct within their 64 first characters (observers' and diagnosers' are at most 64).
 fn sanitize(s: &str) -> String {
-    s.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect()
+    s.chars().take(NAME_IN_FILE).map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect()
 }
+
+/// The longest name a plot's file name carries.
+const NAME_IN_FILE: usize = 64;
 
 fn views(r: &Recording, s: Option<&Scenario>, observers: &[String]) -> Vec<View> {
     let named = |path: &str| signals::named(s, path).unwrap_or_else(|| Named { name: r.names.get(path).cloned().unwrap_or_else(|| path.to_string()), unit: String::new() });

@@ -217,3 +217,23 @@ fn the_diagnosis_view_has_j_on_a_log_axis_and_dashed_thresholds_in_their_colours
         assert_eq!(t.points[0].1, raw.log10(), "threshold {i} on the log axis");
     }
 }
+
+/// A state name of 250 characters (scenario files allow it): before, `plot` stopped at its
+/// file, "File name too long", and wrote nothing. The file carries the name's first 64
+/// characters; the plot's title and axis the whole name.
+#[test]
+fn a_state_name_of_250_characters_is_plotted_under_a_file_name_that_fits() {
+    let s = Scratch::new("plot-long-name");
+    let long = "x".repeat(250);
+    let text_ = std::fs::read_to_string(scenario("seed002-sine")).unwrap();
+    let path = s.join("long.toml");
+    std::fs::write(&path, text_.replacen("[plant]", &format!("[plant]\nstate_names = [\"{long}\", \"vel\", \"volt\"]"), 1)).unwrap();
+    assert!(run(&s, &path, &["--mode", "in-process"]).status.success());
+    let out = launcher(&s).arg("plot").arg(s.join("out/seed002-sine.rrd")).arg("--out").arg(s.join("png")).output().unwrap();
+    assert!(out.status.success(), "{:?}", text(&out));
+    let file = format!("state_1_{}.png", "x".repeat(64));
+    assert!(s.join("png").join(&file).is_file(), "{file} missing");
+    let figs = figures(&read(&s.join("out/seed002-sine.rrd")).unwrap(), &PlotSelection::default()).unwrap();
+    let fig = &figs.iter().find(|(f, _)| *f == file).unwrap().1;
+    assert!(fig.title.contains(&long) && fig.y_label.contains(&long), "{}", fig.title);
+}
