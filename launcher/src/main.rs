@@ -242,6 +242,9 @@ enum Command {
         /// the plant's own units.
         #[arg(long)]
         deviations: bool,
+        /// Replace export files that already exist (without it they are refused, exit 2).
+        #[arg(long)]
+        force: bool,
     },
     /// Write one of a scenario's observers as an FMI co-simulation FMU, DIR/<observer>_fmi<2|3>.fmu.
     ExportFmu {
@@ -566,7 +569,7 @@ fn main() -> ExitCode {
                 Err(e) => fail(&LaunchError::BadInput(format!("{}: {e}", recording.display()))),
             }
         }
-        Command::Export { recording, csv, mcap, npz, mat, deviations } => {
+        Command::Export { recording, csv, mcap, npz, mat, deviations, force } => {
             // An export written over its own recording would replace the data it was made from.
             if let Some(p) = [&mcap, &npz, &mat].into_iter().flatten().find(|p| same_file(p, &recording)) {
                 return fail(&LaunchError::BadInput(format!("{}: is the recording being exported ({}); refusing to write over it", p.display(), recording.display())));
@@ -575,6 +578,11 @@ fn main() -> ExitCode {
                 Ok(r) => r,
                 Err(code) => return code,
             };
+            // Existing files are replaced only when asked, as `run` replaces its outputs.
+            let csv_files = csv.iter().flat_map(|d| recording::export::csv::planned(&r).into_iter().map(move |f| d.join(f)));
+            if !force && let Some(p) = [&mcap, &npz, &mat].into_iter().flatten().cloned().chain(csv_files).find(|p| p.symlink_metadata().is_ok()) {
+                return fail(&LaunchError::BadInput(format!("{}: already exists (pass --force to overwrite)", p.display())));
+            }
             let dt = recording::tools::recorded_dt(&r);
             if !r.complete {
                 eprintln!("warning: {}: incomplete recording (its writer did not finish); exporting what it holds", recording.display());

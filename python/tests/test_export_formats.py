@@ -220,6 +220,8 @@ def test_an_output_that_cannot_be_written(flag, name, exported, tmp_path):
     taken.mkdir()
     (taken / "keep").write_text("kept")
     done = export(exported["rrd"], flag, taken)
+    assert_failed(done, 2, "already exists (pass --force to overwrite)", str(taken))
+    done = export(exported["rrd"], flag, taken, "--force")
     assert_failed(done, 2, "cannot write", str(taken))
     assert [p.name for p in taken.iterdir()] == ["keep"] and not left_behind(tmp_path)
     assert sorted(p.name for p in tmp_path.iterdir()) == [taken.name]
@@ -255,3 +257,27 @@ def test_no_format_is_a_usage_error(exported):
     done = export(exported["rrd"])
     assert done.returncode == 2 and "--mcap" in done.stderr
 
+
+
+def test_existing_exports_are_replaced_only_with_force(exported, tmp_path):
+    """Before, a second export silently replaced the first's files. Now it is refused (exit 2,
+    naming the first file that exists, nothing written) unless --force, which replaces them."""
+    args = ["--csv", tmp_path / "csv", "--mcap", tmp_path / "x.mcap", "--npz", tmp_path / "x.npz", "--mat", tmp_path / "x.mat"]
+    assert export(exported["rrd"], *args).returncode == 0
+    for f in [tmp_path / "x.mcap", tmp_path / "x.npz", tmp_path / "x.mat", *sorted((tmp_path / "csv").iterdir())]:
+        f.write_bytes(b"mine")
+    for one in (["--mcap", tmp_path / "x.mcap"], ["--csv", tmp_path / "csv"], args):
+        done = export(exported["rrd"], *one)
+        assert_failed(done, 2, "already exists (pass --force to overwrite)")
+    files = [tmp_path / "x.mcap", tmp_path / "x.npz", tmp_path / "x.mat", *sorted((tmp_path / "csv").iterdir())]
+    assert all(f.read_bytes() == b"mine" for f in files)
+    # A CSV folder holding other files only is no conflict.
+    (tmp_path / "other").mkdir()
+    (tmp_path / "other" / "notes.txt").write_text("kept")
+    assert export(exported["rrd"], "--csv", tmp_path / "other").returncode == 0
+    assert (tmp_path / "other" / "notes.txt").read_text() == "kept"
+    done = export(exported["rrd"], *args, "--force")
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "x.npz").stat().st_size == (exported["dir"] / "x.npz").stat().st_size
+    assert (tmp_path / "x.mcap").read_bytes()[:8] == b"\x89MCAP0\r\n"
+    assert all(f.read_bytes() != b"mine" for f in files)

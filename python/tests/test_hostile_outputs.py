@@ -104,6 +104,9 @@ def test_plot_export_export_fmu_sweep_and_linearize_write_no_output_through_a_pl
     assert p.returncode == 0, p.stderr
     intact(victim, out, "outputs.png", "errors_log.png")
     p = launch("export", rrd, "--csv", out)
+    assert p.returncode == 2 and "plant_x.csv: already exists" in p.stderr, p.stderr
+    intact(victim, out)
+    p = launch("export", rrd, "--csv", out, "--force")
     assert p.returncode == 0, p.stderr
     intact(victim, out, "plant_x.csv")
     p = launch("export-fmu", SCENARIO, "--observer", "uio", "--out", out)

@@ -25,9 +25,32 @@ pub fn header(s: Option<&Scenario>, r: &Recording, group: &str, member: &str) ->
     csv_field(&name_and_label(s, r, group, member).1)
 }
 
-/// Quotes a field holding a comma or a quote (RFC 4180).
+/// A header cell as a spreadsheet shows it, neither a formula nor text that reorders or breaks
+/// lines, then quoted where it holds a comma, a quote or a line break (RFC 4180). Names come
+/// from the recorded scenario, which anyone may have written:
+/// - a cell starting with `=`, `+`, `-`, `@`, a tab or a carriage return is a formula to
+///   Excel and LibreOffice (`=cmd|' /C calc'!A0`): it gets a leading `'`, the escape they
+///   document for text (OWASP, "CSV Injection");
+/// - bidirectional controls (U+200E, U+200F, U+202A–U+202E, U+2066–U+2069) and the line and
+///   paragraph separators (U+2028, U+2029) are written as `\u{…}`: they make a header read
+///   other than it is.
 fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n']) { format!("\"{}\"", s.replace('"', "\"\"")) } else { s.to_string() }
+    let mut s: String = s
+        .chars()
+        .map(|c| match c {
+            '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}' | '\u{2028}' | '\u{2029}' => format!("\\u{{{:x}}}", c as u32),
+            c => c.to_string(),
+        })
+        .collect();
+    if s.starts_with(['=', '+', '-', '@', '\t', '\r']) {
+        s.insert(0, '\'');
+    }
+    if s.contains([',', '"', '\n', '\r']) { format!("\"{}\"", s.replace('"', "\"\"")) } else { s }
+}
+
+/// The files [`export`] writes for `r`, by name.
+pub fn planned(r: &Recording) -> Vec<String> {
+    labelled(r).iter().map(|g| file_name(&g.path)).collect()
 }
 
 /// Writes the CSV files; returns them. `dt` converts steps to sim_time.
@@ -58,4 +81,27 @@ pub fn export(r: &Recording, dir: &Path, dt: Option<f64>) -> Result<Vec<PathBuf>
         written.push(path);
     }
     Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::csv_field;
+
+    #[test]
+    fn a_header_that_a_spreadsheet_would_run_is_written_as_text() {
+        assert_eq!(csv_field("=cmd|' /C calc'!A0"), "'=cmd|' /C calc'!A0");
+        assert_eq!(csv_field("@SUM(A1)"), "'@SUM(A1)");
+        assert_eq!(csv_field("+1"), "'+1");
+        assert_eq!(csv_field("-x [m]"), "'-x [m]");
+        assert_eq!(csv_field("=a,b"), "\"'=a,b\"");
+    }
+
+    #[test]
+    fn bidi_controls_and_line_separators_are_escaped_and_plain_names_kept() {
+        assert_eq!(csv_field("x\u{202e}gnp.exe"), "x\\u{202e}gnp.exe");
+        assert_eq!(csv_field("a\u{2028}b\u{2069}"), "a\\u{2028}b\\u{2069}");
+        assert_eq!(csv_field("eta [rad]"), "eta [rad]");
+        assert_eq!(csv_field("θ−1 [°]"), "θ−1 [°]");
+        assert_eq!(csv_field("say \"hi\""), "\"say \"\"hi\"\"\"");
+    }
 }
