@@ -20,7 +20,13 @@ SEED002 = dict(A=[[0.0, 1.0, 0.0], [-2.0, -3.0, 0.0], [0.0, 0.0, -2.0]], B=[[0.0
 MOTOR = dict(A=[[-2.0, -0.02, 0.0], [1.0, -10.0, 0.0], [0.0, 1.0, 0.0]], B=[[2.0], [0.0], [0.0]],
              C=[[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], E=[[0.0], [-100.0], [0.0]])
 
+# 30 states: A (900 entries) and B go to the launcher as .npy files, not TOML text.
+_rng = np.random.default_rng(30)
+LARGE = dict(A=_rng.standard_normal((30, 30)) - 8 * np.eye(30), B=_rng.standard_normal((30, 2)),
+             C=np.round(_rng.standard_normal((6, 30)), 2), E=_rng.standard_normal((30, 1)))
+
 CASES = {
+    "random-30-states-lqe": (LARGE, dict(kind="chen-patton-uio", gain="lqe", dt=0.01)),
     "seed002-chen-patton": (SEED002, dict(kind="chen-patton-uio", poles=[-1.0, -2.0, -3.0], placement="matlab", dt=0.001)),
     "seed002-luenberger-lqe": (SEED002, dict(kind="luenberger", gain="lqe", Q=np.eye(3), R=0.01 * np.eye(2), dt=0.01)),
     "motor-chen-patton": (MOTOR, dict(kind="chen-patton-uio", poles=[-20.0, -30.0], dt=0.001)),
@@ -122,3 +128,20 @@ def test_a_run_without_out_leaves_no_folder_behind(tmp_path, monkeypatch):
     kept = uo.run("seed002-piecewise", tmp_path / "out")
     for g in ("/plant/x", "/observer/uio/xhat", "/controller/u"):  # not the latencies: timing
         assert np.array_equal(kept.groups[g], r.groups[g], equal_nan=True), g
+
+
+def test_a_matrix_beyond_the_launchers_limit_is_refused_before_anything_is_built():
+    """Before, a 10⁴ × 10⁴ A was turned into TOML text (gigabytes) and the interpreter aborted.
+    Now the launcher's own limit (1 GiB a matrix) is checked on the array's size first: a
+    12 000 × 12 000 A (1.15 GB, here a broadcast view that takes no memory) raises at once."""
+    import resource
+    import time
+
+    A = np.broadcast_to(0.0, (12000, 12000))
+    before, t = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, time.monotonic()
+    with pytest.raises(ValueError, match=r"A: 12000 × 12000 is 1152000000 bytes of doubles, more than the 1073741824 bytes \(1 GiB\)"):
+        uo.design(A=A, B=np.zeros((12000, 1)), C=np.zeros((1, 12000)), dt=0.01, kind="luenberger", gain="lqe")
+    assert time.monotonic() - t < 5
+    assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before < 100_000  # KiB: under 100 MB
+    with pytest.raises(ValueError, match="not a finite number"):
+        uo.design(A=[[np.nan]], B=[[1.0]], C=[[1.0]], dt=0.01, kind="luenberger", poles=[-1.0])

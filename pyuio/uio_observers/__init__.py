@@ -54,6 +54,27 @@ def _toml_poles(poles):
     return "[" + ", ".join(out) + "]"
 
 
+# The launcher's limits (scenario/src/untrusted.rs, scenario/src/matrix_file.rs): a scenario's
+# text and a matrix file. Checked here before anything is built: a 10⁴ × 10⁴ A as TOML text
+# took gigabytes and aborted the interpreter.
+MAX_SCENARIO_BYTES = 1 << 20
+MAX_MATRIX_FILE_BYTES = 1 << 30
+# Matrices above this many entries go to the launcher as .npy files (exact bits, no text).
+_INLINE_MAX = 256
+
+
+def _checked(name, m):
+    m = np.atleast_2d(np.asarray(m, dtype=float))
+    if m.ndim != 2:
+        raise ValueError(f"{name}: a matrix (2-D), not {m.ndim}-D")
+    if m.nbytes + 128 > MAX_MATRIX_FILE_BYTES:
+        raise ValueError(f"{name}: {m.shape[0]} × {m.shape[1]} is {m.nbytes} bytes of doubles, more than the "
+                         f"{MAX_MATRIX_FILE_BYTES} bytes (1 GiB) a matrix may hold")
+    if not np.all(np.isfinite(m)):
+        raise ValueError(f"{name}: holds {m[~np.isfinite(m)][0]}, not a finite number")
+    return m
+
+
 def _matrices(sys, A, B, C):
     if sys is not None:
         if any(m is not None for m in (A, B, C)):
@@ -67,19 +88,25 @@ def _matrices(sys, A, B, C):
 
 
 def design_scenario(A=None, B=None, C=None, E=None, *, sys=None, D=None, kind="chen-patton-uio", poles=None,
-                    gain=None, Q=None, R=None, placement=None, dt, x0=None, name="design", **keys):
+                    gain=None, Q=None, R=None, placement=None, dt, x0=None, name="design", files=None, **keys):
     """The scenario text `design` designs: the plant and one observer named `observer`; extra
-    keyword arguments become keys of the `[[observer]]` table (e.g. decay=1.0, H=[[...]])."""
+    keyword arguments become keys of the `[[observer]]` table (e.g. decay=1.0, H=[[...]]).
+    With `files` (a folder), plant matrices of more than 256 entries are written there as
+    `<name>.npy` and the text names them (as a scenario beside its matrix files does)."""
     A, B, C = _matrices(sys, A, B, C)
-    n = A.shape[0]
-    lines = [f'name = "{name}"', f"dt = {_toml_number(dt)}", f"duration = {_toml_number(dt)}", "", "[plant]",
-             f"A = {_toml_matrix('A', A)}", f"B = {_toml_matrix('B', B)}", f"C = {_toml_matrix('C', C)}"]
     column = lambda m: None if m is None else np.asarray(m, dtype=float).reshape(len(m), -1)  # noqa: E731 (a 1-D E is one column)
     E, D = column(E), column(D)
-    if E is not None and E.size:
-        lines.append(f"E = {_toml_matrix('E', E)}")
-    if D is not None and D.size:
-        lines.append(f"D = {_toml_matrix('D', D)}")
+    plant = {k: _checked(k, m) for k, m in (("A", A), ("B", B), ("C", C), ("E", E), ("D", D)) if m is not None and (m.size or k in "ABC")}
+    n = plant["A"].shape[0]
+
+    def entry(k, m):
+        if files is not None and m.size > _INLINE_MAX:
+            np.save(os.path.join(files, f"{k}.npy"), m)
+            return f'{k} = "{k}.npy"'
+        return f"{k} = {_toml_matrix(k, m)}"
+
+    lines = [f'name = "{name}"', f"dt = {_toml_number(dt)}", f"duration = {_toml_number(dt)}", "", "[plant]"]
+    lines += [entry(k, m) for k, m in plant.items()]
     lines.append(f"x0 = {_toml_list(np.zeros(n) if x0 is None else x0)}")
     # A design needs no signals, but a scenario names one per column of B, E and D.
     for table, m in (("input", B), ("disturbance", E), ("measurement_disturbance", D)):
@@ -142,8 +169,12 @@ def design(A=None, B=None, C=None, E=None, **kw):
     """Designs one observer of `kind` for ẋ = Ax + Bu + Ew, y = Cx (+ Dv) sampled at `dt`; see
     `design_scenario` for the keywords. Raises ValueError, with the launcher's reason, when the
     design's conditions do not hold."""
-    text = design_scenario(A, B, C, E, **kw)
-    ok, report, lines = _native.design(os.path.join(os.getcwd(), "design.toml"), text)
+    with tempfile.TemporaryDirectory(prefix="uio-design-") as files:
+        text = design_scenario(A, B, C, E, files=files, **kw)
+        if len(text.encode()) > MAX_SCENARIO_BYTES:
+            raise ValueError(f"the design's scenario text is {len(text.encode())} bytes, more than the "
+                             f"{MAX_SCENARIO_BYTES} a scenario may hold (its lists grow with the model's order)")
+        ok, report, lines = _native.design(os.path.join(files, "design.toml"), text)
     report = json.loads(report)
     if not ok:
         o = report["observers"][0]
