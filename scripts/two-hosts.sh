@@ -69,6 +69,11 @@ fail() { echo "two-hosts $case_name: $*"; for f in "$work/launcher.err" "$work"/
 
 # The agent on B: listens on B's address only.
 agent_args=(--host rig --listen "$endpoint" --max-workers 4)
+# A wildcard address (every interface) is refused before anything listens, unless asked for.
+for wild in "${endpoint%%/*}/0.0.0.0:7447" "${endpoint%%/*}/[::]:7447"; do
+  rc=0; "$launcher" agent --host rig --listen "$wild" 2>"$work/wildcard.err" || rc=$?
+  [ "$rc" -eq 2 ] && grep -q "add --all-interfaces" "$work/wildcard.err" || { echo "two-hosts $case_name: --listen $wild exited $rc: $(cat "$work/wildcard.err")"; exit 1; }
+done
 if [ "$case_name" = insecure ]; then
   # Plain TCP without --insecure is refused before anything listens.
   rc=0; "$launcher" agent "${agent_args[@]}" 2>"$work/refusal.err" || rc=$?

@@ -41,12 +41,27 @@ pub struct Options {
     pub insecure: bool,
     /// Components (workers) this agent runs at once, over every run.
     pub max_workers: usize,
+    /// Accept a wildcard listen address.
+    pub all_interfaces: bool,
+}
+
+/// True for an endpoint whose address is a wildcard (`quic/0.0.0.0:7447`, `tcp/[::]:7447`):
+/// it listens on every interface of the host.
+pub fn wildcard(endpoint: &str) -> bool {
+    let address = endpoint.split_once('/').map_or(endpoint, |(_, a)| a);
+    let host = address.rsplit_once(':').map_or(address, |(h, _)| h);
+    let host = host.trim_start_matches('[').trim_end_matches(']');
+    host.parse::<std::net::IpAddr>().is_ok_and(|ip| ip.is_unspecified())
 }
 
 /// Runs the agent until SIGTERM or SIGINT; returns the exit code.
 pub fn run(o: &Options) -> i32 {
     if let Err(e) = keys::check_host(&o.host) {
         say!("agent: --host: {e}");
+        return 2;
+    }
+    if wildcard(&o.listen) && !o.all_interfaces {
+        say!("agent {}: --listen {}: a wildcard address listens on every interface of this host; give the one address the launcher reaches (e.g. quic/10.0.0.2:7447), or add --all-interfaces", o.host, o.listen);
         return 2;
     }
     let tls = if o.listen.starts_with("tls/") {
@@ -178,4 +193,19 @@ fn worker(o: &Options, tls: bool, request: &str) -> Result<Child, String> {
         return Err(format!("worker: {e}"));
     }
     Ok(child)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::wildcard;
+
+    #[test]
+    fn wildcard_addresses_are_told_from_one_interfaces_address() {
+        for w in ["quic/0.0.0.0:7447", "tcp/0.0.0.0:1", "quic/[::]:7447", "tcp/[0:0:0:0:0:0:0:0]:7447"] {
+            assert!(wildcard(w), "{w}");
+        }
+        for one in ["quic/10.0.0.2:7447", "quic/127.0.0.1:7447", "quic/[::1]:7447", "tcp/[fe80::1]:9", "quic/agent.example:7447"] {
+            assert!(!wildcard(one), "{one}");
+        }
+    }
 }

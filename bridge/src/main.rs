@@ -64,6 +64,10 @@ enum Cmd {
         /// Components this agent runs at once, over all runs.
         #[arg(long, default_value_t = 16)]
         max_workers: usize,
+        /// Accept a wildcard listen address (0.0.0.0, ::): the agent is then reachable on
+        /// every interface of the host, not only the one the launcher uses.
+        #[arg(long)]
+        all_interfaces: bool,
     },
     /// Stand in for a component on another host (started by the launcher).
     Remote {
@@ -121,12 +125,12 @@ fn main() {
                 }
             }
         }
-        Cmd::Agent { init: None, host, listen, credentials: dir, insecure, max_workers } => {
+        Cmd::Agent { init: None, host, listen, credentials: dir, insecure, max_workers, all_interfaces } => {
             let (Some(host), Some(listen)) = (host, listen) else {
                 say!("agent: --host and --listen are required (or `agent init`)");
                 std::process::exit(2);
             };
-            agent::run(&agent::Options { host, listen, credentials: dir.unwrap_or_else(credentials::default_dir), insecure, max_workers })
+            agent::run(&agent::Options { host, listen, credentials: dir.unwrap_or_else(credentials::default_dir), insecure, max_workers, all_interfaces })
         }
         Cmd::Remote { host, connect, builtin } => proxy::run(&host, &connect, &builtin),
         Cmd::Worker { connect, credentials } => worker::run(&connect, credentials.as_deref()),
