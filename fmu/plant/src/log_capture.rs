@@ -38,6 +38,11 @@ pub fn record(instance: &str, level: log::Level, category: &str, text: &str) {
     if line.is_empty() {
         return;
     }
+    // The FMU's text, made one line that cannot forge another (a lone \r, an escape sequence,
+    // a bidi control) and at most LINE_CHARS long: it reaches the launcher's messages.
+    let line = one_line_capped(&line);
+    let (instance, category) = (one_line_capped(instance), one_line_capped(category));
+    let (instance, category) = (instance.as_str(), category.as_str());
     if level <= log::Level::Warn {
         let category = if category.is_empty() { String::new() } else { format!(", {category}") };
         eprintln!("FMU {instance} ({}{category}): {line}", level.as_str().to_lowercase());
@@ -63,4 +68,33 @@ pub fn install() {
 pub fn take() -> String {
     let last: Vec<String> = LAST.lock().map(|mut l| l.drain(..).collect()).unwrap_or_default();
     if last.is_empty() { String::new() } else { format!(": the FMU logged: {}", last.join(" | ")) }
+}
+
+/// The longest FMU log line kept or shown, characters.
+const LINE_CHARS: usize = 1000;
+
+fn one_line_capped(text: &str) -> String {
+    let count = text.chars().count();
+    let shown: String = text.chars().take(LINE_CHARS).collect();
+    let mut line = scenario::untrusted::one_line(&shown);
+    if count > LINE_CHARS {
+        line += &format!("… ({count} characters)");
+    }
+    line
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_fmus_log_text_cannot_forge_a_line_or_flood_the_message() {
+        record("inst\rfake", log::Level::Info, "", "ok\rerror: forged\x1b[2K\u{202e}x\nsecond line");
+        let got = take();
+        assert!(!got.contains(['\r', '\n', '\x1b', '\u{202e}']), "{got:?}");
+        assert!(got.contains("second line") && got.contains("forged"), "{got}");
+        record("i", log::Level::Info, "", &"y".repeat(5_000_000));
+        let got = take();
+        assert!(got.len() < 1100 && got.ends_with("(5000000 characters)"), "{}", got.len());
+    }
 }
