@@ -3,6 +3,8 @@ with exit 2 and one line, quickly, within a memory bound, and leaving no process
 
 * A 1.7 KB MCAP whose zstd chunk declares 2^62 bytes uncompressed: before, `replay_plant
   --check` spun at 100 % CPU forever. Now refused from the chunk header (≤ 64 MiB a chunk).
+* SIGINT while the pre-flight check reads a 200 MB CSV: exit 130 at once, the check stopped
+  (before, the launcher ignored the interrupt while it waited).
 * An MCAP whose one message has a 20 MiB field name, and a CSV whose header is a 20 MiB line:
   "did you mean" built an edit-distance table of every pair of words (2.7 GB, 24 GB for 1 GiB)
   and the messages were 20–99 MB lines. Now: the peak RSS of the launcher and its children
@@ -132,3 +134,48 @@ def test_a_20_mib_name_costs_no_more_than_200_mb(tmp_path, kind):
     assert code == 2 and len(err) < 1000 and "(20971520 characters)" in err, err[:2000]
     assert rss < 200, rss
     assert leftovers(str(tmp_path)) == []
+
+
+def children(pid):
+    try:
+        return [int(c) for c in open(f"/proc/{pid}/task/{pid}/children").read().split()]
+    except OSError:
+        return []
+
+
+def cmdline(pid):
+    try:
+        return open(f"/proc/{pid}/cmdline", "rb").read()
+    except OSError:
+        return b""
+
+
+def test_an_interrupt_during_the_preflight_stops_it_at_once(tmp_path):
+    """A 200 MB CSV log: its pre-flight check (`replay_plant --check`, which reads every row)
+    takes seconds. SIGINT to the launcher while the check runs: before, the launcher ignored
+    it while it waited. Now exit 130 at once, naming the check, and the check is gone."""
+    with open(tmp_path / "big.csv", "w") as f:
+        f.write("t,u,y\n")
+        for k in range(60):
+            f.write("".join(f"{0.1 * (k * 200_000 + i):.1f},0.25,0.5\n" for i in range(200_000)))
+    (tmp_path / "s.toml").write_text(SCENARIO.format(path="big.csv", extra=""))
+    launched = subprocess.Popen([launcher(), "run", str(tmp_path / "s.toml"), "--out", str(tmp_path / "out")],
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    check = None
+    deadline = time.monotonic() + 20
+    while check is None and time.monotonic() < deadline:
+        check = next((c for c in children(launched.pid) if b"--check" in cmdline(c)), None)
+        time.sleep(0.01)
+    assert check is not None, "no pre-flight check seen"
+    time.sleep(0.3)
+    assert launched.poll() is None, "the check ended before the interrupt: make the log larger"
+    t = time.monotonic()
+    launched.send_signal(2)
+    _, err = launched.communicate(timeout=30)
+    seconds = time.monotonic() - t
+    print(f"interrupted pre-flight: exit {launched.returncode} after {seconds:.3f} s: {err.strip()}")
+    assert launched.returncode == 130 and "interrupted by SIGINT during replay_plant --check" in err, err
+    assert seconds < 5
+    assert b"replay_plant" not in cmdline(check)
+    assert leftovers(str(tmp_path)) == []
+    assert not (tmp_path / "out").exists() or list((tmp_path / "out").iterdir()) == []
