@@ -179,3 +179,25 @@ def test_an_interrupt_during_the_preflight_stops_it_at_once(tmp_path):
     assert b"replay_plant" not in cmdline(check)
     assert leftovers(str(tmp_path)) == []
     assert not (tmp_path / "out").exists() or list((tmp_path / "out").iterdir()) == []
+
+
+def test_a_preflight_past_its_time_limit_is_stopped_and_named(tmp_path):
+    """The same 200 MB log under a 1 s limit (UIO_CHECK_TIMEOUT; 120 s by default): the check
+    is stopped with its process group, exit 2 with one line naming it, nothing left."""
+    with open(tmp_path / "big.csv", "w") as f:
+        f.write("t,u,y\n")
+        for k in range(60):
+            f.write("".join(f"{0.1 * (k * 200_000 + i):.1f},0.25,0.5\n" for i in range(200_000)))
+    (tmp_path / "s.toml").write_text(SCENARIO.format(path="big.csv", extra=""))
+    env = dict(os.environ, UIO_CHECK_TIMEOUT="1")
+    t = time.monotonic()
+    done = subprocess.run([launcher(), "run", str(tmp_path / "s.toml"), "--out", str(tmp_path / "out")], capture_output=True, text=True, env=env, timeout=60)
+    seconds = time.monotonic() - t
+    print(f"pre-flight past 1 s: exit {done.returncode} after {seconds:.2f} s: {done.stderr.strip()}")
+    assert done.returncode == 2 and "replay_plant --check did not answer within 1 s; it was stopped" in done.stderr, done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1 and seconds < 10
+    assert leftovers(str(tmp_path)) == []
+    assert not (tmp_path / "out").exists() or list((tmp_path / "out").iterdir()) == []
+    bad = subprocess.run([launcher(), "run", str(tmp_path / "s.toml"), "--out", str(tmp_path / "out")], capture_output=True, text=True,
+                         env=dict(os.environ, UIO_CHECK_TIMEOUT="0"), timeout=60)
+    assert bad.returncode == 2 and "UIO_CHECK_TIMEOUT='0': the pre-flight limit is a whole number of seconds from 1 to 3600" in bad.stderr, bad.stderr

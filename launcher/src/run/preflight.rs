@@ -54,7 +54,19 @@ const SIBLING_OUTPUT: u64 = 16 << 20;
 /// with `params` on stdin: its stdout, or its last line on stderr as bad input. `field` heads
 /// this function's own messages and the component's line.
 fn check(s: &Scenario, field: [&str; 2], program: &str, package: &str, params: &serde_json::Value) -> Result<Vec<u8>, LaunchError> {
-    sibling(&s.path, field, program, "--check", package, params, CHECK_TIMEOUT)
+    sibling(&s.path, field, program, "--check", package, params, check_timeout()?)
+}
+
+/// Environment variable that sets the `--check` limit, in whole seconds (1 to 3600): a log at
+/// the caps on a slow disk may need more than [`CHECK_TIMEOUT`].
+pub const CHECK_TIMEOUT_ENV: &str = "UIO_CHECK_TIMEOUT";
+
+fn check_timeout() -> Result<Duration, LaunchError> {
+    let Some(v) = std::env::var_os(CHECK_TIMEOUT_ENV) else { return Ok(CHECK_TIMEOUT) };
+    match v.to_str().and_then(|t| t.trim().parse::<u64>().ok()) {
+        Some(secs @ 1..=3600) => Ok(Duration::from_secs(secs)),
+        _ => Err(LaunchError::BadInput(format!("{CHECK_TIMEOUT_ENV}={}: the pre-flight limit is a whole number of seconds from 1 to 3600", scenario::untrusted::quoted(&v.to_string_lossy())))),
+    }
 }
 
 /// `program flag` (a kit component built beside the launcher, of cargo package `package`) with
