@@ -150,15 +150,21 @@ def cmdline(pid):
         return b""
 
 
-def test_an_interrupt_during_the_preflight_stops_it_at_once(tmp_path):
-    """A 200 MB CSV log: its pre-flight check (`replay_plant --check`, which reads every row)
-    takes seconds. SIGINT to the launcher while the check runs: before, the launcher ignored
-    it while it waited. Now exit 130 at once, naming the check, and the check is gone."""
+def big_log(tmp_path):
+    """A 200 MB CSV log (12 million rows) and a scenario replaying it: its pre-flight check,
+    which reads every row, takes seconds."""
     with open(tmp_path / "big.csv", "w") as f:
         f.write("t,u,y\n")
         for k in range(60):
             f.write("".join(f"{0.1 * (k * 200_000 + i):.1f},0.25,0.5\n" for i in range(200_000)))
     (tmp_path / "s.toml").write_text(SCENARIO.format(path="big.csv", extra=""))
+
+
+def test_an_interrupt_during_the_preflight_stops_it_at_once(tmp_path):
+    """A 200 MB CSV log: its pre-flight check (`replay_plant --check`, which reads every row)
+    takes seconds. SIGINT to the launcher while the check runs: before, the launcher ignored
+    it while it waited. Now exit 130 at once, naming the check, and the check is gone."""
+    big_log(tmp_path)
     launched = subprocess.Popen([launcher(), "run", str(tmp_path / "s.toml"), "--out", str(tmp_path / "out")],
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     check = None
@@ -184,11 +190,7 @@ def test_an_interrupt_during_the_preflight_stops_it_at_once(tmp_path):
 def test_a_preflight_past_its_time_limit_is_stopped_and_named(tmp_path):
     """The same 200 MB log under a 1 s limit (UIO_CHECK_TIMEOUT; 120 s by default): the check
     is stopped with its process group, exit 2 with one line naming it, nothing left."""
-    with open(tmp_path / "big.csv", "w") as f:
-        f.write("t,u,y\n")
-        for k in range(60):
-            f.write("".join(f"{0.1 * (k * 200_000 + i):.1f},0.25,0.5\n" for i in range(200_000)))
-    (tmp_path / "s.toml").write_text(SCENARIO.format(path="big.csv", extra=""))
+    big_log(tmp_path)
     env = dict(os.environ, UIO_CHECK_TIMEOUT="1")
     t = time.monotonic()
     done = subprocess.run([launcher(), "run", str(tmp_path / "s.toml"), "--out", str(tmp_path / "out")], capture_output=True, text=True, env=env, timeout=60)

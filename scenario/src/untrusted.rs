@@ -80,8 +80,10 @@ fn escape_controls(text: &str, keep_lines: bool) -> String {
 
 /// Control characters (C0, DEL, C1) and the invisible bidirectional overrides that can make
 /// text read differently from what it is.
+/// Controls, bidirectional controls, and the line and paragraph separators (U+2028, U+2029:
+/// not controls, but line breaks to some terminals and to spreadsheets).
 fn needs_escape(c: char) -> bool {
-    c.is_control() || matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}')
+    c.is_control() || matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}' | '\u{2028}' | '\u{2029}')
 }
 
 /// Opens `path` for reading if it is a regular file, without blocking on a FIFO; returns the

@@ -28,24 +28,18 @@ pub fn header(s: Option<&Scenario>, r: &Recording, group: &str, member: &str) ->
 /// A header cell as a spreadsheet shows it, neither a formula nor text that reorders or breaks
 /// lines, then quoted where it holds a comma, a quote or a line break (RFC 4180). Names come
 /// from the recorded scenario, which anyone may have written:
-/// - a cell starting with `=`, `+`, `-`, `@`, a tab or a carriage return is a formula to
-///   Excel and LibreOffice (`=cmd|' /C calc'!A0`): it gets a leading `'`, the escape they
-///   document for text (OWASP, "CSV Injection");
-/// - bidirectional controls (U+200E, U+200F, U+202A–U+202E, U+2066–U+2069) and the line and
-///   paragraph separators (U+2028, U+2029) are written as `\u{…}`: they make a header read
-///   other than it is.
+/// - controls other than newline and tab, bidirectional controls and the line and paragraph
+///   separators are written as `\u{…}` ([`scenario::untrusted::printable`]): they make a header
+///   read other than it is;
+/// - a cell starting with `=`, `+`, `-`, `@` or a tab is a formula to Excel and LibreOffice
+///   (`=cmd|' /C calc'!A0`): it gets a leading `'`, the escape they document for text (OWASP,
+///   "CSV Injection").
 fn csv_field(s: &str) -> String {
-    let mut s: String = s
-        .chars()
-        .map(|c| match c {
-            '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}' | '\u{2028}' | '\u{2029}' => format!("\\u{{{:x}}}", c as u32),
-            c => c.to_string(),
-        })
-        .collect();
-    if s.starts_with(['=', '+', '-', '@', '\t', '\r']) {
+    let mut s = scenario::untrusted::printable(s);
+    if s.starts_with(['=', '+', '-', '@', '\t']) {
         s.insert(0, '\'');
     }
-    if s.contains([',', '"', '\n', '\r']) { format!("\"{}\"", s.replace('"', "\"\"")) } else { s }
+    if s.contains([',', '"', '\n']) { format!("\"{}\"", s.replace('"', "\"\"")) } else { s }
 }
 
 /// The files [`export`] writes for `r`, by name.
@@ -100,6 +94,7 @@ mod tests {
     fn bidi_controls_and_line_separators_are_escaped_and_plain_names_kept() {
         assert_eq!(csv_field("x\u{202e}gnp.exe"), "x\\u{202e}gnp.exe");
         assert_eq!(csv_field("a\u{2028}b\u{2069}"), "a\\u{2028}b\\u{2069}");
+        assert_eq!(csv_field("\rx\u{1b}[2K"), "\\rx\\u{1b}[2K");
         assert_eq!(csv_field("eta [rad]"), "eta [rad]");
         assert_eq!(csv_field("θ−1 [°]"), "θ−1 [°]");
         assert_eq!(csv_field("say \"hi\""), "\"say \"\"hi\"\"\"");
