@@ -44,6 +44,9 @@ if [ ! -x "$venv/bin/python3" ] || [ ! -e "$stamp" ] \
 fi
 export PATH="$venv/bin:$PATH"
 
+# One formatting (rustfmt.toml), checked before anything is built: `cargo fmt --all` fixes it.
+cargo fmt --all --check >/dev/null || { echo "cargo fmt --all --check: the sources are not formatted (run cargo fmt --all)"; exit 1; }
+
 # The multi-process tests start the component binaries: build them all first.
 cargo build --release --workspace --bins
 # The observer FMUs' library (a cdylib, which --bins does not build), for `launcher export-fmu`.

@@ -23,12 +23,22 @@ fn main() {
     }
     let endpoint = args.remove(0);
     let mut c = Config::default();
-    let set = |c: &mut Config, k: &str, v: serde_json::Value| c.insert_json5(k, &v.to_string()).expect("a valid setting");
+    let set = |c: &mut Config, k: &str, v: serde_json::Value| {
+        c.insert_json5(k, &v.to_string()).expect("a valid setting")
+    };
     set(&mut c, "mode", "client".into());
     set(&mut c, "connect/endpoints", serde_json::json!([endpoint]));
     set(&mut c, "scouting/multicast/enabled", false.into());
-    set(&mut c, "transport/link/tls/verify_name_on_connect", false.into());
-    set(&mut c, "transport/link/rx/max_message_size", serde_json::json!(2u64 << 30));
+    set(
+        &mut c,
+        "transport/link/tls/verify_name_on_connect",
+        false.into(),
+    );
+    set(
+        &mut c,
+        "transport/link/rx/max_message_size",
+        serde_json::json!(2u64 << 30),
+    );
     for (flag, path) in &tls {
         let key = match flag.as_str() {
             "--ca" => "root_ca_certificate",
@@ -36,7 +46,11 @@ fn main() {
             "--key" => "connect_private_key",
             f => panic!("unknown flag {f}"),
         };
-        set(&mut c, &format!("transport/link/tls/{key}"), path.as_str().into());
+        set(
+            &mut c,
+            &format!("transport/link/tls/{key}"),
+            path.as_str().into(),
+        );
         if key == "connect_certificate" {
             set(&mut c, "transport/link/tls/enable_mtls", true.into());
         }
@@ -45,7 +59,13 @@ fn main() {
         Ok(z) => z,
         Err(e) => {
             let e = e.to_string();
-            println!("refused: {}", e.split("  at ").next().unwrap_or(&e).trim_end_matches(['!', ' ']));
+            println!(
+                "refused: {}",
+                e.split("  at ")
+                    .next()
+                    .unwrap_or(&e)
+                    .trim_end_matches(['!', ' '])
+            );
             return;
         }
     };
@@ -53,7 +73,10 @@ fn main() {
     match action.as_str() {
         "open" => println!("connected"),
         "listen" => {
-            let sub = z.declare_subscriber(args[0].as_str()).wait().expect("declares");
+            let sub = z
+                .declare_subscriber(args[0].as_str())
+                .wait()
+                .expect("declares");
             let until = Instant::now() + Duration::from_secs_f64(args[1].parse().expect("seconds"));
             let (mut n, mut plain, mut key) = (0u64, 0u64, String::from("-"));
             while Instant::now() < until {
@@ -61,7 +84,10 @@ fn main() {
                     n += 1;
                     let b = s.payload().to_bytes();
                     // A plain sample: a 40-byte header whose protocol field is 1, then f64s.
-                    if b.len() >= 40 && (b.len() - 40) % 8 == 0 && u32::from_le_bytes(b[32..36].try_into().unwrap()) == 1 {
+                    if b.len() >= 40
+                        && (b.len() - 40) % 8 == 0
+                        && u32::from_le_bytes(b[32..36].try_into().unwrap()) == 1
+                    {
                         plain += 1;
                     }
                     key = s.key_expr().to_string();
@@ -95,7 +121,10 @@ fn main() {
             answer(&z, &args[0], vec![b'x'; mb << 20]);
         }
         "queryable" => {
-            let q = z.declare_queryable(args[0].as_str()).wait().expect("declares");
+            let q = z
+                .declare_queryable(args[0].as_str())
+                .wait()
+                .expect("declares");
             let until = Instant::now() + Duration::from_secs_f64(args[1].parse().expect("seconds"));
             let mut n = 0;
             while Instant::now() < until {
@@ -111,11 +140,22 @@ fn main() {
 
 /// Asks the agent of `host` to start something; prints its answer.
 fn answer(z: &zenoh::Session, host: &str, payload: Vec<u8>) {
-    let replies = z.get(format!("uio/agent/{host}/start")).payload(payload).timeout(Duration::from_secs(10)).wait().expect("queries");
+    let replies = z
+        .get(format!("uio/agent/{host}/start"))
+        .payload(payload)
+        .timeout(Duration::from_secs(10))
+        .wait()
+        .expect("queries");
     match replies.recv() {
         Ok(r) => match r.result() {
-            Ok(s) => println!("reply ok: {}", s.payload().try_to_string().unwrap_or_default()),
-            Err(e) => println!("reply err: {}", e.payload().try_to_string().unwrap_or_default()),
+            Ok(s) => println!(
+                "reply ok: {}",
+                s.payload().try_to_string().unwrap_or_default()
+            ),
+            Err(e) => println!(
+                "reply err: {}",
+                e.payload().try_to_string().unwrap_or_default()
+            ),
         },
         Err(_) => println!("no reply"),
     }

@@ -21,7 +21,7 @@ use crate::credentials::{self, Credentials, Side};
 use crate::keys;
 use crate::proxy::StartRequest;
 use crate::seal::Secret;
-use crate::session::{self, open, secured, Role};
+use crate::session::{self, Role, open, secured};
 
 static STOP: AtomicBool = AtomicBool::new(false);
 
@@ -51,7 +51,8 @@ pub fn wildcard(endpoint: &str) -> bool {
     let address = endpoint.split_once('/').map_or(endpoint, |(_, a)| a);
     let host = address.rsplit_once(':').map_or(address, |(h, _)| h);
     let host = host.trim_start_matches('[').trim_end_matches(']');
-    host.parse::<std::net::IpAddr>().is_ok_and(|ip| ip.is_unspecified())
+    host.parse::<std::net::IpAddr>()
+        .is_ok_and(|ip| ip.is_unspecified())
 }
 
 /// Runs the agent until SIGTERM or SIGINT; returns the exit code.
@@ -61,11 +62,20 @@ pub fn run(o: &Options) -> i32 {
         return 2;
     }
     if wildcard(&o.listen) && !o.all_interfaces {
-        say!("agent {}: --listen {}: a wildcard address listens on every interface of this host; give the one address the launcher reaches (e.g. quic/10.0.0.2:7447), or add --all-interfaces", o.host, o.listen);
+        say!(
+            "agent {}: --listen {}: a wildcard address listens on every interface of this host; give the one address the launcher reaches (e.g. quic/10.0.0.2:7447), or add --all-interfaces",
+            o.host,
+            o.listen
+        );
         return 2;
     }
     let tls = if o.listen.starts_with("tls/") {
-        say!("agent {}: --listen {}: {}", o.host, o.listen, session::TLS_OVER_TCP);
+        say!(
+            "agent {}: --listen {}: {}",
+            o.host,
+            o.listen,
+            session::TLS_OVER_TCP
+        );
         return 2;
     } else if secured(&o.listen) {
         match credentials::load(&o.credentials, Side::Agent) {
@@ -76,13 +86,25 @@ pub fn run(o: &Options) -> i32 {
             }
         }
     } else if o.listen.starts_with("tcp/") && o.insecure {
-        say!("agent {}: --insecure: plain TCP, anyone who reaches {} can start components here and read their samples", o.host, o.listen);
+        say!(
+            "agent {}: --insecure: plain TCP, anyone who reaches {} can start components here and read their samples",
+            o.host,
+            o.listen
+        );
         None
     } else if o.listen.starts_with("tcp/") {
-        say!("agent {}: --listen {}: plain TCP admits anyone who reaches it; listen on quic/… with credentials (`launcher agent init`), or add --insecure on a network you trust", o.host, o.listen);
+        say!(
+            "agent {}: --listen {}: plain TCP admits anyone who reaches it; listen on quic/… with credentials (`launcher agent init`), or add --insecure on a network you trust",
+            o.host,
+            o.listen
+        );
         return 2;
     } else {
-        say!("agent {}: --listen {}: an endpoint is quic/<address>:<port> (or tcp/… with --insecure)", o.host, o.listen);
+        say!(
+            "agent {}: --listen {}: an endpoint is quic/<address>:<port> (or tcp/… with --insecure)",
+            o.host,
+            o.listen
+        );
         return 2;
     };
     if o.max_workers == 0 {
@@ -105,16 +127,36 @@ pub fn run(o: &Options) -> i32 {
 
 fn serve(o: &Options, tls: Option<&Credentials>) -> Result<(), String> {
     let host = o.host.as_str();
-    let z = open(Role::Router { listen: &o.listen, access: access::config(tls.is_some()) }, tls).map_err(|e| format!("cannot listen on {e}"))?;
-    let _token = z.liveliness().declare_token(keys::agent(host)).wait().map_err(|e| e.to_string())?;
-    let starts = z.declare_queryable(keys::start(host)).wait().map_err(|e| e.to_string())?;
+    let z = open(
+        Role::Router {
+            listen: &o.listen,
+            access: access::config(tls.is_some()),
+        },
+        tls,
+    )
+    .map_err(|e| format!("cannot listen on {e}"))?;
+    let _token = z
+        .liveliness()
+        .declare_token(keys::agent(host))
+        .wait()
+        .map_err(|e| e.to_string())?;
+    let starts = z
+        .declare_queryable(keys::start(host))
+        .wait()
+        .map_err(|e| e.to_string())?;
     say!("agent {host}: listening on {}", o.listen);
     // Each worker with the (run, component) it serves: one worker per pair.
     let mut workers: Vec<(Child, String, String)> = Vec::new();
     while !STOP.load(Ordering::Relaxed) {
         workers.retain_mut(|(w, _, _)| matches!(w.try_wait(), Ok(None)));
-        let Ok(Some(query)) = starts.recv_timeout(Duration::from_millis(100)) else { continue };
-        let text = query.payload().and_then(|p| p.try_to_string().ok()).map(|s| s.to_string()).unwrap_or_default();
+        let Ok(Some(query)) = starts.recv_timeout(Duration::from_millis(100)) else {
+            continue;
+        };
+        let text = query
+            .payload()
+            .and_then(|p| p.try_to_string().ok())
+            .map(|s| s.to_string())
+            .unwrap_or_default();
         let answer = admit(&text, &workers, o.max_workers).and_then(|(run, name)| {
             let w = worker(o, tls.is_some(), &text)?;
             workers.push((w, run, name));
@@ -143,29 +185,53 @@ fn serve(o: &Options, tls: Option<&Credentials>) -> Result<(), String> {
 /// Checks a start request before anything is started for it: its run id and component name
 /// are plain key chunks (no wildcards), its secret well formed, the (run, component) pair not
 /// already served, and the agent below its worker limit. Returns the pair.
-fn admit(text: &str, workers: &[(Child, String, String)], max: usize) -> Result<(String, String), String> {
-    let req: StartRequest = serde_json::from_str(text).map_err(|e| format!("bad start request: {e}"))?;
+fn admit(
+    text: &str,
+    workers: &[(Child, String, String)],
+    max: usize,
+) -> Result<(String, String), String> {
+    let req: StartRequest =
+        serde_json::from_str(text).map_err(|e| format!("bad start request: {e}"))?;
     keys::check_run(&req.run)?;
     Secret::from_hex(&req.secret)?;
-    let cfg: ComponentConfig = serde_json::from_str(&req.config).map_err(|e| format!("bad component configuration: {e}"))?;
+    let cfg: ComponentConfig = serde_json::from_str(&req.config)
+        .map_err(|e| format!("bad component configuration: {e}"))?;
     keys::check_component(&cfg.name)?;
     // What the worker will make here from the request: services (Zenoh keys and shared memory)
     // of plain names and of samples no larger than a proxy or a worker accepts.
     let max_len = (session::MAX_CLIENT_MESSAGE - 64) / 8;
-    for (service, len) in std::iter::once((&cfg.publishes.service, cfg.publishes.len)).chain(cfg.reads.iter().map(|r| (&r.service, r.len))) {
+    for (service, len) in std::iter::once((&cfg.publishes.service, cfg.publishes.len))
+        .chain(cfg.reads.iter().map(|r| (&r.service, r.len)))
+    {
         keys::check_service(service)?;
         if len == 0 || len > max_len {
-            return Err(format!("service '{}' has samples of {len} values; at most {max_len} cross hosts", service.escape_debug()));
+            return Err(format!(
+                "service '{}' has samples of {len} values; at most {max_len} cross hosts",
+                service.escape_debug()
+            ));
         }
     }
     if cfg.reads.len() > 64 {
-        return Err(format!("{} reads {} services; at most 64", cfg.name, cfg.reads.len()));
+        return Err(format!(
+            "{} reads {} services; at most 64",
+            cfg.name,
+            cfg.reads.len()
+        ));
     }
-    if workers.iter().any(|(_, r, n)| *r == req.run && *n == cfg.name) {
-        return Err(format!("run {} already has its {} here", req.run, cfg.name.escape_debug()));
+    if workers
+        .iter()
+        .any(|(_, r, n)| *r == req.run && *n == cfg.name)
+    {
+        return Err(format!(
+            "run {} already has its {} here",
+            req.run,
+            cfg.name.escape_debug()
+        ));
     }
     if workers.len() >= max {
-        return Err(format!("this agent runs {max} components already (its --max-workers)"));
+        return Err(format!(
+            "this agent runs {max} components already (its --max-workers)"
+        ));
     }
     Ok((req.run, cfg.name))
 }
@@ -174,7 +240,8 @@ fn admit(text: &str, workers: &[(Child, String, String)], max: usize) -> Result<
 fn worker(o: &Options, tls: bool, request: &str) -> Result<Child, String> {
     let exe = std::env::current_exe().map_err(|e| e.to_string())?;
     let mut cmd = Command::new(exe);
-    cmd.args(["worker", "--connect", &o.listen]).stdin(Stdio::piped());
+    cmd.args(["worker", "--connect", &o.listen])
+        .stdin(Stdio::piped());
     if tls {
         cmd.arg("--credentials").arg(&o.credentials);
     }
@@ -185,7 +252,9 @@ fn worker(o: &Options, tls: bool, request: &str) -> Result<Child, String> {
             Ok(())
         });
     }
-    let mut child = cmd.spawn().map_err(|e| format!("cannot start a worker: {e}"))?;
+    let mut child = cmd
+        .spawn()
+        .map_err(|e| format!("cannot start a worker: {e}"))?;
     let mut stdin = child.stdin.take().expect("piped");
     if let Err(e) = stdin.write_all(request.as_bytes()) {
         let _ = child.kill();
@@ -201,10 +270,21 @@ mod tests {
 
     #[test]
     fn wildcard_addresses_are_told_from_one_interfaces_address() {
-        for w in ["quic/0.0.0.0:7447", "tcp/0.0.0.0:1", "quic/[::]:7447", "tcp/[0:0:0:0:0:0:0:0]:7447"] {
+        for w in [
+            "quic/0.0.0.0:7447",
+            "tcp/0.0.0.0:1",
+            "quic/[::]:7447",
+            "tcp/[0:0:0:0:0:0:0:0]:7447",
+        ] {
             assert!(wildcard(w), "{w}");
         }
-        for one in ["quic/10.0.0.2:7447", "quic/127.0.0.1:7447", "quic/[::1]:7447", "tcp/[fe80::1]:9", "quic/agent.example:7447"] {
+        for one in [
+            "quic/10.0.0.2:7447",
+            "quic/127.0.0.1:7447",
+            "quic/[::1]:7447",
+            "tcp/[fe80::1]:9",
+            "quic/agent.example:7447",
+        ] {
             assert!(!wildcard(one), "{one}");
         }
     }

@@ -38,9 +38,20 @@ pub struct Beat {
 
 impl Beat {
     /// Beats as `me` (`proxy` or `worker`) and listens to `other`, for component `name` of `run`.
-    pub fn new(z: &Session, secret: &Secret, run: &str, name: &str, me: &str, other: &str) -> Result<Self, String> {
+    pub fn new(
+        z: &Session,
+        secret: &Secret,
+        run: &str,
+        name: &str,
+        me: &str,
+        other: &str,
+    ) -> Result<Self, String> {
         let mut tx = SealedPublisher::new(z, secret, keys::beat(run, name, me))?;
-        let (heard, armed, stop) = (Arc::new(AtomicU64::new(0)), Arc::new(AtomicBool::new(false)), Arc::new(AtomicBool::new(false)));
+        let (heard, armed, stop) = (
+            Arc::new(AtomicU64::new(0)),
+            Arc::new(AtomicBool::new(false)),
+            Arc::new(AtomicBool::new(false)),
+        );
         let key = keys::beat(run, name, other);
         let opener = Mutex::new(secret.opener(&key));
         let (h, a) = (heard.clone(), armed.clone());
@@ -48,7 +59,9 @@ impl Beat {
             .declare_subscriber(key.clone())
             .callback(move |s| {
                 let mut bytes = s.payload().to_bytes().to_vec();
-                let authentic = opener.lock().is_ok_and(|mut o| o.open(&mut bytes).is_some());
+                let authentic = opener
+                    .lock()
+                    .is_ok_and(|mut o| o.open(&mut bytes).is_some());
                 if authentic && a.load(Ordering::Relaxed) {
                     h.store(lockstep::now_ns(), Ordering::Relaxed);
                 }
@@ -65,7 +78,12 @@ impl Beat {
                 std::thread::sleep(PERIOD);
             }
         });
-        Ok(Beat { heard, armed, stop, _sub: sub })
+        Ok(Beat {
+            heard,
+            armed,
+            stop,
+            _sub: sub,
+        })
     }
 
     /// From now on, silence counts (once both sides are running).
@@ -81,7 +99,10 @@ impl Beat {
 
     /// What another thread needs to tell whether the other side is alive.
     pub fn pulse(&self) -> Pulse {
-        Pulse { heard: self.heard.clone(), armed: self.armed.clone() }
+        Pulse {
+            heard: self.heard.clone(),
+            armed: self.armed.clone(),
+        }
     }
 }
 

@@ -20,12 +20,19 @@ pub fn estimate(exchanges: &[(u64, u64, u64)]) -> Option<Offset> {
         .iter()
         .filter(|(t1, _, t3)| t3 >= t1)
         .min_by_key(|(t1, _, t3)| t3 - t1)
-        .map(|&(t1, t2, t3)| Offset { theta_ns: t2 as i64 - ((t1 as i128 + t3 as i128) / 2) as i64, rtt_ns: t3 - t1 })
+        .map(|&(t1, t2, t3)| Offset {
+            theta_ns: t2 as i64 - ((t1 as i128 + t3 as i128) / 2) as i64,
+            rtt_ns: t3 - t1,
+        })
 }
 
 /// A header time moved by `by` ns onto another clock; 0 (no time: the plant's k = 0) stays 0.
 pub fn shift(t: u64, by: i64) -> u64 {
-    if t == 0 { 0 } else { (t as i64).saturating_add(by).max(1) as u64 }
+    if t == 0 {
+        0
+    } else {
+        (t as i64).saturating_add(by).max(1) as u64
+    }
 }
 
 #[cfg(test)]
@@ -37,9 +44,22 @@ mod tests {
         // The remote clock is 5 s ahead. Symmetric 40 µs legs give it exactly; an asymmetric
         // exchange (10 µs out, 300 µs back) is off by 145 µs, but its round trip is longer.
         let ahead = 5_000_000_000i64;
-        let ex = |t1: u64, out: u64, back: u64| (t1, (t1 + out) as i64 as u64 + ahead as u64, t1 + out + back);
-        let e = estimate(&[ex(1_000, 10_000, 300_000), ex(2_000_000, 40_000, 40_000), ex(3_000_000, 90_000, 90_000)]).unwrap();
-        assert_eq!(e, Offset { theta_ns: ahead, rtt_ns: 80_000 });
+        let ex = |t1: u64, out: u64, back: u64| {
+            (t1, (t1 + out) as i64 as u64 + ahead as u64, t1 + out + back)
+        };
+        let e = estimate(&[
+            ex(1_000, 10_000, 300_000),
+            ex(2_000_000, 40_000, 40_000),
+            ex(3_000_000, 90_000, 90_000),
+        ])
+        .unwrap();
+        assert_eq!(
+            e,
+            Offset {
+                theta_ns: ahead,
+                rtt_ns: 80_000
+            }
+        );
         let skewed = estimate(&[ex(1_000, 10_000, 300_000)]).unwrap();
         assert_eq!(skewed.theta_ns - ahead, 10_000 - 155_000);
         assert!((skewed.theta_ns - ahead).unsigned_abs() <= skewed.rtt_ns / 2);

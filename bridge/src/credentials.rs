@@ -17,7 +17,10 @@ use std::io::Write;
 use std::os::unix::fs::{DirBuilderExt, MetadataExt, OpenOptionsExt, PermissionsExt};
 use std::path::{Path, PathBuf};
 
-use rcgen::{BasicConstraints, CertificateParams, CertifiedIssuer, DnType, ExtendedKeyUsagePurpose, IsCa, KeyPair, KeyUsagePurpose};
+use rcgen::{
+    BasicConstraints, CertificateParams, CertifiedIssuer, DnType, ExtendedKeyUsagePurpose, IsCa,
+    KeyPair, KeyUsagePurpose,
+};
 
 /// Environment variable naming the credentials directory.
 pub const ENV: &str = "UIO_CREDENTIALS";
@@ -66,30 +69,60 @@ pub fn default_dir() -> PathBuf {
     let config = std::env::var_os("XDG_CONFIG_HOME")
         .filter(|d| !d.is_empty())
         .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(std::env::var_os("HOME").unwrap_or_else(|| "/".into())).join(".config"));
+        .unwrap_or_else(|| {
+            PathBuf::from(std::env::var_os("HOME").unwrap_or_else(|| "/".into())).join(".config")
+        });
     config.join("uio-observers").join("credentials")
 }
 
 /// One side's credentials in `dir`, checked: every file present, regular, the key owned by us
 /// and readable by us only.
 pub fn load(dir: &Path, side: Side) -> Result<Credentials, String> {
-    let c = Credentials { ca: dir.join("ca.pem"), cert: dir.join(format!("{}.pem", side.stem())), key: dir.join(format!("{}.key", side.stem())) };
+    let c = Credentials {
+        ca: dir.join("ca.pem"),
+        cert: dir.join(format!("{}.pem", side.stem())),
+        key: dir.join(format!("{}.key", side.stem())),
+    };
     // SAFETY: geteuid has no preconditions.
     let me = unsafe { libc::geteuid() };
     // Whoever could write the folder or a certificate could swap in a CA of their own.
-    let d = fs::symlink_metadata(dir).map_err(|e| format!("{}: {e} (make the credentials with `launcher agent init`)", dir.display()))?;
+    let d = fs::symlink_metadata(dir).map_err(|e| {
+        format!(
+            "{}: {e} (make the credentials with `launcher agent init`)",
+            dir.display()
+        )
+    })?;
     if !d.file_type().is_dir() || d.uid() != me || d.mode() & 0o022 != 0 {
-        return Err(format!("{}: the credentials folder must be a real directory of this user that others cannot write (mode {:o}, owner {})", dir.display(), d.mode() & 0o777, d.uid()));
+        return Err(format!(
+            "{}: the credentials folder must be a real directory of this user that others cannot write (mode {:o}, owner {})",
+            dir.display(),
+            d.mode() & 0o777,
+            d.uid()
+        ));
     }
     for f in [&c.ca, &c.cert, &c.key] {
-        let m = fs::symlink_metadata(f).map_err(|e| format!("{}: {e} (make the credentials with `launcher agent init`)", f.display()))?;
+        let m = fs::symlink_metadata(f).map_err(|e| {
+            format!(
+                "{}: {e} (make the credentials with `launcher agent init`)",
+                f.display()
+            )
+        })?;
         if !m.file_type().is_file() || m.uid() != me || m.mode() & 0o022 != 0 {
-            return Err(format!("{}: must be a regular file of this user that others cannot write (mode {:o}, owner {})", f.display(), m.mode() & 0o777, m.uid()));
+            return Err(format!(
+                "{}: must be a regular file of this user that others cannot write (mode {:o}, owner {})",
+                f.display(),
+                m.mode() & 0o777,
+                m.uid()
+            ));
         }
     }
     let m = fs::symlink_metadata(&c.key).map_err(|e| format!("{}: {e}", c.key.display()))?;
     if m.mode() & 0o077 != 0 {
-        return Err(format!("{}: a private key must be owned by this user with mode 0600 (it is {:o})", c.key.display(), m.mode() & 0o777));
+        return Err(format!(
+            "{}: a private key must be owned by this user with mode 0600 (it is {:o})",
+            c.key.display(),
+            m.mode() & 0o777
+        ));
     }
     Ok(c)
 }
@@ -99,25 +132,53 @@ pub fn load(dir: &Path, side: Side) -> Result<Credentials, String> {
 pub fn init(dir: &Path, force: bool) -> Result<(), String> {
     let err = |e: rcgen::Error| format!("cannot make a certificate: {e}");
     if !force && dir.join("ca.pem").exists() {
-        return Err(format!("{} already holds credentials (--force replaces them, and every host then needs the new ones)", dir.display()));
+        return Err(format!(
+            "{} already holds credentials (--force replaces them, and every host then needs the new ones)",
+            dir.display()
+        ));
     }
-    fs::DirBuilder::new().recursive(true).mode(0o700).create(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    fs::DirBuilder::new()
+        .recursive(true)
+        .mode(0o700)
+        .create(dir)
+        .map_err(|e| format!("{}: {e}", dir.display()))?;
     // Opened without following a link and checked as ours before its mode is set: a link or a
     // folder of another user planted at `dir` must not get root's chmod or root's keys.
-    let opened = fs::OpenOptions::new().read(true).custom_flags(libc::O_NOFOLLOW | libc::O_DIRECTORY).open(dir);
-    let folder = opened.map_err(|e| format!("{}: not a real directory ({e}); refusing to write credentials there", dir.display()))?;
+    let opened = fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NOFOLLOW | libc::O_DIRECTORY)
+        .open(dir);
+    let folder = opened.map_err(|e| {
+        format!(
+            "{}: not a real directory ({e}); refusing to write credentials there",
+            dir.display()
+        )
+    })?;
     // SAFETY: geteuid has no preconditions.
     let me = unsafe { libc::geteuid() };
-    let owner = folder.metadata().map_err(|e| format!("{}: {e}", dir.display()))?.uid();
+    let owner = folder
+        .metadata()
+        .map_err(|e| format!("{}: {e}", dir.display()))?
+        .uid();
     if owner != me {
-        return Err(format!("{}: belongs to uid {owner}, not to this user ({me}); refusing to write credentials there", dir.display()));
+        return Err(format!(
+            "{}: belongs to uid {owner}, not to this user ({me}); refusing to write credentials there",
+            dir.display()
+        ));
     }
-    folder.set_permissions(fs::Permissions::from_mode(0o700)).map_err(|e| format!("{}: {e}", dir.display()))?;
+    folder
+        .set_permissions(fs::Permissions::from_mode(0o700))
+        .map_err(|e| format!("{}: {e}", dir.display()))?;
 
     let mut ca = CertificateParams::new(Vec::<String>::new()).map_err(err)?;
-    ca.distinguished_name.push(DnType::CommonName, "uio-observers CA");
+    ca.distinguished_name
+        .push(DnType::CommonName, "uio-observers CA");
     ca.is_ca = IsCa::Ca(BasicConstraints::Constrained(0));
-    ca.key_usages = vec![KeyUsagePurpose::KeyCertSign, KeyUsagePurpose::CrlSign, KeyUsagePurpose::DigitalSignature];
+    ca.key_usages = vec![
+        KeyUsagePurpose::KeyCertSign,
+        KeyUsagePurpose::CrlSign,
+        KeyUsagePurpose::DigitalSignature,
+    ];
     let ca_key = KeyPair::generate().map_err(err)?;
     let ca_key_pem = ca_key.serialize_pem();
     let issuer = CertifiedIssuer::self_signed(ca, ca_key).map_err(err)?;
@@ -129,14 +190,25 @@ pub fn init(dir: &Path, force: bool) -> Result<(), String> {
         let mut p = CertificateParams::new(vec![cn.to_string()]).map_err(err)?;
         p.distinguished_name.push(DnType::CommonName, cn);
         p.extended_key_usages = match side {
-            Side::Agent => vec![ExtendedKeyUsagePurpose::ServerAuth, ExtendedKeyUsagePurpose::ClientAuth],
+            Side::Agent => vec![
+                ExtendedKeyUsagePurpose::ServerAuth,
+                ExtendedKeyUsagePurpose::ClientAuth,
+            ],
             Side::Launcher => vec![ExtendedKeyUsagePurpose::ClientAuth],
         };
         p.key_usages = vec![KeyUsagePurpose::DigitalSignature];
         let key = KeyPair::generate().map_err(err)?;
         let cert = p.signed_by(&key, &issuer).map_err(err)?;
-        write(&dir.join(format!("{}.key", side.stem())), &key.serialize_pem(), 0o600)?;
-        write(&dir.join(format!("{}.pem", side.stem())), &cert.pem(), 0o644)?;
+        write(
+            &dir.join(format!("{}.key", side.stem())),
+            &key.serialize_pem(),
+            0o600,
+        )?;
+        write(
+            &dir.join(format!("{}.pem", side.stem())),
+            &cert.pem(),
+            0o644,
+        )?;
     }
     Ok(())
 }
@@ -146,8 +218,16 @@ pub fn init(dir: &Path, force: bool) -> Result<(), String> {
 fn write(path: &Path, text: &str, mode: u32) -> Result<(), String> {
     let tmp = path.with_extension("new");
     let _ = fs::remove_file(&tmp);
-    let mut f = fs::OpenOptions::new().write(true).create_new(true).mode(mode).custom_flags(libc::O_NOFOLLOW).open(&tmp).map_err(|e| format!("{}: {e}", tmp.display()))?;
-    f.write_all(text.as_bytes()).and_then(|_| f.sync_all()).map_err(|e| format!("{}: {e}", tmp.display()))?;
+    let mut f = fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .mode(mode)
+        .custom_flags(libc::O_NOFOLLOW)
+        .open(&tmp)
+        .map_err(|e| format!("{}: {e}", tmp.display()))?;
+    f.write_all(text.as_bytes())
+        .and_then(|_| f.sync_all())
+        .map_err(|e| format!("{}: {e}", tmp.display()))?;
     fs::rename(&tmp, path).map_err(|e| format!("{}: {e}", path.display()))
 }
 
@@ -182,21 +262,41 @@ mod tests {
         init(&dir, false).unwrap();
         for side in [Side::Agent, Side::Launcher] {
             let c = load(&dir, side).unwrap();
-            assert!(fs::read_to_string(&c.cert).unwrap().starts_with("-----BEGIN CERTIFICATE-----"));
+            assert!(
+                fs::read_to_string(&c.cert)
+                    .unwrap()
+                    .starts_with("-----BEGIN CERTIFICATE-----")
+            );
             assert_eq!(fs::metadata(&c.key).unwrap().mode() & 0o777, 0o600);
         }
         assert_eq!(fs::metadata(&dir).unwrap().mode() & 0o777, 0o700);
-        assert!(init(&dir, false).unwrap_err().contains("already holds credentials"));
+        assert!(
+            init(&dir, false)
+                .unwrap_err()
+                .contains("already holds credentials")
+        );
         fs::set_permissions(dir.join("agent.key"), fs::Permissions::from_mode(0o644)).unwrap();
         assert!(load(&dir, Side::Agent).unwrap_err().contains("mode 0600"));
         init(&dir, true).unwrap();
         assert!(load(&dir, Side::Agent).is_ok());
         fs::set_permissions(dir.join("ca.pem"), fs::Permissions::from_mode(0o666)).unwrap();
-        assert!(load(&dir, Side::Launcher).unwrap_err().contains("others cannot write"));
+        assert!(
+            load(&dir, Side::Launcher)
+                .unwrap_err()
+                .contains("others cannot write")
+        );
         fs::set_permissions(dir.join("ca.pem"), fs::Permissions::from_mode(0o644)).unwrap();
         fs::set_permissions(&dir, fs::Permissions::from_mode(0o777)).unwrap();
-        assert!(load(&dir, Side::Launcher).unwrap_err().contains("credentials folder"));
+        assert!(
+            load(&dir, Side::Launcher)
+                .unwrap_err()
+                .contains("credentials folder")
+        );
         let _ = fs::remove_dir_all(&dir);
-        assert!(load(&dir, Side::Launcher).unwrap_err().contains("launcher agent init"));
+        assert!(
+            load(&dir, Side::Launcher)
+                .unwrap_err()
+                .contains("launcher agent init")
+        );
     }
 }

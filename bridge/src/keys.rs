@@ -56,13 +56,19 @@ pub fn alive(run: &str, name: &str, side: &str) -> String {
 
 /// 1–64 letters, digits, `-` and `_`: one key chunk, never a wildcard or a separator.
 fn chunk(s: &str) -> bool {
-    !s.is_empty() && s.len() <= 64 && s.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+    !s.is_empty()
+        && s.len() <= 64
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
 }
 
 /// A host name is one key chunk: letters, digits, `-` and `_`.
 pub fn check_host(host: &str) -> Result<(), String> {
     if !chunk(host) {
-        return Err(format!("'{}' is not a host name (1–64 letters, digits, - and _)", host.escape_debug()));
+        return Err(format!(
+            "'{}' is not a host name (1–64 letters, digits, - and _)",
+            host.escape_debug()
+        ));
     }
     Ok(())
 }
@@ -70,7 +76,10 @@ pub fn check_host(host: &str) -> Result<(), String> {
 /// A component's name is one key chunk (as scenario names are).
 pub fn check_component(name: &str) -> Result<(), String> {
     if !chunk(name) {
-        return Err(format!("'{}' is not a component name (1–64 letters, digits, - and _)", name.escape_debug()));
+        return Err(format!(
+            "'{}' is not a component name (1–64 letters, digits, - and _)",
+            name.escape_debug()
+        ));
     }
     Ok(())
 }
@@ -78,7 +87,10 @@ pub fn check_component(name: &str) -> Result<(), String> {
 /// A service name is key chunks joined by `/` (`plant`, `observer/uio`): no wildcards.
 pub fn check_service(service: &str) -> Result<(), String> {
     if service.len() > 200 || !service.split('/').all(chunk) {
-        return Err(format!("'{}' is not a service name (chunks of letters, digits, - and _ joined by /)", service.escape_debug()));
+        return Err(format!(
+            "'{}' is not a service name (chunks of letters, digits, - and _ joined by /)",
+            service.escape_debug()
+        ));
     }
     Ok(())
 }
@@ -86,7 +98,10 @@ pub fn check_service(service: &str) -> Result<(), String> {
 /// A run id is what a launcher's `RunSpace` makes ([`lockstep::is_run_id`]).
 pub fn check_run(run: &str) -> Result<(), String> {
     if !lockstep::is_run_id(run) {
-        return Err(format!("'{}' is not a run id (a launcher's run id is <pid>x<n>x<nonce>, in digits)", run.escape_debug()));
+        return Err(format!(
+            "'{}' is not a run id (a launcher's run id is <pid>x<n>x<nonce>, in digits)",
+            run.escape_debug()
+        ));
     }
     Ok(())
 }

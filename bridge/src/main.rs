@@ -111,12 +111,20 @@ fn main() {
     zenoh::try_init_log_from_env();
     let cli = Cli::parse();
     let code = match cli.command {
-        Cmd::Agent { init: Some(Init::Init { dir, force }), .. } => {
+        Cmd::Agent {
+            init: Some(Init::Init { dir, force }),
+            ..
+        } => {
             let dir = dir.unwrap_or_else(credentials::default_dir);
             match credentials::init(&dir, force) {
                 Ok(()) => {
-                    println!("credentials in {}: ca.pem, agent.pem/.key (for agents), launcher.pem/.key (for launchers)", dir.display());
-                    println!("copy ca.pem and the agent's pair to each agent's host, and ca.pem and the launcher's pair to each launcher's host (same directory, or set UIO_CREDENTIALS / --credentials); ca.key stays here");
+                    println!(
+                        "credentials in {}: ca.pem, agent.pem/.key (for agents), launcher.pem/.key (for launchers)",
+                        dir.display()
+                    );
+                    println!(
+                        "copy ca.pem and the agent's pair to each agent's host, and ca.pem and the launcher's pair to each launcher's host (same directory, or set UIO_CREDENTIALS / --credentials); ca.key stays here"
+                    );
                     0
                 }
                 Err(e) => {
@@ -125,15 +133,37 @@ fn main() {
                 }
             }
         }
-        Cmd::Agent { init: None, host, listen, credentials: dir, insecure, max_workers, all_interfaces } => {
+        Cmd::Agent {
+            init: None,
+            host,
+            listen,
+            credentials: dir,
+            insecure,
+            max_workers,
+            all_interfaces,
+        } => {
             let (Some(host), Some(listen)) = (host, listen) else {
                 say!("agent: --host and --listen are required (or `agent init`)");
                 std::process::exit(2);
             };
-            agent::run(&agent::Options { host, listen, credentials: dir.unwrap_or_else(credentials::default_dir), insecure, max_workers, all_interfaces })
+            agent::run(&agent::Options {
+                host,
+                listen,
+                credentials: dir.unwrap_or_else(credentials::default_dir),
+                insecure,
+                max_workers,
+                all_interfaces,
+            })
         }
-        Cmd::Remote { host, connect, builtin } => proxy::run(&host, &connect, &builtin),
-        Cmd::Worker { connect, credentials } => worker::run(&connect, credentials.as_deref()),
+        Cmd::Remote {
+            host,
+            connect,
+            builtin,
+        } => proxy::run(&host, &connect, &builtin),
+        Cmd::Worker {
+            connect,
+            credentials,
+        } => worker::run(&connect, credentials.as_deref()),
     };
     std::process::exit(code);
 }

@@ -8,17 +8,17 @@ use std::time::{Duration, Instant};
 
 use lockstep::component::ComponentConfig;
 use lockstep::{Bus, RunSpace, Wait};
-use zenoh::sample::SampleKind;
 use zenoh::Wait as _;
+use zenoh::sample::SampleKind;
 
 use crate::beat::{Beat, Pulse};
-use crate::clock::{estimate, Offset};
+use crate::clock::{Offset, estimate};
 use crate::credentials::{self, Side};
 use crate::keys;
 use crate::pump::{Exports, Idle, Imports};
 use crate::seal::Secret;
 use crate::sealed::{SealedPublisher, SealedSubscriber};
-use crate::session::{open, secured, Role, MAX_MESSAGE};
+use crate::session::{MAX_MESSAGE, Role, open, secured};
 
 /// What the agent is asked to start.
 #[derive(serde::Serialize, serde::Deserialize)]
@@ -49,39 +49,90 @@ pub fn run(host: &str, connect: &str, builtin: &str) -> i32 {
 }
 
 fn proxy(host: &str, connect: &str, builtin: &str) -> Result<i32, String> {
-    let path = std::env::var("UIO_CONFIG").map_err(|_| "UIO_CONFIG is not set: the proxy is started by the launcher".to_string())?;
+    let path = std::env::var("UIO_CONFIG")
+        .map_err(|_| "UIO_CONFIG is not set: the proxy is started by the launcher".to_string())?;
     let text = std::fs::read_to_string(&path).map_err(|e| format!("{path}: {e}"))?;
     let cfg: ComponentConfig = serde_json::from_str(&text).map_err(|e| format!("{path}: {e}"))?;
     let wait: Wait = cfg.wait.parse().map_err(|e| format!("{path}: wait: {e}"))?;
     let space = RunSpace::open(&cfg.run).map_err(|e| e.to_string())?;
-    let bus = Bus::join(&space, &format!("bridge-{}", cfg.name), wait).map_err(|e| e.to_string())?;
+    let bus =
+        Bus::join(&space, &format!("bridge-{}", cfg.name), wait).map_err(|e| e.to_string())?;
 
-    let tls = if secured(connect) { Some(credentials::load(&credentials::default_dir(), Side::Launcher)?) } else { None };
+    let tls = if secured(connect) {
+        Some(credentials::load(
+            &credentials::default_dir(),
+            Side::Launcher,
+        )?)
+    } else {
+        None
+    };
     let z = connect_to(connect, tls.as_ref())?;
     wait_for_agent(&z, host, connect)?;
     let (run, name) = (cfg.run.as_str(), cfg.name.as_str());
     let secret = Secret::draw()?;
-    let _token = z.liveliness().declare_token(keys::alive(run, name, "proxy")).wait().map_err(|e| e.to_string())?;
-    let worker = z.liveliness().declare_subscriber(keys::alive(run, name, "worker")).wait().map_err(|e| e.to_string())?;
+    let _token = z
+        .liveliness()
+        .declare_token(keys::alive(run, name, "proxy"))
+        .wait()
+        .map_err(|e| e.to_string())?;
+    let worker = z
+        .liveliness()
+        .declare_subscriber(keys::alive(run, name, "worker"))
+        .wait()
+        .map_err(|e| e.to_string())?;
     let mut status = SealedSubscriber::new(&z, &secret, keys::status(run, name))?;
     let mut go = SealedPublisher::new(&z, &secret, keys::go(run, name))?;
-    let mut imports = Imports::new(&bus, &z, &secret, &[(cfg.publishes.service.clone(), cfg.publishes.len, keys::from_component(run, name))])?;
-    let reads: Vec<(String, String)> = cfg.reads.iter().map(|r| (r.service.clone(), keys::to_component(run, name, &r.service))).collect();
+    let mut imports = Imports::new(
+        &bus,
+        &z,
+        &secret,
+        &[(
+            cfg.publishes.service.clone(),
+            cfg.publishes.len,
+            keys::from_component(run, name),
+        )],
+    )?;
+    let reads: Vec<(String, String)> = cfg
+        .reads
+        .iter()
+        .map(|r| (r.service.clone(), keys::to_component(run, name, &r.service)))
+        .collect();
     let mut exports = Exports::new(&bus, &z, &secret, &reads)?;
     let mut beat = Beat::new(&z, &secret, run, name, "proxy", "worker")?;
 
-    let request = serde_json::to_string(&StartRequest { run: run.to_string(), builtin: builtin.to_string(), config: text.clone(), secret: secret.to_hex() }).expect("serialises");
+    let request = serde_json::to_string(&StartRequest {
+        run: run.to_string(),
+        builtin: builtin.to_string(),
+        config: text.clone(),
+        secret: secret.to_hex(),
+    })
+    .expect("serialises");
     if request.len() > MAX_MESSAGE {
-        return Err(format!("{name}'s configuration is {} bytes; a start request carries at most {MAX_MESSAGE}", request.len()));
+        return Err(format!(
+            "{name}'s configuration is {} bytes; a start request carries at most {MAX_MESSAGE}",
+            request.len()
+        ));
     }
-    let replies = z.get(keys::start(host)).payload(request).timeout(Duration::from_secs(10)).wait().map_err(|e| e.to_string())?;
+    let replies = z
+        .get(keys::start(host))
+        .payload(request)
+        .timeout(Duration::from_secs(10))
+        .wait()
+        .map_err(|e| e.to_string())?;
     match replies.recv() {
         Ok(reply) => {
             if let Err(e) = reply.result() {
-                return Err(format!("its agent cannot start {name}: {}", e.payload().try_to_string().unwrap_or_default()));
+                return Err(format!(
+                    "its agent cannot start {name}: {}",
+                    e.payload().try_to_string().unwrap_or_default()
+                ));
             }
         }
-        Err(_) => return Err(format!("its agent at {connect} did not answer the start of {name}")),
+        Err(_) => {
+            return Err(format!(
+                "its agent at {connect} did not answer the start of {name}"
+            ));
+        }
     }
     // The component is up on the other host when its worker says `ready`.
     let deadline = Instant::now() + Duration::from_secs(20);
@@ -89,7 +140,9 @@ fn proxy(host: &str, connect: &str, builtin: &str) -> Result<i32, String> {
         if let Ok(Some(s)) = worker.try_recv()
             && s.kind() == SampleKind::Delete
         {
-            return Err(format!("its worker for {name} stopped before the component was ready"));
+            return Err(format!(
+                "its worker for {name} stopped before the component was ready"
+            ));
         }
         if let Some(line) = status.try_recv_text() {
             if line == "ready" {
@@ -128,7 +181,11 @@ fn proxy(host: &str, connect: &str, builtin: &str) -> Result<i32, String> {
 /// as it did.
 fn finish(name: &str, host: &str, line: &str, imports: &mut Imports) -> Result<i32, String> {
     let mut parts = line.splitn(4, ' ');
-    let (Some("exit"), Some(code), Some(count)) = (parts.next(), parts.next().and_then(|c| c.parse::<i32>().ok()), parts.next().and_then(|c| c.parse::<u64>().ok())) else {
+    let (Some("exit"), Some(code), Some(count)) = (
+        parts.next(),
+        parts.next().and_then(|c| c.parse::<i32>().ok()),
+        parts.next().and_then(|c| c.parse::<u64>().ok()),
+    ) else {
         return Err(format!("{name}: its worker said '{}'", line.escape_debug()));
     };
     let message = parts.next().unwrap_or("");
@@ -139,7 +196,10 @@ fn finish(name: &str, host: &str, line: &str, imports: &mut Imports) -> Result<i
         }
     }
     if imports.received < count {
-        return Err(format!("{name} sent {count} samples, {} arrived", imports.received));
+        return Err(format!(
+            "{name} sent {count} samples, {} arrived",
+            imports.received
+        ));
     }
     if code != 0 {
         say!("{name} on host {host}: {message}");
@@ -152,12 +212,19 @@ fn finish(name: &str, host: &str, line: &str, imports: &mut Imports) -> Result<i
 fn wait_for_agent(z: &zenoh::Session, host: &str, connect: &str) -> Result<(), String> {
     let asked = Instant::now();
     loop {
-        let replies = z.liveliness().get(keys::agent(host)).timeout(Duration::from_millis(500)).wait().map_err(|e| e.to_string())?;
+        let replies = z
+            .liveliness()
+            .get(keys::agent(host))
+            .timeout(Duration::from_millis(500))
+            .wait()
+            .map_err(|e| e.to_string())?;
         if replies.recv().is_ok() {
             return Ok(());
         }
         if asked.elapsed() > Duration::from_secs(2) {
-            return Err(format!("no agent answers at {connect} (start `launcher agent --host {host} --listen {connect}` there)"));
+            return Err(format!(
+                "no agent answers at {connect} (start `launcher agent --host {host} --listen {connect}` there)"
+            ));
         }
         std::thread::sleep(Duration::from_millis(50));
     }
@@ -173,11 +240,13 @@ fn lost(name: &str) -> String {
 /// lease alone let such a run go on past the launcher's 5 s hang rule.
 fn watchdog(z: &zenoh::Session, pulse: Pulse, host: &str, name: &str) {
     let (z, host, name) = (z.clone(), host.to_string(), name.to_string());
-    std::thread::spawn(move || loop {
-        std::thread::sleep(Duration::from_millis(100));
-        if z.info().routers_zid().wait().next().is_none() || !pulse.alive() {
-            say!("host {host}: {}", lost(&name));
-            std::process::exit(FAILED);
+    std::thread::spawn(move || {
+        loop {
+            std::thread::sleep(Duration::from_millis(100));
+            if z.info().routers_zid().wait().next().is_none() || !pulse.alive() {
+                say!("host {host}: {}", lost(&name));
+                std::process::exit(FAILED);
+            }
         }
     });
 }
@@ -185,19 +254,29 @@ fn watchdog(z: &zenoh::Session, pulse: Pulse, host: &str, name: &str) {
 /// Opens the client session to the agent. A flood of idle connections can hold the agent's
 /// handshake slots for up to its accept timeout: the session is retried for 10 s before the
 /// agent is called unreachable.
-fn connect_to(connect: &str, tls: Option<&credentials::Credentials>) -> Result<zenoh::Session, String> {
+fn connect_to(
+    connect: &str,
+    tls: Option<&credentials::Credentials>,
+) -> Result<zenoh::Session, String> {
     let deadline = Instant::now() + Duration::from_secs(10);
     loop {
         match open(Role::Client { connect }, tls) {
             Ok(z) => return Ok(z),
-            Err(e) if Instant::now() >= deadline => return Err(format!("cannot reach its agent at {e}")),
+            Err(e) if Instant::now() >= deadline => {
+                return Err(format!("cannot reach its agent at {e}"));
+            }
             Err(_) => std::thread::sleep(Duration::from_millis(250)),
         }
     }
 }
 
 /// Round trips with the worker ([`crate::clock`]): 16 exchanges, the shortest one's offset.
-fn probe_clock(z: &zenoh::Session, secret: &Secret, run: &str, name: &str) -> Result<Offset, String> {
+fn probe_clock(
+    z: &zenoh::Session,
+    secret: &Secret,
+    run: &str,
+    name: &str,
+) -> Result<Offset, String> {
     let mut pongs = SealedSubscriber::new(z, secret, keys::pong(run, name))?;
     let mut ping = SealedPublisher::new(z, secret, keys::ping(run, name))?;
     let mut exchanges = Vec::new();
@@ -206,15 +285,22 @@ fn probe_clock(z: &zenoh::Session, secret: &Secret, run: &str, name: &str) -> Re
         ping.put(&t1.to_le_bytes())?;
         let deadline = Instant::now() + Duration::from_secs(1);
         while Instant::now() < deadline {
-            let Some(b) = pongs.recv_timeout(Duration::from_millis(100)) else { continue };
+            let Some(b) = pongs.recv_timeout(Duration::from_millis(100)) else {
+                continue;
+            };
             let t3 = lockstep::now_ns();
             if b.len() == 16 && b[..8] == t1.to_le_bytes() {
-                exchanges.push((t1, u64::from_le_bytes(b[8..].try_into().expect("8 bytes")), t3));
+                exchanges.push((
+                    t1,
+                    u64::from_le_bytes(b[8..].try_into().expect("8 bytes")),
+                    t3,
+                ));
                 break;
             }
         }
     }
-    estimate(&exchanges).ok_or_else(|| format!("its worker for {name} does not answer the clock probes"))
+    estimate(&exchanges)
+        .ok_or_else(|| format!("its worker for {name} does not answer the clock probes"))
 }
 
 fn exit_message(name: &str, line: &str) -> String {

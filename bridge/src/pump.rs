@@ -32,13 +32,22 @@ pub struct Imports {
 
 impl Exports {
     /// Reads each (service, key) on `bus` and sends it, sealed, under its key.
-    pub fn new(bus: &Bus, z: &Session, secret: &Secret, services: &[(String, String)]) -> Result<Self, String> {
+    pub fn new(
+        bus: &Bus,
+        z: &Session,
+        secret: &Secret,
+        services: &[(String, String)],
+    ) -> Result<Self, String> {
         let mut list = Vec::new();
         for (s, key) in services {
             let reader = bus.reader(s).map_err(|e| format!("{s}: {e}"))?;
             list.push((reader, SealedPublisher::new(z, secret, key.clone())?));
         }
-        Ok(Exports { list, buf: Vec::new(), sent: 0 })
+        Ok(Exports {
+            list,
+            buf: Vec::new(),
+            sent: 0,
+        })
     }
 
     /// Sends what has arrived; returns how many samples.
@@ -65,13 +74,27 @@ impl Exports {
 
 impl Imports {
     /// Publishes each (service, values per sample, key) on `bus` from its key's sealed samples.
-    pub fn new(bus: &Bus, z: &Session, secret: &Secret, services: &[(String, usize, String)]) -> Result<Self, String> {
+    pub fn new(
+        bus: &Bus,
+        z: &Session,
+        secret: &Secret,
+        services: &[(String, usize, String)],
+    ) -> Result<Self, String> {
         let mut list = Vec::new();
         for (s, len, key) in services {
             let outlet = bus.outlet(s, *len).map_err(|e| format!("{s}: {e}"))?;
-            list.push((SealedSubscriber::new(z, secret, key.clone())?, outlet, s.clone()));
+            list.push((
+                SealedSubscriber::new(z, secret, key.clone())?,
+                outlet,
+                s.clone(),
+            ));
         }
-        Ok(Imports { list, values: Vec::new(), received: 0, shift_ns: 0 })
+        Ok(Imports {
+            list,
+            values: Vec::new(),
+            received: 0,
+            shift_ns: 0,
+        })
     }
 
     /// Publishes what has arrived; returns how many samples. A sample of the wrong size from
@@ -81,13 +104,20 @@ impl Imports {
         for (sub, outlet, service) in &mut self.list {
             for _ in 0..64 {
                 let Some(bytes) = sub.try_recv() else { break };
-                let mut h = decode(bytes, &mut self.values).map_err(|e| format!("{service}: {e}"))?;
+                let mut h =
+                    decode(bytes, &mut self.values).map_err(|e| format!("{service}: {e}"))?;
                 h.sent_ns = shift(h.sent_ns, self.shift_ns);
                 h.taken_ns = shift(h.taken_ns, self.shift_ns);
                 if self.values.len() != outlet.len() {
-                    return Err(format!("{service}: a sample of {} values arrived; the service holds {}", self.values.len(), outlet.len()));
+                    return Err(format!(
+                        "{service}: a sample of {} values arrived; the service holds {}",
+                        self.values.len(),
+                        outlet.len()
+                    ));
                 }
-                outlet.forward(&h, &self.values).map_err(|e| format!("{service}: {e}"))?;
+                outlet
+                    .forward(&h, &self.values)
+                    .map_err(|e| format!("{service}: {e}"))?;
                 n += 1;
             }
         }

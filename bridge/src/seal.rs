@@ -10,8 +10,8 @@
 //! receiver accepts only numbers above the last it accepted (Zenoh delivers one publisher's
 //! messages in order), so a replayed or reordered message is refused like a forged one.
 
-use ring::aead::{Aad, LessSafeKey, Nonce, UnboundKey, CHACHA20_POLY1305, NONCE_LEN};
-use ring::hkdf::{Salt, HKDF_SHA256};
+use ring::aead::{Aad, CHACHA20_POLY1305, LessSafeKey, NONCE_LEN, Nonce, UnboundKey};
+use ring::hkdf::{HKDF_SHA256, Salt};
 use ring::rand::{SecureRandom, SystemRandom};
 
 /// Bytes of a run secret.
@@ -28,7 +28,9 @@ impl Secret {
     /// A fresh secret from the system's random source.
     pub fn draw() -> Result<Self, String> {
         let mut s = [0u8; SECRET_BYTES];
-        SystemRandom::new().fill(&mut s).map_err(|_| "the system's random source failed".to_string())?;
+        SystemRandom::new()
+            .fill(&mut s)
+            .map_err(|_| "the system's random source failed".to_string())?;
         Ok(Secret(s))
     }
 
@@ -69,12 +71,19 @@ impl Secret {
 
     /// The sealer of the messages this side sends under `key_expr`.
     pub fn sealer(&self, key_expr: &str) -> Sealer {
-        Sealer { key: self.key(key_expr), sent: 0 }
+        Sealer {
+            key: self.key(key_expr),
+            sent: 0,
+        }
     }
 
     /// The opener of the messages the other side sends under `key_expr`.
     pub fn opener(&self, key_expr: &str) -> Opener {
-        Opener { key: self.key(key_expr), last: 0, refused: 0 }
+        Opener {
+            key: self.key(key_expr),
+            last: 0,
+            refused: 0,
+        }
     }
 }
 
@@ -98,7 +107,10 @@ impl Sealer {
         out.extend(self.sent.to_le_bytes());
         out.extend_from_slice(plain);
         let (head, body) = out.split_at_mut(8);
-        let tag = self.key.seal_in_place_separate_tag(nonce(self.sent), Aad::from(&head[..]), body).expect("a message under 256 GiB");
+        let tag = self
+            .key
+            .seal_in_place_separate_tag(nonce(self.sent), Aad::from(&head[..]), body)
+            .expect("a message under 256 GiB");
         out.extend_from_slice(tag.as_ref());
     }
 
@@ -126,10 +138,15 @@ impl Opener {
         let ok = sealed.len() >= OVERHEAD && {
             let n = u64::from_le_bytes(sealed[..8].try_into().expect("8 bytes"));
             let (head, body) = sealed.split_at_mut(8);
-            n > self.last && self.key.open_in_place(nonce(n), Aad::from(&head[..]), body).is_ok() && {
-                self.last = n;
-                true
-            }
+            n > self.last
+                && self
+                    .key
+                    .open_in_place(nonce(n), Aad::from(&head[..]), body)
+                    .is_ok()
+                && {
+                    self.last = n;
+                    true
+                }
         };
         if ok {
             let len = sealed.len() - 16;
@@ -157,7 +174,9 @@ mod tests {
         // A replay of an accepted message, a message for another key, another run's secret,
         // a flipped byte and a short message are all refused.
         assert_eq!(rx.open(&mut replay), None);
-        let mut other_key = s.sealer("uio/run/1x0x2/c/plant/status").seal(b"exit 4 0 forged");
+        let mut other_key = s
+            .sealer("uio/run/1x0x2/c/plant/status")
+            .seal(b"exit 4 0 forged");
         assert_eq!(rx.open(&mut other_key), None);
         let mut other_run = Secret::draw().unwrap().sealer(key).seal(b"forged");
         assert_eq!(rx.open(&mut other_run), None);

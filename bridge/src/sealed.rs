@@ -29,13 +29,20 @@ impl SealedPublisher {
             .express(true)
             .wait()
             .map_err(|e| format!("zenoh publisher {key}: {e}"))?;
-        Ok(SealedPublisher { sealer: secret.sealer(&key), publisher, buf: Vec::new() })
+        Ok(SealedPublisher {
+            sealer: secret.sealer(&key),
+            publisher,
+            buf: Vec::new(),
+        })
     }
 
     /// Seals and sends `plain`.
     pub fn put(&mut self, plain: &[u8]) -> Result<(), String> {
         self.sealer.seal_into(plain, &mut self.buf);
-        self.publisher.put(self.buf.as_slice()).wait().map_err(|e| format!("sending to the other host: {e}"))
+        self.publisher
+            .put(self.buf.as_slice())
+            .wait()
+            .map_err(|e| format!("sending to the other host: {e}"))
     }
 }
 
@@ -50,8 +57,16 @@ pub struct SealedSubscriber {
 impl SealedSubscriber {
     /// Declares the subscriber of `key` for the run of `secret`.
     pub fn new(z: &Session, secret: &Secret, key: String) -> Result<Self, String> {
-        let sub = z.declare_subscriber(key.clone()).wait().map_err(|e| format!("zenoh subscriber {key}: {e}"))?;
-        Ok(SealedSubscriber { sub, opener: secret.opener(&key), key, buf: Vec::new() })
+        let sub = z
+            .declare_subscriber(key.clone())
+            .wait()
+            .map_err(|e| format!("zenoh subscriber {key}: {e}"))?;
+        Ok(SealedSubscriber {
+            sub,
+            opener: secret.opener(&key),
+            key,
+            buf: Vec::new(),
+        })
     }
 
     /// The next authentic message that has arrived, if any (without blocking).
@@ -67,14 +82,19 @@ impl SealedSubscriber {
                 return Some(&self.buf[8..len]);
             }
             if refused.is_multiple_of(1000) {
-                say!("ignored a message on {} that is not from this run's other side ({} so far)", self.key, refused + 1);
+                say!(
+                    "ignored a message on {} that is not from this run's other side ({} so far)",
+                    self.key,
+                    refused + 1
+                );
             }
         }
     }
 
     /// [`SealedSubscriber::try_recv`] as text.
     pub fn try_recv_text(&mut self) -> Option<String> {
-        self.try_recv().map(|b| String::from_utf8_lossy(b).into_owned())
+        self.try_recv()
+            .map(|b| String::from_utf8_lossy(b).into_owned())
     }
 
     /// Waits up to `timeout` for the next authentic message.

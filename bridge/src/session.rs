@@ -17,7 +17,7 @@
 //! `UIO_ZENOH_CONFIG`, when set, names a Zenoh configuration file (JSON5) to start from; the
 //! settings above are applied on top of it.
 
-use serde_json::{json, Value};
+use serde_json::{Value, json};
 use zenoh::{Config, Session, Wait};
 
 use crate::credentials::Credentials;
@@ -66,10 +66,14 @@ pub enum Role<'a> {
 /// failed.
 pub fn open(role: Role, tls: Option<&Credentials>) -> Result<Session, String> {
     let mut c = match std::env::var_os("UIO_ZENOH_CONFIG") {
-        Some(path) => Config::from_file(&path).map_err(|e| format!("UIO_ZENOH_CONFIG {}: {e}", path.to_string_lossy()))?,
+        Some(path) => Config::from_file(&path)
+            .map_err(|e| format!("UIO_ZENOH_CONFIG {}: {e}", path.to_string_lossy()))?,
         None => Config::default(),
     };
-    let set = |c: &mut Config, k: &str, v: Value| c.insert_json5(k, &v.to_string()).map_err(|e| format!("zenoh configuration {k}: {e}"));
+    let set = |c: &mut Config, k: &str, v: Value| {
+        c.insert_json5(k, &v.to_string())
+            .map_err(|e| format!("zenoh configuration {k}: {e}"))
+    };
     let endpoint = match &role {
         Role::Router { listen, access } => {
             set(&mut c, "mode", json!("router"))?;
@@ -85,11 +89,21 @@ pub fn open(role: Role, tls: Option<&Credentials>) -> Result<Session, String> {
         }
     };
     if secured(endpoint) {
-        let Some(t) = tls else { return Err(format!("{endpoint}: a secured endpoint needs credentials")) };
+        let Some(t) = tls else {
+            return Err(format!("{endpoint}: a secured endpoint needs credentials"));
+        };
         let path = |p: &std::path::Path| json!(p.to_string_lossy());
-        set(&mut c, "transport/link/tls/root_ca_certificate", path(&t.ca))?;
+        set(
+            &mut c,
+            "transport/link/tls/root_ca_certificate",
+            path(&t.ca),
+        )?;
         set(&mut c, "transport/link/tls/enable_mtls", json!(true))?;
-        set(&mut c, "transport/link/tls/verify_name_on_connect", json!(false))?;
+        set(
+            &mut c,
+            "transport/link/tls/verify_name_on_connect",
+            json!(false),
+        )?;
         let (cert, key) = match role {
             Role::Router { .. } => ("listen_certificate", "listen_private_key"),
             Role::Client { .. } => ("connect_certificate", "connect_private_key"),
@@ -102,17 +116,43 @@ pub fn open(role: Role, tls: Option<&Credentials>) -> Result<Session, String> {
     set(&mut c, "transport/link/tx/lease", json!(LEASE_MS))?;
     // Only the agent receives start requests; a proxy or a worker receives samples and short
     // control messages, so a peer cannot fill them with large forgeries.
-    let max = if matches!(role, Role::Router { .. }) { MAX_MESSAGE } else { MAX_CLIENT_MESSAGE };
+    let max = if matches!(role, Role::Router { .. }) {
+        MAX_MESSAGE
+    } else {
+        MAX_CLIENT_MESSAGE
+    };
     set(&mut c, "transport/link/rx/max_message_size", json!(max))?;
     // A publisher blocked on a dead link (QUIC: a killed peer sends nothing) gives up with the
     // lease, not Zenoh's default 5 s.
-    set(&mut c, "transport/link/tx/queue/congestion_control/block/wait_before_close", json!(LEASE_MS * 1000))?;
-    set(&mut c, "transport/unicast/max_sessions", json!(MAX_SESSIONS))?;
-    set(&mut c, "transport/unicast/accept_timeout", json!(ACCEPT_TIMEOUT_MS))?;
-    set(&mut c, "transport/unicast/accept_pending", json!(ACCEPT_PENDING))?;
+    set(
+        &mut c,
+        "transport/link/tx/queue/congestion_control/block/wait_before_close",
+        json!(LEASE_MS * 1000),
+    )?;
+    set(
+        &mut c,
+        "transport/unicast/max_sessions",
+        json!(MAX_SESSIONS),
+    )?;
+    set(
+        &mut c,
+        "transport/unicast/accept_timeout",
+        json!(ACCEPT_TIMEOUT_MS),
+    )?;
+    set(
+        &mut c,
+        "transport/unicast/accept_pending",
+        json!(ACCEPT_PENDING),
+    )?;
     // Zenoh's messages end with the source location that raised them: not the user's concern.
     zenoh::open(c).wait().map_err(|e| {
         let e = e.to_string();
-        format!("{endpoint}: {}", e.split("  at ").next().unwrap_or(&e).trim_end_matches(['!', ' ']))
+        format!(
+            "{endpoint}: {}",
+            e.split("  at ")
+                .next()
+                .unwrap_or(&e)
+                .trim_end_matches(['!', ' '])
+        )
     })
 }

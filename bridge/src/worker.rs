@@ -9,13 +9,13 @@ use std::io::{BufRead, BufReader, Read, Write};
 use std::os::unix::process::{CommandExt, ExitStatusExt};
 use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{mpsc, Arc, Mutex};
+use std::sync::{Arc, Mutex, mpsc};
 use std::time::{Duration, Instant};
 
 use lockstep::component::{ComponentConfig, Iceoryx2Place};
 use lockstep::{Bus, RunSpace, Wait};
-use zenoh::sample::SampleKind;
 use zenoh::Wait as _;
+use zenoh::sample::SampleKind;
 
 use crate::beat::Beat;
 use crate::credentials::{self, Side};
@@ -24,7 +24,7 @@ use crate::proxy::StartRequest;
 use crate::pump::{Exports, Idle, Imports};
 use crate::seal::Secret;
 use crate::sealed::{SealedPublisher, SealedSubscriber};
-use crate::session::{open, Role};
+use crate::session::{Role, open};
 
 static STOP: AtomicBool = AtomicBool::new(false);
 
@@ -71,30 +71,74 @@ pub fn run(connect: &str, credentials: Option<&std::path::Path>) -> i32 {
     code
 }
 
-fn serve(connect: &str, credentials: Option<&std::path::Path>, req: &StartRequest, space: &RunSpace) -> Result<(), String> {
-    let mut cfg: ComponentConfig = serde_json::from_str(&req.config).map_err(|e| format!("configuration: {e}"))?;
+fn serve(
+    connect: &str,
+    credentials: Option<&std::path::Path>,
+    req: &StartRequest,
+    space: &RunSpace,
+) -> Result<(), String> {
+    let mut cfg: ComponentConfig =
+        serde_json::from_str(&req.config).map_err(|e| format!("configuration: {e}"))?;
     keys::check_run(&req.run)?;
     keys::check_component(&cfg.name)?;
     let secret = Secret::from_hex(&req.secret)?;
-    let tls = credentials.map(|d| credentials::load(d, Side::Agent)).transpose()?;
+    let tls = credentials
+        .map(|d| credentials::load(d, Side::Agent))
+        .transpose()?;
     let (run, name) = (req.run.clone(), cfg.name.clone());
     let wait: Wait = cfg.wait.parse().map_err(|e| format!("wait: {e}"))?;
     // The component's world is this host's run space.
     cfg.run = space.id().to_string();
     cfg.iceoryx2 = Iceoryx2Place::of(space);
-    space.write_config(&cfg.file(), &serde_json::to_string_pretty(&cfg).expect("serialises")).map_err(|e| e.to_string())?;
+    space
+        .write_config(
+            &cfg.file(),
+            &serde_json::to_string_pretty(&cfg).expect("serialises"),
+        )
+        .map_err(|e| e.to_string())?;
     let bus = Bus::join(space, "bridge", wait).map_err(|e| e.to_string())?;
 
     let z = open(Role::Client { connect }, tls.as_ref())?;
-    let _token = z.liveliness().declare_token(keys::alive(&run, &name, "worker")).wait().map_err(|e| e.to_string())?;
-    let proxy = z.liveliness().declare_subscriber(keys::alive(&run, &name, "proxy")).history(true).wait().map_err(|e| e.to_string())?;
-    let status = std::cell::RefCell::new(SealedPublisher::new(&z, &secret, keys::status(&run, &name))?);
+    let _token = z
+        .liveliness()
+        .declare_token(keys::alive(&run, &name, "worker"))
+        .wait()
+        .map_err(|e| e.to_string())?;
+    let proxy = z
+        .liveliness()
+        .declare_subscriber(keys::alive(&run, &name, "proxy"))
+        .history(true)
+        .wait()
+        .map_err(|e| e.to_string())?;
+    let status = std::cell::RefCell::new(SealedPublisher::new(
+        &z,
+        &secret,
+        keys::status(&run, &name),
+    )?);
     let mut go = SealedSubscriber::new(&z, &secret, keys::go(&run, &name))?;
     let mut pings = SealedSubscriber::new(&z, &secret, keys::ping(&run, &name))?;
     let mut pong = SealedPublisher::new(&z, &secret, keys::pong(&run, &name))?;
-    let reads: Vec<(String, usize, String)> = cfg.reads.iter().map(|r| (r.service.clone(), r.len, keys::to_component(&run, &name, &r.service))).collect();
+    let reads: Vec<(String, usize, String)> = cfg
+        .reads
+        .iter()
+        .map(|r| {
+            (
+                r.service.clone(),
+                r.len,
+                keys::to_component(&run, &name, &r.service),
+            )
+        })
+        .collect();
     let mut imports = Imports::new(&bus, &z, &secret, &reads)?;
-    let mut exports = Exports::new(&bus, &z, &secret, &[(cfg.publishes.service.clone(), keys::from_component(&run, &name))])?;
+    let mut exports = Exports::new(
+        &bus,
+        &z,
+        &secret,
+        &[(
+            cfg.publishes.service.clone(),
+            keys::from_component(&run, &name),
+        )],
+    )?;
     let report = |line: String| status.borrow_mut().put(line.as_bytes());
     let mut beat = Beat::new(&z, &secret, &run, &name, "worker", "proxy")?;
 
@@ -128,13 +172,17 @@ fn serve(connect: &str, credentials: Option<&std::path::Path>, req: &StartReques
                 SampleKind::Put => proxy_seen = true,
                 SampleKind::Delete => {
                     kill(&mut child);
-                    return Err(format!("the launcher's side of {name} went away (run stopped, or the link was cut)"));
+                    return Err(format!(
+                        "the launcher's side of {name} went away (run stopped, or the link was cut)"
+                    ));
                 }
             }
         }
         if !beat.alive() {
             kill(&mut child);
-            return Err(format!("the launcher's side of {name} went silent (run stopped, or the link was cut)"));
+            return Err(format!(
+                "the launcher's side of {name} went silent (run stopped, or the link was cut)"
+            ));
         }
         if !proxy_seen && started.elapsed() > Duration::from_secs(5) {
             kill(&mut child);
@@ -154,20 +202,36 @@ fn serve(connect: &str, credentials: Option<&std::path::Path>, req: &StartReques
             Phase::Ready if let Some(text) = go.try_recv_text() => {
                 // `go <θ> <round trip>`: the launcher's host's times onto this one's.
                 let mut words = text.split(' ');
-                let (Some("go"), Some(Ok(theta)), Some(Ok(rtt))) = (words.next(), words.next().map(str::parse::<i64>), words.next().map(str::parse::<u64>)) else {
-                    return Err(format!("{name}: a malformed go from the proxy: '{}'", text.escape_debug()));
+                let (Some("go"), Some(Ok(theta)), Some(Ok(rtt))) = (
+                    words.next(),
+                    words.next().map(str::parse::<i64>),
+                    words.next().map(str::parse::<u64>),
+                ) else {
+                    return Err(format!(
+                        "{name}: a malformed go from the proxy: '{}'",
+                        text.escape_debug()
+                    ));
                 };
                 imports.shift_ns = theta;
                 beat.arm();
-                say!("worker for {name}: this host's clock reads {theta} ns ahead of the launcher's host's (± {} ns, half the shortest of 16 round trips)", rtt / 2);
+                say!(
+                    "worker for {name}: this host's clock reads {theta} ns ahead of the launcher's host's (± {} ns, half the shortest of 16 round trips)",
+                    rtt / 2
+                );
                 if let Some(s) = stdin.as_mut() {
-                    s.write_all(b"go\n").and_then(|_| s.flush()).map_err(|e| format!("{name}: {e}"))?;
+                    s.write_all(b"go\n")
+                        .and_then(|_| s.flush())
+                        .map_err(|e| format!("{name}: {e}"))?;
                 }
                 phase = Phase::Running;
             }
             _ => {}
         }
-        let worked = if phase == Phase::Running { exports.pump()? + imports.pump()? > 0 } else { false };
+        let worked = if phase == Phase::Running {
+            exports.pump()? + imports.pump()? > 0
+        } else {
+            false
+        };
         if let Ok(Some(st)) = child.try_wait() {
             // Everything it published before it exited goes first.
             while exports.pump()? > 0 {}
@@ -175,7 +239,10 @@ fn serve(connect: &str, credentials: Option<&std::path::Path>, req: &StartReques
             let why = match (st.code(), st.signal()) {
                 (_, Some(sig)) => format!("killed by signal {sig}"),
                 (Some(0), _) => "exited".to_string(),
-                (Some(c), _) => format!("exited with status {c}: {}", last_err.lock().map(|s| s.clone()).unwrap_or_default()),
+                (Some(c), _) => format!(
+                    "exited with status {c}: {}",
+                    last_err.lock().map(|s| s.clone()).unwrap_or_default()
+                ),
                 _ => "exited".to_string(),
             };
             report(format!("exit {code} {} {why}", exports.sent))?;
@@ -197,13 +264,30 @@ enum Phase {
 
 /// Starts our built-in component of this kind, beside this executable, in its own process
 /// group, as the launcher would (PROTOCOL.md §1).
-fn spawn(builtin: &str, space: &RunSpace, cfg: &ComponentConfig, wait: Wait) -> Result<Child, String> {
+fn spawn(
+    builtin: &str,
+    space: &RunSpace,
+    cfg: &ComponentConfig,
+    wait: Wait,
+) -> Result<Child, String> {
     if !matches!(builtin, "plant" | "observer" | "controller") {
-        return Err(format!("'{}' is not a built-in component", builtin.escape_debug()));
+        return Err(format!(
+            "'{}' is not a built-in component",
+            builtin.escape_debug()
+        ));
     }
-    let exe = std::env::current_exe().map_err(|e| e.to_string())?.with_file_name(builtin);
+    let exe = std::env::current_exe()
+        .map_err(|e| e.to_string())?
+        .with_file_name(builtin);
     Command::new(&exe)
-        .args(["--run", space.id(), "--name", &cfg.name, "--wait", &wait.to_string()])
+        .args([
+            "--run",
+            space.id(),
+            "--name",
+            &cfg.name,
+            "--wait",
+            &wait.to_string(),
+        ])
         .envs(cfg.launch_env(space))
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())

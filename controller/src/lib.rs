@@ -12,11 +12,11 @@
 pub mod design;
 pub mod shell;
 
+use lti::MatData;
 use lti::input_estimate::InputEstimateStep;
 use lti::kernel::{mul_acc, mul_into};
 use lti::sampled::SampledSignal;
 use lti::signal::Signal;
-use lti::MatData;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
@@ -133,11 +133,21 @@ impl Controller {
     pub fn new(cfg: &ControllerConfig) -> Result<Self, String> {
         let g: DMatrix<f64> = (&cfg.g).into();
         if g.nrows() != cfg.references.len() {
-            return Err(format!("G has {} rows but there are {} references", g.nrows(), cfg.references.len()));
+            return Err(format!(
+                "G has {} rows but there are {} references",
+                g.nrows(),
+                cfg.references.len()
+            ));
         }
         let n: DMatrix<f64> = (&cfg.n).into();
         if n.shape() != (g.nrows(), g.nrows()) {
-            return Err(format!("N is {}×{}, must be {}×{}", n.nrows(), n.ncols(), g.nrows(), g.nrows()));
+            return Err(format!(
+                "N is {}×{}, must be {}×{}",
+                n.nrows(),
+                n.ncols(),
+                g.nrows(),
+                g.nrows()
+            ));
         }
         let (l, nx) = g.shape();
         let integral = cfg
@@ -147,25 +157,55 @@ impl Controller {
                 let (gi, ct): (DMatrix<f64>, DMatrix<f64>) = ((&i.gi).into(), (&i.ct).into());
                 let y = i.y.map(|[a, b]| a..b);
                 let cols = y.as_ref().map_or(nx, |y| y.len());
-                let references = if i.references.is_empty() { (0..l).collect() } else { i.references.clone() };
+                let references = if i.references.is_empty() {
+                    (0..l).collect()
+                } else {
+                    i.references.clone()
+                };
                 let lt = references.len();
                 if gi.shape() != (l, lt) || ct.shape() != (lt, cols) {
-                    return Err(format!("integral: G_ξ is {}×{} and C_t {}×{}, must be {l}×{lt} and {lt}×{cols}", gi.nrows(), gi.ncols(), ct.nrows(), ct.ncols()));
+                    return Err(format!(
+                        "integral: G_ξ is {}×{} and C_t {}×{}, must be {l}×{lt} and {lt}×{cols}",
+                        gi.nrows(),
+                        gi.ncols(),
+                        ct.nrows(),
+                        ct.ncols()
+                    ));
                 }
                 if references.iter().any(|&j| j >= l) {
-                    return Err(format!("integral: references must index the {l} references"));
+                    return Err(format!(
+                        "integral: references must index the {l} references"
+                    ));
                 }
-                Ok(Integral { gi, references, ct, y, xi: DVector::zeros(lt), z: DVector::zeros(lt) })
+                Ok(Integral {
+                    gi,
+                    references,
+                    ct,
+                    y,
+                    xi: DVector::zeros(lt),
+                    z: DVector::zeros(lt),
+                })
             })
             .transpose()?;
         let feedforward = cfg
             .feedforward
             .as_ref()
             .map(|f| {
-                let (mw, a, b): (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>) = ((&f.mw).into(), (&f.mw_c_phi).into(), (&f.mw_c_gamma_b).into());
+                let (mw, a, b): (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>) = (
+                    (&f.mw).into(),
+                    (&f.mw_c_phi).into(),
+                    (&f.mw_c_gamma_b).into(),
+                );
                 let (y, u_prev) = (f.y[0]..f.y[1], f.u_prev[0]..f.u_prev[1]);
-                if mw.shape() != (l, y.len()) || a.shape() != (l, nx) || b.shape() != (l, l) || u_prev.len() != l {
-                    return Err("feedforward: MW, MWCΦ, MWCΓ_B and the sample's ranges do not conform".to_string());
+                if mw.shape() != (l, y.len())
+                    || a.shape() != (l, nx)
+                    || b.shape() != (l, l)
+                    || u_prev.len() != l
+                {
+                    return Err(
+                        "feedforward: MW, MWCΦ, MWCΓ_B and the sample's ranges do not conform"
+                            .to_string(),
+                    );
                 }
                 let mut m_what = InputEstimateStep::new(mw, &a, &b);
                 if let Some(c) = &f.offset {
@@ -180,9 +220,23 @@ impl Controller {
         if let Some(c) = &cfg.offset
             && (c.len() != l || c.iter().any(|v| !v.is_finite()))
         {
-            return Err(format!("offset must hold {l} finite values (one per input)"));
+            return Err(format!(
+                "offset must hold {l} finite values (one per input)"
+            ));
         }
-        Ok(Self { gx: DVector::zeros(l), u: DVector::zeros(l), r: DVector::zeros(l), g, n, references: SampledSignal::all(&cfg.references, cfg.dt), dt: cfg.dt, integral, feedforward, reads_plant: cfg.reads_plant(), offset: cfg.offset.clone() })
+        Ok(Self {
+            gx: DVector::zeros(l),
+            u: DVector::zeros(l),
+            r: DVector::zeros(l),
+            g,
+            n,
+            references: SampledSignal::all(&cfg.references, cfg.dt),
+            dt: cfg.dt,
+            integral,
+            feedforward,
+            reads_plant: cfg.reads_plant(),
+            offset: cfg.offset.clone(),
+        })
     }
 
     /// Whether it reads the plant's sample (for ŵ, or measured tracked outputs).
@@ -194,7 +248,11 @@ impl Controller {
     /// when [`Self::reads_plant`] (may be empty otherwise).
     pub fn step(&mut self, k: u64, xhat: &[f64], plant: &[f64]) -> &[f64] {
         // (Slices, not nalgebra's iterators: this runs every step.)
-        let (r, gx, u) = (self.r.as_mut_slice(), self.gx.as_mut_slice(), self.u.as_mut_slice());
+        let (r, gx, u) = (
+            self.r.as_mut_slice(),
+            self.gx.as_mut_slice(),
+            self.u.as_mut_slice(),
+        );
         for (r, s) in r.iter_mut().zip(&self.references) {
             *r = s.sample_step(k);
         }
@@ -207,13 +265,20 @@ impl Controller {
                 Some(y) => mul_into(i.z.as_mut_slice(), &i.ct, &plant[y.clone()]),
                 None => mul_into(i.z.as_mut_slice(), &i.ct, xhat),
             }
-            for ((xi, &j), z) in i.xi.as_mut_slice().iter_mut().zip(&i.references).zip(i.z.as_slice()) {
+            for ((xi, &j), z) in
+                i.xi.as_mut_slice()
+                    .iter_mut()
+                    .zip(&i.references)
+                    .zip(i.z.as_slice())
+            {
                 *xi += self.dt * (r[j] - z);
             }
         }
         if let Some(f) = &mut self.feedforward {
             // M ŵ_{k−1} once there is an x̂_{k−1}; nothing is cancelled at k = 0.
-            if f.m_what.push(&plant[f.y.clone()], &plant[f.u_prev.clone()], xhat) {
+            if f.m_what
+                .push(&plant[f.y.clone()], &plant[f.u_prev.clone()], xhat)
+            {
                 for (gx, m) in gx.iter_mut().zip(&f.m_what.value) {
                     *gx += m;
                 }

@@ -15,12 +15,18 @@ pub struct ControllerComponent {
 
 impl Component for ControllerComponent {
     fn new(cfg: &ComponentConfig) -> Result<Self, String> {
-        Ok(ControllerComponent { ctrl: Controller::new(&cfg.params::<ControllerConfig>()?)? })
+        Ok(ControllerComponent {
+            ctrl: Controller::new(&cfg.params::<ControllerConfig>()?)?,
+        })
     }
 
     fn step(&mut self, k: u64, inputs: &Inputs, out: &mut [f64]) -> Result<(), StepError> {
         // Its observer's x̂_k, and with feedforward the plant's sample k (the second read).
-        let plant = if self.ctrl.reads_plant() { inputs.get(1) } else { &[] };
+        let plant = if self.ctrl.reads_plant() {
+            inputs.get(1)
+        } else {
+            &[]
+        };
         out.copy_from_slice(self.ctrl.step(k, inputs.get(0), plant));
         Ok(())
     }

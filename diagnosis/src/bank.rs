@@ -15,12 +15,12 @@
 use lti::{Mat, Model};
 use nalgebra::DVector;
 use observer::design::Gain;
-use observer::{design, Designed, Spec};
+use observer::{Designed, Spec, design};
 
 use crate::covariance::residual_covariance;
 use crate::evaluate::threshold_for;
 use crate::spec::{Channels, DiagnoserSpec, MemberKind, Scheme};
-use crate::structure::{reacts, FaultInput, SteadyState, BLIND};
+use crate::structure::{BLIND, FaultInput, SteadyState, reacts};
 
 /// One residual generator.
 #[derive(Debug, Clone)]
@@ -87,14 +87,22 @@ pub fn channel_labels(channels: Channels, model: &Model, ff: &Mat) -> Vec<String
 /// its `channels = […]` subset.
 pub fn monitored(spec: &DiagnoserSpec, model: &Model, ff: &Mat) -> (Vec<usize>, Vec<String>) {
     let all = channel_labels(spec.channels, model, ff);
-    let ids: Vec<usize> = spec.subset.clone().unwrap_or_else(|| (0..all.len()).collect());
+    let ids: Vec<usize> = spec
+        .subset
+        .clone()
+        .unwrap_or_else(|| (0..all.len()).collect());
     let labels = ids.iter().map(|&j| all[j].clone()).collect();
     (ids, labels)
 }
 
 /// What member i is blind to, in words: "blind to u2", "without y1", "on y3 alone".
 pub fn role(spec: &DiagnoserSpec, labels: &[String], i: usize) -> String {
-    let others: Vec<&str> = labels.iter().enumerate().filter(|&(j, _)| j != i).map(|(_, l)| l.as_str()).collect();
+    let others: Vec<&str> = labels
+        .iter()
+        .enumerate()
+        .filter(|&(j, _)| j != i)
+        .map(|(_, l)| l.as_str())
+        .collect();
     match (spec.channels, spec.scheme) {
         (Channels::Sensor, Scheme::Generalized) => format!("every output but {}", labels[i]),
         (Channels::Sensor, Scheme::Dedicated) => format!("on {} alone", labels[i]),
@@ -104,11 +112,24 @@ pub fn role(spec: &DiagnoserSpec, labels: &[String], i: usize) -> String {
 }
 
 /// Designs every member, computes the structure matrix and each member's threshold.
-pub fn design_bank(spec: &DiagnoserSpec, model: &Model, ff: &Mat, dt: f64, noise: NoiseCov) -> Result<Bank, BankError> {
+pub fn design_bank(
+    spec: &DiagnoserSpec,
+    model: &Model,
+    ff: &Mat,
+    dt: f64,
+    noise: NoiseCov,
+) -> Result<Bank, BankError> {
     let (ids, labels) = monitored(spec, model, ff);
     let m = labels.len();
     if m < 2 {
-        return Err(BankError { member: None, key: "faults", reason: format!("a bank needs at least two {} channels to isolate between, it watches {m}", spec.channels.name()) });
+        return Err(BankError {
+            member: None,
+            key: "faults",
+            reason: format!(
+                "a bank needs at least two {} channels to isolate between, it watches {m}",
+                spec.channels.name()
+            ),
+        });
     }
     let columns: Option<Mat> = match spec.channels {
         Channels::Actuator => Some(model.b.clone()),
@@ -137,24 +158,58 @@ pub fn design_bank(spec: &DiagnoserSpec, model: &Model, ff: &Mat, dt: f64, noise
                 let outputs: Vec<usize> = (0..p).filter(|j| !blind.contains(j)).collect();
                 let c = model.c.select_rows(&outputs);
                 let d = model.d.select_rows(&outputs);
-                (Model { c, d, ..model.clone() }, outputs)
+                (
+                    Model {
+                        c,
+                        d,
+                        ..model.clone()
+                    },
+                    outputs,
+                )
             }
         };
-        let fail = |key: &'static str, reason: String| BankError { member: Some(i), key, reason };
+        let fail = |key: &'static str, reason: String| BankError {
+            member: Some(i),
+            key,
+            reason,
+        };
         let observer_spec = match &spec.member {
-            MemberKind::ChenPatton { poles, placement } => Spec::ChenPatton { gain: Gain::place(poles.clone(), *placement) },
-            MemberKind::Luenberger { poles, placement } => Spec::Luenberger { gain: Gain::place(poles.clone(), *placement) },
+            MemberKind::ChenPatton { poles, placement } => Spec::ChenPatton {
+                gain: Gain::place(poles.clone(), *placement),
+            },
+            MemberKind::Luenberger { poles, placement } => Spec::Luenberger {
+                gain: Gain::place(poles.clone(), *placement),
+            },
             MemberKind::Kalman => {
-                let (qd, r) = noise.ok_or_else(|| fail("observer", "a kalman member needs [noise]".into()))?;
-                Spec::Kalman { qd: qd.clone(), r: r.select_rows(&outputs).select_columns(&outputs) }
+                let (qd, r) = noise
+                    .ok_or_else(|| fail("observer", "a kalman member needs [noise]".into()))?;
+                Spec::Kalman {
+                    qd: qd.clone(),
+                    r: r.select_rows(&outputs).select_columns(&outputs),
+                }
             }
         };
         let mut designed = design(&member_model, &observer_spec, dt).map_err(|e| {
-            let key = if e.condition.ends_with("poles") || e.condition.ends_with("pole placement") { "poles" } else { "" };
-            fail(key, format!("{}: {} does not hold: {}", e.kind, e.condition, e.detail))
+            let key = if e.condition.ends_with("poles") || e.condition.ends_with("pole placement") {
+                "poles"
+            } else {
+                ""
+            };
+            fail(
+                key,
+                format!("{}: {} does not hold: {}", e.kind, e.condition, e.detail),
+            )
         })?;
         widen(&mut designed, &outputs, p);
-        members.push(Member { name: format!("{}-{}", spec.name, i + 1), outputs, blind, designed, covariance: None, threshold: 0.0, dof: 0 });
+        members.push(Member {
+            name: format!("{}-{}", spec.name, i + 1),
+            outputs,
+            blind,
+            designed,
+            covariance: None,
+            threshold: 0.0,
+            dof: 0,
+        });
     }
     // The structure, from the designs: residual i against a fault on watched channel j.
     let inputs: Vec<FaultInput> = ids
@@ -167,47 +222,99 @@ pub fn design_bank(spec: &DiagnoserSpec, model: &Model, ff: &Mat, dt: f64, noise
             None => FaultInput::Output(j),
         })
         .collect();
-    let structure: Vec<Vec<u8>> =
-        members.iter().map(|mb| inputs.iter().map(|inp| u8::from(reacts(&dm.a, &dm.c, &mb.designed.runtime, &mb.outputs, inp))).collect()).collect();
+    let structure: Vec<Vec<u8>> = members
+        .iter()
+        .map(|mb| {
+            inputs
+                .iter()
+                .map(|inp| u8::from(reacts(&dm.a, &dm.c, &mb.designed.runtime, &mb.outputs, inp)))
+                .collect()
+        })
+        .collect();
     check_structure(spec, &structure, &labels)?;
     // Under a constant fault: which residuals stay away from zero.
     let steady: Option<Vec<Vec<u8>>> = members
         .iter()
-        .map(|mb| SteadyState::new(&dm.a, &dm.c, &mb.designed.runtime, &mb.outputs).map(|ss| inputs.iter().map(|inp| u8::from(ss.response(inp) > BLIND)).collect()))
+        .map(|mb| {
+            SteadyState::new(&dm.a, &dm.c, &mb.designed.runtime, &mb.outputs).map(|ss| {
+                inputs
+                    .iter()
+                    .map(|inp| u8::from(ss.response(inp) > BLIND))
+                    .collect()
+            })
+        })
         .collect();
     for (i, mb) in members.iter_mut().enumerate() {
         if let Some((qd, r)) = noise {
             let cov = residual_covariance(&dm.a, &dm.c, &mb.designed.runtime, &mb.outputs, qd, r)
-                .map_err(|e| BankError { member: Some(i), key: "", reason: format!("residual covariance: {e}") })?;
+                .map_err(|e| BankError {
+                member: Some(i),
+                key: "",
+                reason: format!("residual covariance: {e}"),
+            })?;
             mb.covariance = Some(cov);
         }
-        let (threshold, dof) = threshold_for(spec, mb.covariance.as_ref()).map_err(|reason| BankError { member: Some(i), key: "false_alarm", reason })?;
+        let (threshold, dof) =
+            threshold_for(spec, mb.covariance.as_ref()).map_err(|reason| BankError {
+                member: Some(i),
+                key: "false_alarm",
+                reason,
+            })?;
         mb.threshold = threshold;
         mb.dof = dof;
     }
-    Ok(Bank { spec: spec.clone(), members, structure, steady, channels: labels, ids })
+    Ok(Bank {
+        spec: spec.clone(),
+        members,
+        structure,
+        steady,
+        channels: labels,
+        ids,
+    })
 }
 
 /// Per watched channel whose constant fault only the transient reveals: "u1: residual 2 returns
 /// to 0 in steady state; a constant u1 fault is isolable only during transients".
 pub fn transient_only(bank: &Bank) -> Vec<String> {
-    let Some(steady) = &bank.steady else { return Vec::new() };
+    let Some(steady) = &bank.steady else {
+        return Vec::new();
+    };
     let mut out = Vec::new();
     for (j, label) in bank.channels.iter().enumerate() {
-        let gone: Vec<String> = (0..bank.members.len()).filter(|&i| bank.structure[i][j] == 1 && steady[i][j] == 0).map(|i| (i + 1).to_string()).collect();
+        let gone: Vec<String> = (0..bank.members.len())
+            .filter(|&i| bank.structure[i][j] == 1 && steady[i][j] == 0)
+            .map(|i| (i + 1).to_string())
+            .collect();
         if gone.is_empty() {
             continue;
         }
         let column: Vec<u8> = steady.iter().map(|r| r[j]).collect();
         let consequence = if column.iter().all(|&v| v == 0) {
             "it is detected and isolated only during transients (a bias or step leaves no residual once they settle)".to_string()
-        } else if let Some(k) = (0..bank.channels.len()).find(|&k| k != j && bank.structure.iter().map(|r| r[k]).eq(column.iter().copied())) {
-            format!("in steady state its signature is {}'s: isolable only during transients", bank.channels[k])
+        } else if let Some(k) = (0..bank.channels.len()).find(|&k| {
+            k != j
+                && bank
+                    .structure
+                    .iter()
+                    .map(|r| r[k])
+                    .eq(column.iter().copied())
+        }) {
+            format!(
+                "in steady state its signature is {}'s: isolable only during transients",
+                bank.channels[k]
+            )
         } else {
             "in steady state its signature matches no channel (\"unknown\"): isolable only during transients".to_string()
         };
-        let which = if gone.len() == 1 { format!("residual {} returns", gone[0]) } else { format!("residuals {} return", gone.join(", ")) };
-        out.push(format!("diagnoser '{}': {label} bias: {which} to 0 in steady state; {consequence}", bank.spec.name));
+        let which = if gone.len() == 1 {
+            format!("residual {} returns", gone[0])
+        } else {
+            format!("residuals {} return", gone.join(", "))
+        };
+        out.push(format!(
+            "diagnoser '{}': {label} bias: {which} to 0 in steady state; {consequence}",
+            bank.spec.name
+        ));
     }
     out
 }
@@ -228,21 +335,50 @@ fn widen(d: &mut Designed, outputs: &[usize], p: usize) {
 
 /// The structure asked for must be the one computed, and must isolate: every channel seen by
 /// some residual, no two channels with the same signature.
-fn check_structure(spec: &DiagnoserSpec, computed: &[Vec<u8>], labels: &[String]) -> Result<(), BankError> {
+fn check_structure(
+    spec: &DiagnoserSpec,
+    computed: &[Vec<u8>],
+    labels: &[String],
+) -> Result<(), BankError> {
     let m = labels.len();
     if let Some(asked) = &spec.structure {
         if asked.len() != m || asked.iter().any(|r| r.len() != m) {
-            return Err(BankError { member: None, key: "structure", reason: format!("must be {m}×{m} (one row per residual, one column per channel {})", labels.join(", ")) });
+            return Err(BankError {
+                member: None,
+                key: "structure",
+                reason: format!(
+                    "must be {m}×{m} (one row per residual, one column per channel {})",
+                    labels.join(", ")
+                ),
+            });
         }
         for (i, (a, c)) in asked.iter().zip(computed).enumerate() {
             for j in 0..m {
                 if a[j] != c[j] {
                     let why = if a[j] == 0 {
-                        format!("asks residual {} to ignore {} but member {} reacts to it (its design cannot be blind to it)", i + 1, labels[j], i + 1)
+                        format!(
+                            "asks residual {} to ignore {} but member {} reacts to it (its design cannot be blind to it)",
+                            i + 1,
+                            labels[j],
+                            i + 1
+                        )
                     } else {
-                        format!("asks residual {} to react to {} but member {} is blind to it", i + 1, labels[j], i + 1)
+                        format!(
+                            "asks residual {} to react to {} but member {} is blind to it",
+                            i + 1,
+                            labels[j],
+                            i + 1
+                        )
                     };
-                    return Err(BankError { member: None, key: "structure", reason: format!("{why}; the {} scheme gives {}", spec.scheme.name(), show(computed)) });
+                    return Err(BankError {
+                        member: None,
+                        key: "structure",
+                        reason: format!(
+                            "{why}; the {} scheme gives {}",
+                            spec.scheme.name(),
+                            show(computed)
+                        ),
+                    });
                 }
             }
         }
@@ -250,11 +386,28 @@ fn check_structure(spec: &DiagnoserSpec, computed: &[Vec<u8>], labels: &[String]
     let column = |j: usize| computed.iter().map(|r| r[j]).collect::<Vec<u8>>();
     for j in 0..m {
         if column(j).iter().all(|&v| v == 0) {
-            return Err(BankError { member: None, key: "structure", reason: format!("no residual reacts to {}: it cannot be detected ({})", labels[j], show(computed)) });
+            return Err(BankError {
+                member: None,
+                key: "structure",
+                reason: format!(
+                    "no residual reacts to {}: it cannot be detected ({})",
+                    labels[j],
+                    show(computed)
+                ),
+            });
         }
         for k in 0..j {
             if column(j) == column(k) {
-                return Err(BankError { member: None, key: "structure", reason: format!("{} and {} have the same signature: no decision can isolate them ({})", labels[k], labels[j], show(computed)) });
+                return Err(BankError {
+                    member: None,
+                    key: "structure",
+                    reason: format!(
+                        "{} and {} have the same signature: no decision can isolate them ({})",
+                        labels[k],
+                        labels[j],
+                        show(computed)
+                    ),
+                });
             }
         }
     }
@@ -263,6 +416,14 @@ fn check_structure(spec: &DiagnoserSpec, computed: &[Vec<u8>], labels: &[String]
 
 /// "[[0, 1], [1, 0]]".
 pub fn show(s: &[Vec<u8>]) -> String {
-    let rows: Vec<String> = s.iter().map(|r| format!("[{}]", r.iter().map(u8::to_string).collect::<Vec<_>>().join(", "))).collect();
+    let rows: Vec<String> = s
+        .iter()
+        .map(|r| {
+            format!(
+                "[{}]",
+                r.iter().map(u8::to_string).collect::<Vec<_>>().join(", ")
+            )
+        })
+        .collect();
     format!("[{}]", rows.join(", "))
 }

@@ -33,13 +33,30 @@ pub fn tracked(phi: &Mat, f: &Mat, k: &Mat, c: &Mat) -> Result<Mat, String> {
 }
 
 /// Σ_r of the residual on `outputs`.
-pub fn residual_covariance(phi: &Mat, c: &Mat, obs: &LinearObserver, outputs: &[usize], qd: &Mat, rn: &Mat) -> Result<Mat, String> {
-    let Residual { f, k, p: pm, q, s, i_cq, cp } = Residual::new(c, obs, outputs);
+pub fn residual_covariance(
+    phi: &Mat,
+    c: &Mat,
+    obs: &LinearObserver,
+    outputs: &[usize],
+    qd: &Mat,
+    rn: &Mat,
+) -> Result<Mat, String> {
+    let Residual {
+        f,
+        k,
+        p: pm,
+        q,
+        s,
+        i_cq,
+        cp,
+    } = Residual::new(c, obs, outputs);
     let m = tracked(phi, &f, &k, c)?;
     let n = phi.nrows();
     let defect = (&pm * &m + &q * c - Mat::identity(n, n)).norm();
     if defect > 1e-8 * (1.0 + (&pm * &m).norm()) {
-        return Err(format!("it does not estimate the plant's state (‖PM + QC − I‖ = {defect:.1e})"));
+        return Err(format!(
+            "it does not estimate the plant's state (‖PM + QC − I‖ = {defect:.1e})"
+        ));
     }
     let w = &k * rn * k.transpose() + &m * qd * m.transpose();
     let sz = lti::lyapunov::discrete(&f.transpose(), &w).map_err(|e| e.to_string())?;

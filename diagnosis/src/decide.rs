@@ -80,13 +80,25 @@ impl Monitor {
             structure: bank.structure.clone(),
             observers,
             outputs: bank.members.iter().map(|mb| mb.outputs.clone()).collect(),
-            asked_false_alarm: if let crate::Threshold::FalseAlarm(a) = bank.spec.threshold { Some(a) } else { None },
-            evaluators: bank.members.iter().map(|mb| Evaluator::new(bank.spec.evaluation, mb.covariance.as_ref())).collect(),
+            asked_false_alarm: if let crate::Threshold::FalseAlarm(a) = bank.spec.threshold {
+                Some(a)
+            } else {
+                None
+            },
+            evaluators: bank
+                .members
+                .iter()
+                .map(|mb| Evaluator::new(bank.spec.evaluation, mb.covariance.as_ref()))
+                .collect(),
             thresholds: bank.members.iter().map(|mb| mb.threshold).collect(),
             persistence: bank.spec.persistence.max(1),
             start_step: lti::signal::first_sample_from(bank.spec.ignore_before, dt),
             counts: vec![0; m],
-            residuals: bank.members.iter().map(|mb| vec![0.0; mb.outputs.len()]).collect(),
+            residuals: bank
+                .members
+                .iter()
+                .map(|mb| vec![0.0; mb.outputs.len()])
+                .collect(),
             evals: vec![0.0; m],
             exceed: vec![false; m],
             alarms: vec![false; m],
@@ -106,7 +118,11 @@ impl Monitor {
             let j = self.evaluators[i].push(&self.residuals[i]);
             self.evals[i] = j;
             self.exceed[i] = j > self.thresholds[i];
-            self.counts[i] = if self.exceed[i] && deciding { self.counts[i].saturating_add(1) } else { 0 };
+            self.counts[i] = if self.exceed[i] && deciding {
+                self.counts[i].saturating_add(1)
+            } else {
+                0
+            };
             self.alarms[i] = self.counts[i] >= self.persistence;
         }
         self.isolation = self.isolate();
@@ -114,7 +130,10 @@ impl Monitor {
 
     /// The label of channel `channel` (index in the class), if the bank watches it.
     pub fn label(&self, channel: usize) -> Option<&str> {
-        self.ids.iter().position(|&j| j == channel).map(|j| self.labels[j].as_str())
+        self.ids
+            .iter()
+            .position(|&j| j == channel)
+            .map(|j| self.labels[j].as_str())
     }
 
     fn isolate(&self) -> Isolation {
@@ -122,7 +141,14 @@ impl Monitor {
             return Isolation::None;
         }
         let m = self.labels.len();
-        let matches: Vec<usize> = (0..m).filter(|&j| self.structure.iter().zip(&self.alarms).all(|(row, &a)| (row[j] == 1) == a)).collect();
+        let matches: Vec<usize> = (0..m)
+            .filter(|&j| {
+                self.structure
+                    .iter()
+                    .zip(&self.alarms)
+                    .all(|(row, &a)| (row[j] == 1) == a)
+            })
+            .collect();
         match matches.as_slice() {
             [j] => Isolation::Channel(self.ids[*j]),
             _ => Isolation::Unknown,

@@ -26,13 +26,19 @@ pub fn threshold_for(spec: &DiagnoserSpec, cov: Option<&Mat>) -> Result<(f64, us
         Threshold::Calibrated { .. } => Ok((f64::INFINITY, dof)),
         Threshold::FalseAlarm(alpha) => {
             if spec.evaluation != Evaluation::Chi2 {
-                return Err("a false-alarm probability sets a χ² threshold: it needs evaluation = \"chi2\"".into());
+                return Err(
+                    "a false-alarm probability sets a χ² threshold: it needs evaluation = \"chi2\""
+                        .into(),
+                );
             }
             if cov.is_none() {
                 return Err("a false-alarm probability needs the noise statistics: the scenario has no [noise]".into());
             }
             if dof == 0 {
-                return Err("the residual has no noise in any direction (Σ_r = 0): give a fixed threshold".into());
+                return Err(
+                    "the residual has no noise in any direction (Σ_r = 0): give a fixed threshold"
+                        .into(),
+                );
             }
             let chi = ChiSquared::new(dof as f64).map_err(|e| e.to_string())?;
             Ok((chi.inverse_cdf(1.0 - alpha), dof))
@@ -44,8 +50,12 @@ pub fn threshold_for(spec: &DiagnoserSpec, cov: Option<&Mat>) -> Result<(f64, us
 pub fn whitening(cov: &Mat) -> Mat {
     let e = cov.clone().symmetric_eigen();
     let top = e.eigenvalues.iter().fold(0.0f64, |a, &b| a.max(b));
-    let keep: Vec<usize> = (0..e.eigenvalues.len()).filter(|&i| e.eigenvalues[i] > RANK_TOL * top && top > 0.0).collect();
-    Mat::from_fn(keep.len(), cov.nrows(), |r, c| e.eigenvectors[(c, keep[r])] / e.eigenvalues[keep[r]].sqrt())
+    let keep: Vec<usize> = (0..e.eigenvalues.len())
+        .filter(|&i| e.eigenvalues[i] > RANK_TOL * top && top > 0.0)
+        .collect();
+    Mat::from_fn(keep.len(), cov.nrows(), |r, c| {
+        e.eigenvectors[(c, keep[r])] / e.eigenvalues[keep[r]].sqrt()
+    })
 }
 
 /// The evaluation of one residual, step by step (no allocation per step).
@@ -71,8 +81,21 @@ impl Evaluator {
             (Evaluation::Chi2, Some(c)) => whitening(c),
             _ => Mat::zeros(0, 0),
         };
-        let window = if let Evaluation::Rms { window } = kind { window.max(1) } else { 0 };
-        Evaluator { kind, ring: vec![0.0; window], at: 0, filled: 0, sum: 0.0, state: 0.0, white: vec![0.0; w.nrows()], w }
+        let window = if let Evaluation::Rms { window } = kind {
+            window.max(1)
+        } else {
+            0
+        };
+        Evaluator {
+            kind,
+            ring: vec![0.0; window],
+            at: 0,
+            filled: 0,
+            sum: 0.0,
+            state: 0.0,
+            white: vec![0.0; w.nrows()],
+            w,
+        }
     }
 
     /// J_k of r_k.

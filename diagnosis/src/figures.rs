@@ -143,8 +143,24 @@ impl Judge {
     /// for at least `fraction` of its active time.
     pub fn new(mut faults: Vec<FaultInfo>, monitors: &[Monitor], dt: f64, fraction: f64) -> Self {
         faults.sort_by(|a, b| a.start.total_cmp(&b.start));
-        let starts: Vec<u64> = faults.iter().map(|f| lti::signal::first_sample_from(f.start, dt)).collect();
-        let windows = starts.iter().map(|&s| (s, starts.iter().copied().filter(|&t| t > s).min().unwrap_or(u64::MAX))).collect();
+        let starts: Vec<u64> = faults
+            .iter()
+            .map(|f| lti::signal::first_sample_from(f.start, dt))
+            .collect();
+        let windows = starts
+            .iter()
+            .map(|&s| {
+                (
+                    s,
+                    starts
+                        .iter()
+                        .copied()
+                        .filter(|&t| t > s)
+                        .min()
+                        .unwrap_or(u64::MAX),
+                )
+            })
+            .collect();
         let figures = faults
             .iter()
             .map(|f| FaultFigure {
@@ -176,8 +192,14 @@ impl Judge {
             false_alarm_steps: 0,
             fault_free_steps: 0,
             was_alarm: false,
-            counts: monitors.iter().map(|m| vec![(0, 0); m.thresholds.len()]).collect(),
-            max_eval: monitors.iter().map(|m| vec![f64::NEG_INFINITY; m.thresholds.len()]).collect(),
+            counts: monitors
+                .iter()
+                .map(|m| vec![(0, 0); m.thresholds.len()])
+                .collect(),
+            max_eval: monitors
+                .iter()
+                .map(|m| vec![f64::NEG_INFINITY; m.thresholds.len()])
+                .collect(),
         }
     }
 
@@ -196,9 +218,17 @@ impl Judge {
                     self.false_alarms += 1;
                 }
             }
-            for ((m, counts), max) in monitors.iter().zip(&mut self.counts).zip(&mut self.max_eval) {
+            for ((m, counts), max) in monitors
+                .iter()
+                .zip(&mut self.counts)
+                .zip(&mut self.max_eval)
+            {
                 if k >= m.start_step {
-                    for ((c, &e), (top, &j)) in counts.iter_mut().zip(&m.exceed).zip(max.iter_mut().zip(&m.evals)) {
+                    for ((c, &e), (top, &j)) in counts
+                        .iter_mut()
+                        .zip(&m.exceed)
+                        .zip(max.iter_mut().zip(&m.evals))
+                    {
                         c.0 += 1;
                         c.1 += u64::from(e);
                         *top = top.max(j);
@@ -226,7 +256,13 @@ impl Judge {
                         let named = if j == f.channel {
                             f.name.clone()
                         } else {
-                            self.faults.iter().find(|g| g.channels == m.channels && g.channel == j).map_or_else(|| m.label(j).unwrap_or("?").to_string(), |g| g.name.clone())
+                            self.faults
+                                .iter()
+                                .find(|g| g.channels == m.channels && g.channel == j)
+                                .map_or_else(
+                                    || m.label(j).unwrap_or("?").to_string(),
+                                    |g| g.name.clone(),
+                                )
                         };
                         fig.isolated_as = Some(named);
                         fig.isolated_at = Some(t);
@@ -259,15 +295,18 @@ impl Judge {
             .zip(self.counts.iter().zip(&self.max_eval))
             .flat_map(|(m, (counts, max))| {
                 let alpha = m.asked_false_alarm;
-                counts.iter().enumerate().map(move |(i, &(steps, exc))| ResidualFigure {
-                    residual: format!("{}-{}", m.name, i + 1),
-                    threshold: m.thresholds[i],
-                    asked_false_alarm: alpha,
-                    fault_free_steps: steps,
-                    exceedances: exc,
-                    exceedance_rate: (steps > 0).then(|| exc as f64 / steps as f64),
-                    max_fault_free_evaluation: (steps > 0).then_some(max[i]),
-                })
+                counts
+                    .iter()
+                    .enumerate()
+                    .map(move |(i, &(steps, exc))| ResidualFigure {
+                        residual: format!("{}-{}", m.name, i + 1),
+                        threshold: m.thresholds[i],
+                        asked_false_alarm: alpha,
+                        fault_free_steps: steps,
+                        exceedances: exc,
+                        exceedance_rate: (steps > 0).then(|| exc as f64 / steps as f64),
+                        max_fault_free_evaluation: (steps > 0).then_some(max[i]),
+                    })
             })
             .collect();
         let mut faults = self.figures;

@@ -20,8 +20,8 @@ pub mod residual;
 pub mod spec;
 pub mod structure;
 
-pub use bank::{design_bank, Bank, Member};
+pub use bank::BankError;
+pub use bank::{Bank, Member, design_bank};
 pub use decide::{Isolation, Monitor};
 pub use figures::{Diagnosis, FaultFigure, FaultInfo, Judge, ResidualFigure};
-pub use bank::BankError;
 pub use spec::{Channels, DiagnoserSpec, Evaluation, MemberKind, Scheme, Threshold};

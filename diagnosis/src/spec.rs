@@ -1,7 +1,7 @@
 //! A `[[diagnoser]]` as validated from the scenario.
 
-use lti::place::Method;
 use lti::Poles;
+use lti::place::Method;
 
 /// Which channels the bank watches.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -34,9 +34,17 @@ pub const BLIND: f64 = 1e-9;
 
 /// The largest relative Markov parameter of the fault-to-residual transfer: ≈ ε for a residual
 /// blind to the fault, O(1e-3 … 1) for one that reacts.
-pub fn sensitivity(phi: &Mat, c: &Mat, obs: &LinearObserver, outputs: &[usize], input: &FaultInput) -> f64 {
+pub fn sensitivity(
+    phi: &Mat,
+    c: &Mat,
+    obs: &LinearObserver,
+    outputs: &[usize],
+    input: &FaultInput,
+) -> f64 {
     let n = phi.nrows();
-    let Residual { f, k, s, i_cq, cp, .. } = Residual::new(c, obs, outputs);
+    let Residual {
+        f, k, s, i_cq, cp, ..
+    } = Residual::new(c, obs, outputs);
     let r = f.nrows();
     let dim = n + r;
     let mut a = Mat::zeros(dim, dim);
@@ -44,15 +52,18 @@ pub fn sensitivity(phi: &Mat, c: &Mat, obs: &LinearObserver, outputs: &[usize], 
     a.view_mut((n, 0), (r, n)).copy_from(&(&k * c));
     a.view_mut((n, n), (r, r)).copy_from(&f);
     let mut ca = Mat::zeros(outputs.len(), dim);
-    ca.view_mut((0, 0), (outputs.len(), n)).copy_from(&(&s * &i_cq * c));
-    ca.view_mut((0, n), (outputs.len(), r)).copy_from(&(-(&s * &cp)));
+    ca.view_mut((0, 0), (outputs.len(), n))
+        .copy_from(&(&s * &i_cq * c));
+    ca.view_mut((0, n), (outputs.len(), r))
+        .copy_from(&(-(&s * &cp)));
     let mut b = DVector::zeros(dim);
     let mut direct = 0.0;
     match input {
         FaultInput::State(g) => b.rows_mut(0, n).copy_from(g),
         FaultInput::Output(j) => {
             b.rows_mut(n, r).copy_from(&k.column(*j));
-            direct = (&s * i_cq.column(*j)).norm() / (s.norm() * i_cq.column(*j).norm()).max(f64::MIN_POSITIVE);
+            direct = (&s * i_cq.column(*j)).norm()
+                / (s.norm() * i_cq.column(*j).norm()).max(f64::MIN_POSITIVE);
         }
     }
     let (cn, bn) = (ca.norm(), b.norm());
@@ -93,7 +104,15 @@ impl SteadyState {
     /// For observer `obs` of the sampled plant (Φ, C), residual on `outputs`; `None` when its
     /// state is not a function of x (no T) or F has an eigenvalue at 1.
     pub fn new(phi: &Mat, c: &Mat, obs: &LinearObserver, outputs: &[usize]) -> Option<Self> {
-        let Residual { f, k, p, q, s, i_cq, cp } = Residual::new(c, obs, outputs);
+        let Residual {
+            f,
+            k,
+            p,
+            q,
+            s,
+            i_cq,
+            cp,
+        } = Residual::new(c, obs, outputs);
         let n = phi.nrows();
         let t = lti::pinv::pinv(&p) * (Mat::identity(n, n) - &q * c);
         // T must make z an estimate of Tx: TΦ − FT = KC (and PT + QC = I).
@@ -105,7 +124,13 @@ impl SteadyState {
         }
         let r = f.nrows();
         let resolvent = (Mat::identity(r, r) - &f).try_inverse()?;
-        Some(SteadyState { scp: &s * &cp, s_i_cq: &s * &i_cq, t, k, resolvent })
+        Some(SteadyState {
+            scp: &s * &cp,
+            s_i_cq: &s * &i_cq,
+            t,
+            k,
+            resolvent,
+        })
     }
 
     /// The relative steady-state response to a constant fault: ≈ ε when the residual returns to
@@ -114,8 +139,16 @@ impl SteadyState {
     /// the size the terms that form it would have without cancellation.
     pub fn response(&self, input: &FaultInput) -> f64 {
         let (b, b_scale, direct) = match input {
-            FaultInput::State(g) => (-(&self.t * g), self.t.norm() * g.norm(), DVector::zeros(self.scp.nrows())),
-            FaultInput::Output(j) => (self.k.column(*j).into_owned(), self.k.column(*j).norm(), self.s_i_cq.column(*j).into_owned()),
+            FaultInput::State(g) => (
+                -(&self.t * g),
+                self.t.norm() * g.norm(),
+                DVector::zeros(self.scp.nrows()),
+            ),
+            FaultInput::Output(j) => (
+                self.k.column(*j).into_owned(),
+                self.k.column(*j).norm(),
+                self.s_i_cq.column(*j).into_owned(),
+            ),
         };
         let through = &self.scp * (&self.resolvent * &b);
         let rss = &direct - &through;
@@ -126,6 +159,12 @@ impl SteadyState {
 }
 
 /// Whether the residual reacts to the fault.
-pub fn reacts(phi: &Mat, c: &Mat, obs: &LinearObserver, outputs: &[usize], input: &FaultInput) -> bool {
+pub fn reacts(
+    phi: &Mat,
+    c: &Mat,
+    obs: &LinearObserver,
+    outputs: &[usize],
+    input: &FaultInput,
+) -> bool {
     sensitivity(phi, c, obs, outputs, input) > BLIND
 }

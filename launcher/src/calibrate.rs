@@ -28,26 +28,55 @@ pub fn calibrate(s: &Scenario, plan: &mut Plan) -> Result<(), LaunchError> {
         .banks
         .iter()
         .enumerate()
-        .filter_map(|(i, b)| if let Threshold::Calibrated { runs, margin } = b.spec.threshold { Some((i, runs, margin)) } else { None })
+        .filter_map(|(i, b)| {
+            if let Threshold::Calibrated { runs, margin } = b.spec.threshold {
+                Some((i, runs, margin))
+            } else {
+                None
+            }
+        })
         .collect();
-    let Some(most) = wanted.iter().map(|w| w.1).max() else { return Ok(()) };
+    let Some(most) = wanted.iter().map(|w| w.1).max() else {
+        return Ok(());
+    };
     let mut clean = s.clone();
     clean.faults.clear();
     clean.expect = Default::default();
-    let opts = Options { allow_unstable: true, ..Options::quiet(&std::env::temp_dir(), Mode::InProcess, lockstep::Wait::default_for_machine(), false) };
-    let mut top: Vec<Vec<f64>> = plan.banks.iter().map(|b| vec![f64::NEG_INFINITY; b.members.len()]).collect();
+    let opts = Options {
+        allow_unstable: true,
+        ..Options::quiet(
+            &std::env::temp_dir(),
+            Mode::InProcess,
+            lockstep::Wait::default_for_machine(),
+            false,
+        )
+    };
+    let mut top: Vec<Vec<f64>> = plan
+        .banks
+        .iter()
+        .map(|b| vec![f64::NEG_INFINITY; b.members.len()])
+        .collect();
     for r in 0..most {
         clean.seed = SEED_OFFSET.wrapping_add(s.seed).wrapping_add(r as u64);
         let o = run::run(&clean, plan, &opts)?;
         if o.stop != Stop::Completed {
             let why = o.summary.stopped.unwrap_or_default();
-            return Err(LaunchError::Component(format!("{}: calibration realisation {} (seed {}) did not complete: {why}", s.name, r + 1, clean.seed)));
+            return Err(LaunchError::Component(format!(
+                "{}: calibration realisation {} (seed {}) did not complete: {why}",
+                s.name,
+                r + 1,
+                clean.seed
+            )));
         }
         let figures = o.summary.diagnosis.map(|d| d.residuals).unwrap_or_default();
         for &(b, _, _) in wanted.iter().filter(|w| r < w.1) {
             for (t, m) in top[b].iter_mut().zip(&plan.banks[b].members) {
                 // A residual's figures carry its member's name.
-                if let Some(v) = figures.iter().find(|f| f.residual == m.name).and_then(|f| f.max_fault_free_evaluation) {
+                if let Some(v) = figures
+                    .iter()
+                    .find(|f| f.residual == m.name)
+                    .and_then(|f| f.max_fault_free_evaluation)
+                {
                     *t = t.max(v);
                 }
             }

@@ -3,11 +3,11 @@
 
 use std::collections::BTreeMap;
 
-use lti::eig::{format_list, sig};
 use lti::Mat;
+use lti::eig::{format_list, sig};
 use observer::design::Condition;
 use serde::Serialize;
-use serde_json::{json, Value};
+use serde_json::{Value, json};
 
 use scenario::Scenario;
 
@@ -22,7 +22,9 @@ pub struct DesignReport {
 }
 
 fn rows(m: &Mat) -> Vec<Vec<f64>> {
-    (0..m.nrows()).map(|i| m.row(i).iter().copied().collect()).collect()
+    (0..m.nrows())
+        .map(|i| m.row(i).iter().copied().collect())
+        .collect()
 }
 
 #[derive(Serialize)]
@@ -33,26 +35,51 @@ struct JsonCondition<'a> {
 }
 
 fn conditions_json(c: &[Condition]) -> Value {
-    json!(c.iter().map(|c| JsonCondition { name: &c.name, ok: c.ok, detail: &c.detail }).collect::<Vec<_>>())
+    json!(
+        c.iter()
+            .map(|c| JsonCondition {
+                name: &c.name,
+                ok: c.ok,
+                detail: &c.detail
+            })
+            .collect::<Vec<_>>()
+    )
 }
 
 fn matrix_text(name: &str, m: &Mat) -> String {
     let mut s = format!("    {name} =\n");
     for i in 0..m.nrows() {
-        let row: Vec<String> = m.row(i).iter().map(|&v| format!("{:>14}", sig(v))).collect();
+        let row: Vec<String> = m
+            .row(i)
+            .iter()
+            .map(|&v| format!("{:>14}", sig(v)))
+            .collect();
         s += &format!("      [{} ]\n", row.join(""));
     }
     s
 }
 
 fn conditions_text(c: &[Condition]) -> String {
-    c.iter().map(|c| format!("    {} {:<52} {}\n", if c.ok { "ok  " } else { "FAIL" }, c.name, c.detail)).collect()
+    c.iter()
+        .map(|c| {
+            format!(
+                "    {} {:<52} {}\n",
+                if c.ok { "ok  " } else { "FAIL" },
+                c.name,
+                c.detail
+            )
+        })
+        .collect()
 }
 
 /// Designs everything in the scenario and reports it.
 pub fn report(s: &Scenario) -> DesignReport {
     let mut ok = true;
-    let mut text = format!("{}: {}\n", s.name, scenario::untrusted::one_line(&s.description));
+    let mut text = format!(
+        "{}: {}\n",
+        s.name,
+        scenario::untrusted::one_line(&s.description)
+    );
     let mut observers = Vec::new();
     // Each design made once, then handed to the plan (the controller and the warnings).
     let mut own: Vec<Option<observer::Designed>> = Vec::new();
@@ -63,8 +90,14 @@ pub fn report(s: &Scenario) -> DesignReport {
         }
         text += &format!("\nobserver '{}' ({})\n", o.name, o.kind());
         let Some(spec) = &o.spec else {
-            let p = o.process.as_ref().expect("an observer without a design is a process");
-            text += &format!("  external process: {}\n", scenario::untrusted::one_line(&p.command.join(" ")));
+            let p = o
+                .process
+                .as_ref()
+                .expect("an observer without a design is a process");
+            text += &format!(
+                "  external process: {}\n",
+                scenario::untrusted::one_line(&p.command.join(" "))
+            );
             observers.push(json!({ "name": o.name, "kind": "process", "command": p.command, "params": p.params }));
             continue;
         };
@@ -80,14 +113,22 @@ pub fn report(s: &Scenario) -> DesignReport {
                 // Every list says its domain (issue 30, item 7): s for the continuous poles and
                 // fixed modes (ln(z)/dt for a sampled-only design), z for the sampled ones.
                 text += &format!("  poles (s):        {}\n", format_list(&r.poles));
-                text += &format!("  poles (z, dt = {}): {}\n", s.dt, format_list(&r.discrete_poles));
+                text += &format!(
+                    "  poles (z, dt = {}): {}\n",
+                    s.dt,
+                    format_list(&r.discrete_poles)
+                );
                 if !r.fixed_modes.is_empty() {
                     text += &format!("  fixed modes (s):  {}\n", format_list(&r.fixed_modes));
                 }
                 for n in &r.notes {
                     text += &format!("  note: {n}\n");
                 }
-                let matrices: BTreeMap<&str, Vec<Vec<f64>>> = r.matrices.iter().map(|(n, m)| (n.as_str(), rows(m))).collect();
+                let matrices: BTreeMap<&str, Vec<Vec<f64>>> = r
+                    .matrices
+                    .iter()
+                    .map(|(n, m)| (n.as_str(), rows(m)))
+                    .collect();
                 observers.push(json!({
                     "name": o.name, "kind": o.kind(),
                     "conditions": conditions_json(&r.conditions),
@@ -107,7 +148,10 @@ pub fn report(s: &Scenario) -> DesignReport {
                     text += &format!("    FAIL {:<52} {}\n", e.condition, e.detail);
                 }
                 let carried = crate::plan::carried_by(s, &e);
-                text += &format!("  no observer: {} does not hold: {}{carried}\n", e.condition, e.detail);
+                text += &format!(
+                    "  no observer: {} does not hold: {}{carried}\n",
+                    e.condition, e.detail
+                );
                 observers.push(json!({
                     "name": o.name, "kind": o.kind(),
                     "conditions": conditions_json(&e.conditions),
@@ -127,16 +171,32 @@ pub fn report(s: &Scenario) -> DesignReport {
             Ok(p) => {
                 warnings = p.warnings.clone();
                 if let (Some(c), Some(fb)) = (&s.controller, &p.feedback) {
-                    let kind = if matches!(c.spec, Some(controller::design::FeedbackSpec::Lqr { .. })) { "lqr" } else { "state-feedback" };
+                    let kind =
+                        if matches!(c.spec, Some(controller::design::FeedbackSpec::Lqr { .. })) {
+                            "lqr"
+                        } else {
+                            "state-feedback"
+                        };
                     let law = match (&fb.integral, c.track.is_some()) {
                         (Some(_), _) => "u = −G x̂ − G_ξ ξ, ξ⁺ = ξ + dt (r − z)",
                         (None, true) => "u = N r − G x̂",
                         (None, false) => "u = r − G x̂",
                     };
-                    let ff = if fb.feedforward.is_some() { " − M ŵ" } else { "" };
-                    text += &format!("\ncontroller: {kind}, {law}{ff}, on '{}'\n  G {}\n", c.observer, fb.how);
+                    let ff = if fb.feedforward.is_some() {
+                        " − M ŵ"
+                    } else {
+                        ""
+                    };
+                    text += &format!(
+                        "\ncontroller: {kind}, {law}{ff}, on '{}'\n  G {}\n",
+                        c.observer, fb.how
+                    );
                     text += &matrix_text("G", &fb.g);
-                    let measured: Vec<&str> = fb.measured.iter().map(|&j| s.names.input[j].name.as_str()).collect();
+                    let measured: Vec<&str> = fb
+                        .measured
+                        .iter()
+                        .map(|&j| s.names.input[j].name.as_str())
+                        .collect();
                     if !measured.is_empty() {
                         text += &format!(
                             "  measured disturbances {}: not commanded, u = r (their [[input]] signals); G, R and the tracked outputs cover the other inputs (designed on their columns Γ_c of Γ_B)\n",
@@ -146,7 +206,11 @@ pub fn report(s: &Scenario) -> DesignReport {
                     if let Some((gi, ct, m)) = &fb.integral {
                         text += &format!(
                             "  integral action on the tracked outputs z = C_t x, {} (designed on the augmented sampled plant):\n",
-                            if m.is_some() { "measured as z = M y" } else { "estimated as z = C_t x̂ (not a combination of the outputs)" }
+                            if m.is_some() {
+                                "measured as z = M y"
+                            } else {
+                                "estimated as z = C_t x̂ (not a combination of the outputs)"
+                            }
                         );
                         text += &matrix_text("G_ξ", gi);
                         text += &matrix_text("C_t", ct);
@@ -161,13 +225,26 @@ pub fn report(s: &Scenario) -> DesignReport {
                         text += "  feedforward: u −= M ŵ_{k−1}, M = Γ_B⁺Γ_E (w enters through the inputs: Γ_E = Γ_B M); ŵ from the observer's estimator, M W:\n";
                         text += &matrix_text("MW", mw);
                     }
-                    let closed = if s.discrete || !matches!(c.spec, Some(controller::design::FeedbackSpec::Poles { domain: controller::design::Domain::Continuous, .. }) | Some(controller::design::FeedbackSpec::Gain(_))) {
+                    let closed = if s.discrete
+                        || !matches!(
+                            c.spec,
+                            Some(controller::design::FeedbackSpec::Poles {
+                                domain: controller::design::Domain::Continuous,
+                                ..
+                            }) | Some(controller::design::FeedbackSpec::Gain(_))
+                        ) {
                         "ln(z)/dt of the sampled loop"
                     } else {
                         "eig(A − BG)"
                     };
-                    text += &format!("  closed loop, {closed}: {}\n", format_list(&fb.closed_loop));
-                    text += &format!("  sampled eig(Φ − Γ_BG):       {}\n", format_list(&fb.discrete_closed_loop));
+                    text += &format!(
+                        "  closed loop, {closed}: {}\n",
+                        format_list(&fb.closed_loop)
+                    );
+                    text += &format!(
+                        "  sampled eig(Φ − Γ_BG):       {}\n",
+                        format_list(&fb.discrete_closed_loop)
+                    );
                     text += &format!("  stable: {}\n", fb.stable());
                     if !fb.stable() {
                         // The run refuses it without --allow-unstable: design says so by its exit code.
@@ -200,8 +277,16 @@ pub fn report(s: &Scenario) -> DesignReport {
                         "stable": fb.stable(),
                     });
                 }
-                if let Some((c, p)) = s.controller.as_ref().and_then(|c| c.process.as_ref().map(|p| (c, p))) {
-                    text += &format!("\ncontroller: external process on '{}': {}\n", c.observer, scenario::untrusted::one_line(&p.command.join(" ")));
+                if let Some((c, p)) = s
+                    .controller
+                    .as_ref()
+                    .and_then(|c| c.process.as_ref().map(|p| (c, p)))
+                {
+                    text += &format!(
+                        "\ncontroller: external process on '{}': {}\n",
+                        c.observer,
+                        scenario::untrusted::one_line(&p.command.join(" "))
+                    );
                     controller = json!({ "kind": "process", "observer": c.observer, "command": p.command, "params": p.params });
                 }
             }
@@ -230,7 +315,10 @@ pub fn report(s: &Scenario) -> DesignReport {
 
 /// Each bank: its members (role, poles, threshold), and the structure matrix computed from the
 /// designs beside the one asked for.
-fn banks_report(s: &Scenario, banks: &Result<Vec<diagnosis::Bank>, crate::plan::PlanError>) -> (String, Vec<Value>, bool) {
+fn banks_report(
+    s: &Scenario,
+    banks: &Result<Vec<diagnosis::Bank>, crate::plan::PlanError>,
+) -> (String, Vec<Value>, bool) {
     let mut text = String::new();
     let mut out = Vec::new();
     if s.diagnosers.is_empty() {
@@ -240,15 +328,28 @@ fn banks_report(s: &Scenario, banks: &Result<Vec<diagnosis::Bank>, crate::plan::
         Ok(banks) => {
             for b in banks {
                 let d = &b.spec;
-                text += &format!("\ndiagnoser '{}' ({} scheme, {} faults, {} members)\n", d.name, d.scheme.name(), d.channels.name(), b.members.len());
+                text += &format!(
+                    "\ndiagnoser '{}' ({} scheme, {} faults, {} members)\n",
+                    d.name,
+                    d.scheme.name(),
+                    d.channels.name(),
+                    b.members.len()
+                );
                 let mut members = Vec::new();
                 for (i, m) in b.members.iter().enumerate() {
                     let role = diagnosis::bank::role(d, &b.channels, i);
                     let threshold = match d.threshold {
-                        diagnosis::Threshold::Calibrated { runs, margin } => format!("{margin} × the largest J of {runs} fault-free realisation(s), set when run"),
+                        diagnosis::Threshold::Calibrated { runs, margin } => format!(
+                            "{margin} × the largest J of {runs} fault-free realisation(s), set when run"
+                        ),
                         _ => sig(m.threshold),
                     };
-                    text += &format!("  {} ({role}): {}, sampled poles {}, threshold {threshold}\n", m.name, m.designed.report.kind, format_list(&m.designed.report.discrete_poles));
+                    text += &format!(
+                        "  {} ({role}): {}, sampled poles {}, threshold {threshold}\n",
+                        m.name,
+                        m.designed.report.kind,
+                        format_list(&m.designed.report.discrete_poles)
+                    );
                     members.push(json!({
                         "name": m.name, "role": role, "kind": m.designed.report.kind,
                         "outputs": m.outputs.iter().map(|j| j + 1).collect::<Vec<_>>(),
@@ -259,7 +360,10 @@ fn banks_report(s: &Scenario, banks: &Result<Vec<diagnosis::Bank>, crate::plan::
                         "sampled": sampled_json(&m.designed.runtime, s.dt),
                     }));
                 }
-                text += &format!("  structure, transient (rows: residuals, columns: {}):\n", b.channels.join(", "));
+                text += &format!(
+                    "  structure, transient (rows: residuals, columns: {}):\n",
+                    b.channels.join(", ")
+                );
                 for (i, r) in b.structure.iter().enumerate() {
                     text += &format!("    r{} {:?}\n", i + 1, r);
                 }
@@ -268,12 +372,17 @@ fn banks_report(s: &Scenario, banks: &Result<Vec<diagnosis::Bank>, crate::plan::
                 }
                 match &b.steady {
                     Some(st) => {
-                        text += &format!("  steady-state structure under a constant fault (rows: residuals, columns: {}):\n", b.channels.join(", "));
+                        text += &format!(
+                            "  steady-state structure under a constant fault (rows: residuals, columns: {}):\n",
+                            b.channels.join(", ")
+                        );
                         for (i, r) in st.iter().enumerate() {
                             text += &format!("    r{} {:?}\n", i + 1, r);
                         }
                     }
-                    None => text += "  steady-state structure: not computed (a member's state is not a function of the plant's)\n",
+                    None => {
+                        text += "  steady-state structure: not computed (a member's state is not a function of the plant's)\n"
+                    }
                 }
                 out.push(json!({ "name": d.name, "scheme": d.scheme.name(), "faults": d.channels.name(), "channels": b.channels, "structure": b.structure, "steady_state_structure": b.steady, "members": members }));
             }

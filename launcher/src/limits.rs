@@ -33,7 +33,13 @@ pub fn sweep_runs(runs: usize) -> Result<(), LaunchError> {
         return Err(bad("--runs", runs, "must be at least 1"));
     }
     if runs > MAX_SWEEP_RUNS {
-        return Err(bad("--runs", runs, format!("at most {MAX_SWEEP_RUNS} realisations (each one's summary is kept until the statistics are gathered)")));
+        return Err(bad(
+            "--runs",
+            runs,
+            format!(
+                "at most {MAX_SWEEP_RUNS} realisations (each one's summary is kept until the statistics are gathered)"
+            ),
+        ));
     }
     Ok(())
 }
@@ -41,7 +47,11 @@ pub fn sweep_runs(runs: usize) -> Result<(), LaunchError> {
 /// `--jobs` of a sweep.
 pub fn jobs(jobs: usize) -> Result<(), LaunchError> {
     if !(1..=MAX_JOBS).contains(&jobs) {
-        return Err(bad("--jobs", jobs, format!("must be from 1 to {MAX_JOBS} worker threads")));
+        return Err(bad(
+            "--jobs",
+            jobs,
+            format!("must be from 1 to {MAX_JOBS} worker threads"),
+        ));
     }
     Ok(())
 }
@@ -50,7 +60,11 @@ pub fn jobs(jobs: usize) -> Result<(), LaunchError> {
 pub fn speed(speed: f64) -> Result<(), LaunchError> {
     let (lo, hi) = SPEED;
     if !(speed.is_finite() && (lo..=hi).contains(&speed)) {
-        return Err(bad("--speed", speed, format!("must be from {lo} to {hi} (times real time)")));
+        return Err(bad(
+            "--speed",
+            speed,
+            format!("must be from {lo} to {hi} (times real time)"),
+        ));
     }
     Ok(())
 }
@@ -60,11 +74,21 @@ pub fn speed(speed: f64) -> Result<(), LaunchError> {
 pub fn schedule(speed: f64, dt: f64, steps: u64) -> Result<(), LaunchError> {
     let period_ns = dt / speed * 1e9;
     if period_ns < 1.0 {
-        return Err(bad("--speed", speed, format!("a step of dt = {dt} s would get {period_ns:.3} ns of wall time: too little to pace")));
+        return Err(bad(
+            "--speed",
+            speed,
+            format!(
+                "a step of dt = {dt} s would get {period_ns:.3} ns of wall time: too little to pace"
+            ),
+        ));
     }
     let total_ns = period_ns * steps as f64;
     if total_ns > (1u64 << 62) as f64 {
-        return Err(bad("--speed", speed, format!("the paced run would last {:.3e} s", total_ns * 1e-9)));
+        return Err(bad(
+            "--speed",
+            speed,
+            format!("the paced run would last {:.3e} s", total_ns * 1e-9),
+        ));
     }
     Ok(())
 }
@@ -72,10 +96,18 @@ pub fn schedule(speed: f64, dt: f64, steps: u64) -> Result<(), LaunchError> {
 /// `--steps` and `--repeat` of `bench`.
 pub fn bench(steps: u64, repeat: usize) -> Result<(), LaunchError> {
     if !(1..=MAX_BENCH_STEPS).contains(&steps) {
-        return Err(bad("--steps", steps, format!("must be from 1 to {MAX_BENCH_STEPS}")));
+        return Err(bad(
+            "--steps",
+            steps,
+            format!("must be from 1 to {MAX_BENCH_STEPS}"),
+        ));
     }
     if !(1..=MAX_REPEAT).contains(&repeat) {
-        return Err(bad("--repeat", repeat, format!("must be from 1 to {MAX_REPEAT}")));
+        return Err(bad(
+            "--repeat",
+            repeat,
+            format!("must be from 1 to {MAX_REPEAT}"),
+        ));
     }
     Ok(())
 }
@@ -83,7 +115,11 @@ pub fn bench(steps: u64, repeat: usize) -> Result<(), LaunchError> {
 /// `--states` of `bench`.
 pub fn states(states: &[usize]) -> Result<(), LaunchError> {
     match states.iter().find(|&&n| !(1..=MAX_STATES).contains(&n)) {
-        Some(n) => Err(bad("--states", n, format!("a benchmark plant has from 1 to {MAX_STATES} states"))),
+        Some(n) => Err(bad(
+            "--states",
+            n,
+            format!("a benchmark plant has from 1 to {MAX_STATES} states"),
+        )),
         None => Ok(()),
     }
 }
@@ -95,13 +131,28 @@ mod tests {
     #[test]
     fn bounds_are_inclusive_and_name_the_flag() {
         assert!(sweep_runs(MAX_SWEEP_RUNS).is_ok() && sweep_runs(1).is_ok());
-        assert!(sweep_runs(MAX_SWEEP_RUNS + 1).unwrap_err().to_string().starts_with("--runs "));
+        assert!(
+            sweep_runs(MAX_SWEEP_RUNS + 1)
+                .unwrap_err()
+                .to_string()
+                .starts_with("--runs ")
+        );
         assert!(jobs(0).unwrap_err().to_string().starts_with("--jobs 0:"));
         assert!(speed(1e-3).is_ok() && speed(1e6).is_ok() && schedule(1e6, 0.001, 1000).is_ok());
-        assert!(speed(1e-300).is_err() && speed(f64::NAN).is_err() && speed(0.0).is_err() && speed(2e6).is_err());
+        assert!(
+            speed(1e-300).is_err()
+                && speed(f64::NAN).is_err()
+                && speed(0.0).is_err()
+                && speed(2e6).is_err()
+        );
         assert!(schedule(1e6, 1e-7, 1).is_err(), "a step of less than 1 ns");
-        assert!(schedule(1e-3, 1e9, 1e9 as u64).is_err(), "longer than the clock");
-        assert!(bench(0, 1).is_err() && bench(MAX_BENCH_STEPS + 1, 1).is_err() && bench(10, 0).is_err());
+        assert!(
+            schedule(1e-3, 1e9, 1e9 as u64).is_err(),
+            "longer than the clock"
+        );
+        assert!(
+            bench(0, 1).is_err() && bench(MAX_BENCH_STEPS + 1, 1).is_err() && bench(10, 0).is_err()
+        );
         assert!(states(&[3, 0]).is_err() && states(&[MAX_STATES]).is_ok());
     }
 }

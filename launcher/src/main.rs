@@ -4,20 +4,24 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use launcher::error::{LaunchError, EXIT_BAD_INPUT, EXIT_EXPECT};
+use launcher::error::{EXIT_BAD_INPUT, EXIT_EXPECT, LaunchError};
 // Printing that neither panics on a closed stdout nor passes control characters through.
-use launcher::{eprintln, print, println};
-use launcher::{limits, shipped};
 use launcher::run::{Mode, Options, Stop};
 use launcher::{design_report, plan, run};
-use scenario::Scenario;
+use launcher::{eprintln, print, println};
+use launcher::{limits, shipped};
 use lockstep::Wait;
+use scenario::Scenario;
 
 mod export_fmu;
 mod linearize;
 
 #[derive(Parser)]
-#[command(name = "launcher", version, about = "Design and co-simulate unknown input observers for LTI plants")]
+#[command(
+    name = "launcher",
+    version,
+    about = "Design and co-simulate unknown input observers for LTI plants"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -318,14 +322,32 @@ fn main() -> ExitCode {
         speed: None,
         stall_timeout: None,
     });
-    if matches!(command, Command::Run { .. } | Command::Sweep { .. } | Command::Bench { .. } | Command::Agent { .. }) {
+    if matches!(
+        command,
+        Command::Run { .. } | Command::Sweep { .. } | Command::Bench { .. } | Command::Agent { .. }
+    ) {
         // Dead runs of ours in the machine's /dev/shm go first; then this process and all it
         // starts move to a /dev/shm of their own, before any thread or segment exists (issue 32).
         lockstep::cleanup_dead_runs();
         let _ = lockstep::private_shm::enter();
     }
     match command {
-        Command::Run { scenario, out, mode, wait, force, allow_unstable, pin, record_every, record, compress, seed, realtime, speed, stall_timeout } => {
+        Command::Run {
+            scenario,
+            out,
+            mode,
+            wait,
+            force,
+            allow_unstable,
+            pin,
+            record_every,
+            record,
+            compress,
+            seed,
+            realtime,
+            speed,
+            stall_timeout,
+        } => {
             let speed = speed.unwrap_or(1.0);
             if let Err(e) = limits::speed(speed) {
                 return fail(&e);
@@ -355,43 +377,87 @@ fn main() -> ExitCode {
             for w in &p.warnings {
                 eprintln!("warning: {w}");
             }
-            let mode = if mode == "in-process" { Mode::InProcess } else { Mode::Processes };
+            let mode = if mode == "in-process" {
+                Mode::InProcess
+            } else {
+                Mode::Processes
+            };
             if mode == Mode::InProcess && !s.remote.is_empty() {
-                eprintln!("note: --mode in-process runs every component here; the scenario's [hosts] placements apply across processes");
+                eprintln!(
+                    "note: --mode in-process runs every component here; the scenario's [hosts] placements apply across processes"
+                );
             }
-            let opts = Options { out, mode, wait: wait.unwrap_or_else(Wait::default_for_machine), force, allow_unstable, record: true, pin: pin == "auto", select, progress: true, realtime };
+            let opts = Options {
+                out,
+                mode,
+                wait: wait.unwrap_or_else(Wait::default_for_machine),
+                force,
+                allow_unstable,
+                record: true,
+                pin: pin == "auto",
+                select,
+                progress: true,
+                realtime,
+            };
             match run::run(&s, &p, &opts) {
                 Ok(o) => {
                     print!("{}", o.summary.table());
                     if let Some(rrd) = &o.rrd {
-                        println!("recording: {}   (view it with: rerun {})", rrd.display(), rrd.display());
+                        println!(
+                            "recording: {}   (view it with: rerun {})",
+                            rrd.display(),
+                            rrd.display()
+                        );
                     }
                     match o.stop {
                         Stop::Completed if o.summary.expectations_met() => ExitCode::SUCCESS,
                         Stop::Completed => {
-                            eprintln!("error: {}: the run missed its [expect] table", s.path.display());
+                            eprintln!(
+                                "error: {}: the run missed its [expect] table",
+                                s.path.display()
+                            );
                             ExitCode::from(EXIT_EXPECT as u8)
                         }
-                        Stop::Diverged(w) => fail(&LaunchError::Diverged(format!("{}: run stopped: {w}", s.name))),
-                        Stop::Interrupted(sig) => fail(&LaunchError::Interrupted(format!("{}: run interrupted by {sig}; recording closed", s.name))),
-                        Stop::Failed(w) => fail(&LaunchError::Component(format!("{}: {w}", s.name))),
+                        Stop::Diverged(w) => fail(&LaunchError::Diverged(format!(
+                            "{}: run stopped: {w}",
+                            s.name
+                        ))),
+                        Stop::Interrupted(sig) => fail(&LaunchError::Interrupted(format!(
+                            "{}: run interrupted by {sig}; recording closed",
+                            s.name
+                        ))),
+                        Stop::Failed(w) => {
+                            fail(&LaunchError::Component(format!("{}: {w}", s.name)))
+                        }
                     }
                 }
                 Err(e) => fail(&e),
             }
         }
-        Command::Replay { recording, scenario, out, force } => {
-            let out = out.unwrap_or_else(|| recording.parent().unwrap_or(Path::new(".")).join("replay"));
-            let prepared = launcher::replay::scenario(&recording, scenario.as_deref()).and_then(|s| {
-                launcher::replay::refuse_overwrite(&recording, &out, &s.name)?;
-                let p = launcher::calibrate::planned(&s)?;
-                Ok((s, p))
-            });
+        Command::Replay {
+            recording,
+            scenario,
+            out,
+            force,
+        } => {
+            let out =
+                out.unwrap_or_else(|| recording.parent().unwrap_or(Path::new(".")).join("replay"));
+            let prepared =
+                launcher::replay::scenario(&recording, scenario.as_deref()).and_then(|s| {
+                    launcher::replay::refuse_overwrite(&recording, &out, &s.name)?;
+                    let p = launcher::calibrate::planned(&s)?;
+                    Ok((s, p))
+                });
             let (s, p) = match prepared {
                 Ok(x) => x,
                 Err(e) => return fail(&e),
             };
-            let opts = Options { force, progress: true, pin: true, ..Options::quiet(&out, Mode::Processes, Wait::default_for_machine(), true) };
+            let opts = Options {
+                force,
+                progress: true,
+                pin: true,
+                ..Options::quiet(&out, Mode::Processes, Wait::default_for_machine(), true)
+            };
             match run::run(&s, &p, &opts) {
                 Ok(o) => {
                     print!("{}", o.summary.table());
@@ -400,17 +466,40 @@ fn main() -> ExitCode {
                     }
                     match o.stop {
                         Stop::Completed if o.summary.expectations_met() => ExitCode::SUCCESS,
-                        Stop::Completed => fail(&LaunchError::Expect(format!("{}: the replay missed its [expect] table", s.path.display()))),
-                        Stop::Diverged(w) => fail(&LaunchError::Diverged(format!("{}: replay stopped: {w}", s.name))),
-                        Stop::Interrupted(sig) => fail(&LaunchError::Interrupted(format!("{}: replay interrupted by {sig}; recording closed", s.name))),
-                        Stop::Failed(w) => fail(&LaunchError::Component(format!("{}: {w}", s.name))),
+                        Stop::Completed => fail(&LaunchError::Expect(format!(
+                            "{}: the replay missed its [expect] table",
+                            s.path.display()
+                        ))),
+                        Stop::Diverged(w) => fail(&LaunchError::Diverged(format!(
+                            "{}: replay stopped: {w}",
+                            s.name
+                        ))),
+                        Stop::Interrupted(sig) => fail(&LaunchError::Interrupted(format!(
+                            "{}: replay interrupted by {sig}; recording closed",
+                            s.name
+                        ))),
+                        Stop::Failed(w) => {
+                            fail(&LaunchError::Component(format!("{}: {w}", s.name)))
+                        }
                     }
                 }
                 Err(e) => fail(&e),
             }
         }
-        Command::Sweep { scenario, runs, jobs, seed, mode, out, keep_worst } => {
-            let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()).min(limits::MAX_JOBS));
+        Command::Sweep {
+            scenario,
+            runs,
+            jobs,
+            seed,
+            mode,
+            out,
+            keep_worst,
+        } => {
+            let jobs = jobs.unwrap_or_else(|| {
+                std::thread::available_parallelism()
+                    .map_or(1, |n| n.get())
+                    .min(limits::MAX_JOBS)
+            });
             if let Err(e) = limits::sweep_runs(runs).and_then(|_| limits::jobs(jobs)) {
                 return fail(&e);
             }
@@ -419,8 +508,20 @@ fn main() -> ExitCode {
                 Ok(x) => x,
                 Err(e) => return fail(&e),
             };
-            let mode = if mode == "processes" { Mode::Processes } else { Mode::InProcess };
-            let opts = launcher::sweep::SweepOptions { runs, jobs, seed: s.seed, mode, out: out.clone(), keep_worst, wait: Wait::default_for_machine() };
+            let mode = if mode == "processes" {
+                Mode::Processes
+            } else {
+                Mode::InProcess
+            };
+            let opts = launcher::sweep::SweepOptions {
+                runs,
+                jobs,
+                seed: s.seed,
+                mode,
+                out: out.clone(),
+                keep_worst,
+                wait: Wait::default_for_machine(),
+            };
             run::interrupt::install();
             match launcher::sweep::sweep(&s, &p, &opts) {
                 Ok(sw) => {
@@ -443,19 +544,49 @@ fn main() -> ExitCode {
             };
             let r = design_report::report(&s);
             if json {
-                println!("{}", serde_json::to_string_pretty(&r.json).expect("serialises"));
+                println!(
+                    "{}",
+                    serde_json::to_string_pretty(&r.json).expect("serialises")
+                );
             } else {
                 print!("{}", r.text);
             }
-            if r.ok { ExitCode::SUCCESS } else { ExitCode::from(EXIT_BAD_INPUT as u8) }
+            if r.ok {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(EXIT_BAD_INPUT as u8)
+            }
         }
-        Command::FloorNode { run, index, steps, len_plant, len_observer, len_controller, wait } => {
-            match launcher::bench::floor::node(&run, index.min(2), steps, [len_plant, len_observer, len_controller], wait) {
+        Command::FloorNode {
+            run,
+            index,
+            steps,
+            len_plant,
+            len_observer,
+            len_controller,
+            wait,
+        } => {
+            match launcher::bench::floor::node(
+                &run,
+                index.min(2),
+                steps,
+                [len_plant, len_observer, len_controller],
+                wait,
+            ) {
                 Ok(()) => ExitCode::SUCCESS,
                 Err(e) => fail(&LaunchError::Component(format!("floor node {index}: {e}"))),
             }
         }
-        Command::Bench { steps, json, wait, mode, recording, pin, repeat, states } => {
+        Command::Bench {
+            steps,
+            json,
+            wait,
+            mode,
+            recording,
+            pin,
+            repeat,
+            states,
+        } => {
             if let Err(e) = limits::bench(steps, repeat).and_then(|_| limits::states(&states)) {
                 return fail(&e);
             }
@@ -471,10 +602,23 @@ fn main() -> ExitCode {
                 None => vec![false, true],
             };
             if !states.is_empty() {
-                return match launcher::bench::states::states(&states, steps, wait, pin == "auto", &modes, &rec) {
+                return match launcher::bench::states::states(
+                    &states,
+                    steps,
+                    wait,
+                    pin == "auto",
+                    &modes,
+                    &rec,
+                ) {
                     Ok(runs) => {
                         if json {
-                            println!("{}", serde_json::to_string_pretty(&serde_json::json!({ "states": runs })).expect("serialises"));
+                            println!(
+                                "{}",
+                                serde_json::to_string_pretty(
+                                    &serde_json::json!({ "states": runs })
+                                )
+                                .expect("serialises")
+                            );
                         } else {
                             print!("{}", launcher::bench::states::table(&runs));
                         }
@@ -483,7 +627,15 @@ fn main() -> ExitCode {
                     Err(e) => fail(&e),
                 };
             }
-            match launcher::bench::bench(&shipped::dir().join("seed002-sine.toml"), steps, wait, pin == "auto", &modes, &rec, repeat) {
+            match launcher::bench::bench(
+                &shipped::dir().join("seed002-sine.toml"),
+                steps,
+                wait,
+                pin == "auto",
+                &modes,
+                &rec,
+                repeat,
+            ) {
                 Ok(runs) => {
                     if json {
                         println!("{}", serde_json::to_string_pretty(&serde_json::json!({ "runs": runs, "ratios": launcher::bench::ratios(&runs).into_iter().map(|(n, v)| (n, serde_json::json!({"min": v.0, "median": v.1, "max": v.2, "repetitions": v.3}))).collect::<serde_json::Map<_, _>>() })).expect("serialises"));
@@ -498,8 +650,14 @@ fn main() -> ExitCode {
         Command::Agent { args } => {
             use std::os::unix::process::CommandExt;
             let bridge = launcher::run::bridge_path();
-            let e = std::process::Command::new(&bridge).arg("agent").args(&args).exec();
-            eprintln!("error: cannot run {}: {e} (build it with `cargo build --release --workspace`)", bridge.display());
+            let e = std::process::Command::new(&bridge)
+                .arg("agent")
+                .args(&args)
+                .exec();
+            eprintln!(
+                "error: cannot run {}: {e} (build it with `cargo build --release --workspace`)",
+                bridge.display()
+            );
             ExitCode::from(3)
         }
         Command::List { dir } => match shipped::list(&dir.unwrap_or_else(shipped::dir)) {
@@ -526,7 +684,12 @@ fn main() -> ExitCode {
             }
             Err(code) => code,
         },
-        Command::Compare { a, b, abs_tol, rel_tol } => {
+        Command::Compare {
+            a,
+            b,
+            abs_tol,
+            rel_tol,
+        } => {
             let (ra, rb) = match (read_recording(&a), read_recording(&b)) {
                 (Ok(ra), Ok(rb)) => (ra, rb),
                 (Err(code), _) | (_, Err(code)) => return code,
@@ -538,7 +701,18 @@ fn main() -> ExitCode {
             }
             match recording::compare::compare(&ra, &rb, abs_tol, rel_tol) {
                 Ok(n) => {
-                    println!("same: {n} values of {} signals{}", ra.series.keys().filter(|k| !k.starts_with("/latency")).count(), if abs_tol.is_none() && rel_tol.is_none() { ", bit for bit" } else { ", within tolerance" });
+                    println!(
+                        "same: {n} values of {} signals{}",
+                        ra.series
+                            .keys()
+                            .filter(|k| !k.starts_with("/latency"))
+                            .count(),
+                        if abs_tol.is_none() && rel_tol.is_none() {
+                            ", bit for bit"
+                        } else {
+                            ", within tolerance"
+                        }
+                    );
                     ExitCode::SUCCESS
                 }
                 Err(d) => {
@@ -547,17 +721,28 @@ fn main() -> ExitCode {
                 }
             }
         }
-        Command::Plot { recording, out, signals, from, to, deviations } => {
+        Command::Plot {
+            recording,
+            out,
+            signals,
+            from,
+            to,
+            deviations,
+        } => {
             let selection = recording::plot::PlotSelection { signals, from, to };
             if let Err(e) = selection.validate() {
                 return fail(&LaunchError::BadInput(e));
             }
-            let r = match read_recording(&recording).and_then(|r| shifted(&recording, r, deviations)) {
-                Ok(r) => r,
-                Err(code) => return code,
-            };
+            let r =
+                match read_recording(&recording).and_then(|r| shifted(&recording, r, deviations)) {
+                    Ok(r) => r,
+                    Err(code) => return code,
+                };
             if !r.complete {
-                eprintln!("warning: {}: incomplete recording (its writer did not finish); plotting what it holds", recording.display());
+                eprintln!(
+                    "warning: {}: incomplete recording (its writer did not finish); plotting what it holds",
+                    recording.display()
+                );
             }
             match recording::plot::plot(&r, &out, &selection) {
                 Ok(files) => {
@@ -566,26 +751,63 @@ fn main() -> ExitCode {
                     }
                     ExitCode::SUCCESS
                 }
-                Err(e) => fail(&LaunchError::BadInput(format!("{}: {e}", recording.display()))),
+                Err(e) => fail(&LaunchError::BadInput(format!(
+                    "{}: {e}",
+                    recording.display()
+                ))),
             }
         }
-        Command::Export { recording, csv, mcap, npz, mat, deviations, force } => {
+        Command::Export {
+            recording,
+            csv,
+            mcap,
+            npz,
+            mat,
+            deviations,
+            force,
+        } => {
             // An export written over its own recording would replace the data it was made from.
-            if let Some(p) = [&mcap, &npz, &mat].into_iter().flatten().find(|p| same_file(p, &recording)) {
-                return fail(&LaunchError::BadInput(format!("{}: is the recording being exported ({}); refusing to write over it", p.display(), recording.display())));
+            if let Some(p) = [&mcap, &npz, &mat]
+                .into_iter()
+                .flatten()
+                .find(|p| same_file(p, &recording))
+            {
+                return fail(&LaunchError::BadInput(format!(
+                    "{}: is the recording being exported ({}); refusing to write over it",
+                    p.display(),
+                    recording.display()
+                )));
             }
-            let r = match read_recording(&recording).and_then(|r| shifted(&recording, r, deviations)) {
-                Ok(r) => r,
-                Err(code) => return code,
-            };
+            let r =
+                match read_recording(&recording).and_then(|r| shifted(&recording, r, deviations)) {
+                    Ok(r) => r,
+                    Err(code) => return code,
+                };
             // Existing files are replaced only when asked, as `run` replaces its outputs.
-            let csv_files = csv.iter().flat_map(|d| recording::export::csv::planned(&r).into_iter().map(move |f| d.join(f)));
-            if !force && let Some(p) = [&mcap, &npz, &mat].into_iter().flatten().cloned().chain(csv_files).find(|p| p.symlink_metadata().is_ok()) {
-                return fail(&LaunchError::BadInput(format!("{}: already exists (pass --force to overwrite)", p.display())));
+            let csv_files = csv.iter().flat_map(|d| {
+                recording::export::csv::planned(&r)
+                    .into_iter()
+                    .map(move |f| d.join(f))
+            });
+            if !force
+                && let Some(p) = [&mcap, &npz, &mat]
+                    .into_iter()
+                    .flatten()
+                    .cloned()
+                    .chain(csv_files)
+                    .find(|p| p.symlink_metadata().is_ok())
+            {
+                return fail(&LaunchError::BadInput(format!(
+                    "{}: already exists (pass --force to overwrite)",
+                    p.display()
+                )));
             }
             let dt = recording::tools::recorded_dt(&r);
             if !r.complete {
-                eprintln!("warning: {}: incomplete recording (its writer did not finish); exporting what it holds", recording.display());
+                eprintln!(
+                    "warning: {}: incomplete recording (its writer did not finish); exporting what it holds",
+                    recording.display()
+                );
             }
             use recording::export as ex;
             let done = (|| -> Result<(), String> {
@@ -608,9 +830,20 @@ fn main() -> ExitCode {
                 Err(e) => fail(&LaunchError::BadInput(e)),
             }
         }
-        Command::ExportFmu { scenario, observer, out, fmi } => {
-            let fmi = if fmi == "2" { fmu_export::Fmi::V2 } else { fmu_export::Fmi::V3 };
-            match shipped::load(&scenario).and_then(|s| export_fmu::export_fmu(&s, &observer, &out, fmi)) {
+        Command::ExportFmu {
+            scenario,
+            observer,
+            out,
+            fmi,
+        } => {
+            let fmi = if fmi == "2" {
+                fmu_export::Fmi::V2
+            } else {
+                fmu_export::Fmi::V3
+            };
+            match shipped::load(&scenario)
+                .and_then(|s| export_fmu::export_fmu(&s, &observer, &out, fmi))
+            {
                 Ok(path) => {
                     println!("{}", path.display());
                     ExitCode::SUCCESS
@@ -618,7 +851,11 @@ fn main() -> ExitCode {
                 Err(e) => fail(&e),
             }
         }
-        Command::Linearize { scenario, trim, out } => match linearize::linearize(&scenario, trim, &out) {
+        Command::Linearize {
+            scenario,
+            trim,
+            out,
+        } => match linearize::linearize(&scenario, trim, &out) {
             Ok(path) => {
                 println!("wrote {}", path.display());
                 ExitCode::SUCCESS
@@ -635,11 +872,17 @@ fn read_recording(path: &Path) -> Result<recording::Recording, ExitCode> {
     let r = recording::read(path).map_err(|e| fail(&LaunchError::BadInput(e.to_string())))?;
     if let recording::Integrity::Damaged(what) = &r.integrity {
         let why = if what.starts_with('/') || what == recording::digest::SCENARIO_KEY {
-            format!("{}: its data does not match the digest written with the recording", scenario::quoted(what))
+            format!(
+                "{}: its data does not match the digest written with the recording",
+                scenario::quoted(what)
+            )
         } else {
             what.clone()
         };
-        return Err(fail(&LaunchError::Damaged(format!("{}: damaged: {why}", path.display()))));
+        return Err(fail(&LaunchError::Damaged(format!(
+            "{}: damaged: {why}",
+            path.display()
+        ))));
     }
     Ok(r)
 }
@@ -654,11 +897,20 @@ fn same_file(a: &Path, b: &Path) -> bool {
 }
 
 /// `r` in deviations from its operating point when asked (`--deviations`), else as recorded.
-fn shifted(path: &Path, r: recording::Recording, deviations: bool) -> Result<recording::Recording, ExitCode> {
+fn shifted(
+    path: &Path,
+    r: recording::Recording,
+    deviations: bool,
+) -> Result<recording::Recording, ExitCode> {
     if !deviations {
         return Ok(r);
     }
-    recording::deviations::in_deviations(&r).map_err(|e| fail(&LaunchError::BadInput(format!("{}: --deviations: {e}", path.display()))))
+    recording::deviations::in_deviations(&r).map_err(|e| {
+        fail(&LaunchError::BadInput(format!(
+            "{}: --deviations: {e}",
+            path.display()
+        )))
+    })
 }
 
 /// Runs a component's shell in this process (the fallback when its binary is not installed).

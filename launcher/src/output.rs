@@ -14,7 +14,9 @@ use scenario::untrusted::{one_line, printable};
 /// Writes `text` to stdout as it is, newlines included.
 pub fn out(text: &str) {
     let mut o = std::io::stdout().lock();
-    let _ = o.write_all(printable(text).as_bytes()).and_then(|_| o.flush());
+    let _ = o
+        .write_all(printable(text).as_bytes())
+        .and_then(|_| o.flush());
 }
 
 /// Writes one message line to stderr.

@@ -7,9 +7,9 @@ use lti::eig::sig;
 use serde::Serialize;
 
 use crate::plan::Plan;
+use crate::run::{Options, Stop};
 use recording::signals::figure;
 use recording::write::{Latency, Metrics, Percentiles};
-use crate::run::{Options, Stop};
 use scenario::Scenario;
 
 /// One observer's line.
@@ -144,7 +144,17 @@ pub struct Summary {
 impl Summary {
     /// Gathers the summary of a run.
     #[allow(clippy::too_many_arguments)]
-    pub fn new(s: &Scenario, plan: &Plan, opts: &Options, m: &Metrics, lat: &Latency, wall_s: f64, stop: &Stop, rrd: Option<&Path>, diagnosis: Option<diagnosis::Diagnosis>) -> Self {
+    pub fn new(
+        s: &Scenario,
+        plan: &Plan,
+        opts: &Options,
+        m: &Metrics,
+        lat: &Latency,
+        wall_s: f64,
+        stop: &Stop,
+        rrd: Option<&Path>,
+        diagnosis: Option<diagnosis::Diagnosis>,
+    ) -> Self {
         let observers: Vec<ObserverSummary> = s
             .observers
             .iter()
@@ -158,13 +168,26 @@ impl Summary {
                 max_abs_error: Some(f.max_abs_error),
                 final_abs_error: Some(f.final_abs_error),
                 tail_max_abs_input_error: f.tail_max_abs_input_error,
-                fault_free: f.fault_free.map(|f| FaultFree { until: f.until, tail_max_abs_error: Some(f.tail_max_abs_error), tail_max_abs_residual: f.tail_max_abs_residual, max_abs_error: Some(f.max_abs_error) }),
-                poles: d.as_ref().map_or_else(Vec::new, |d| lti::re_im(&d.report.poles)),
-                discrete_poles: d.as_ref().map_or_else(Vec::new, |d| lti::re_im(&d.report.discrete_poles)),
+                fault_free: f.fault_free.map(|f| FaultFree {
+                    until: f.until,
+                    tail_max_abs_error: Some(f.tail_max_abs_error),
+                    tail_max_abs_residual: f.tail_max_abs_residual,
+                    max_abs_error: Some(f.max_abs_error),
+                }),
+                poles: d
+                    .as_ref()
+                    .map_or_else(Vec::new, |d| lti::re_im(&d.report.poles)),
+                discrete_poles: d
+                    .as_ref()
+                    .map_or_else(Vec::new, |d| lti::re_im(&d.report.discrete_poles)),
             })
             .collect();
         let names = s.observer_names();
-        let differences = m.differences.iter().map(|((a, b), d)| (format!("{}/{}", names[*a], names[*b]), *d)).collect();
+        let differences = m
+            .differences
+            .iter()
+            .map(|((a, b), d)| (format!("{}/{}", names[*a], names[*b]), *d))
+            .collect();
         let stopped = match stop {
             Stop::Completed => None,
             Stop::Diverged(w) => Some(format!("diverged: {w}")),
@@ -184,7 +207,10 @@ impl Summary {
             observers,
             differences,
             closed_loop_poles: plan.feedback.as_ref().map(|f| lti::re_im(&f.closed_loop)),
-            latency_ns: LatencySummary { step: lat.step_percentiles(), hops: lat.hop_percentiles().into_iter().collect() },
+            latency_ns: LatencySummary {
+                step: lat.step_percentiles(),
+                hops: lat.hop_percentiles().into_iter().collect(),
+            },
             expectations: Vec::new(),
             stopped,
             diagnosis,
@@ -205,8 +231,17 @@ impl Summary {
     /// false) every state-error figure becomes null, where it holds no w (`disturbances` false)
     /// every |w − ŵ|, each with its reason in `unmeasured`; the expectations are checked again.
     pub fn with_replay(&mut self, s: &Scenario, facts: serde_json::Value, completed: bool) {
-        let has = |k: &str| facts.get(k).and_then(serde_json::Value::as_bool).unwrap_or(true);
-        let file = facts.get("file").and_then(serde_json::Value::as_str).unwrap_or("the data").to_string();
+        let has = |k: &str| {
+            facts
+                .get(k)
+                .and_then(serde_json::Value::as_bool)
+                .unwrap_or(true)
+        };
+        let file = facts
+            .get("file")
+            .and_then(serde_json::Value::as_str)
+            .unwrap_or("the data")
+            .to_string();
         if !has("states") {
             for o in &mut self.observers {
                 (o.tail_max_abs_error, o.max_abs_error, o.final_abs_error) = (None, None, None);
@@ -216,7 +251,12 @@ impl Summary {
             }
             self.unmeasured.push(format!("max|e|: {file} holds no states (plant.replay.states), so x − x̂ would be −x̂, not an estimation error"));
         }
-        if !has("disturbances") && self.observers.iter().any(|o| o.tail_max_abs_input_error.is_some()) {
+        if !has("disturbances")
+            && self
+                .observers
+                .iter()
+                .any(|o| o.tail_max_abs_input_error.is_some())
+        {
             for o in &mut self.observers {
                 o.tail_max_abs_input_error = None;
             }
@@ -236,30 +276,52 @@ impl Summary {
         let mut out = Vec::new();
         let mut add = |what: String, limit: f64, value: Option<f64>| {
             let value = value.filter(|_| completed);
-            out.push(Expectation { what, limit, value, ok: value.is_some_and(|v| v <= limit) });
+            out.push(Expectation {
+                what,
+                limit,
+                value,
+                ok: value.is_some_and(|v| v <= limit),
+            });
         };
         for (name, &limit) in &e.tail_max_abs_error {
-            add(format!("tail_max_abs_error.{name}"), limit, self.observer(name).and_then(|o| o.tail_max_abs_error));
+            add(
+                format!("tail_max_abs_error.{name}"),
+                limit,
+                self.observer(name).and_then(|o| o.tail_max_abs_error),
+            );
         }
         for (name, &limit) in &e.tail_max_abs_residual {
-            add(format!("tail_max_abs_residual.{name}"), limit, self.observer(name).and_then(|o| o.tail_max_abs_residual));
+            add(
+                format!("tail_max_abs_residual.{name}"),
+                limit,
+                self.observer(name).and_then(|o| o.tail_max_abs_residual),
+            );
         }
         for (pair, &limit) in &e.max_abs_difference {
             let (a, b) = pair.split_once('/').unwrap_or((pair, pair));
-            let v = self.differences.get(pair).or_else(|| self.differences.get(&format!("{b}/{a}"))).copied();
+            let v = self
+                .differences
+                .get(pair)
+                .or_else(|| self.differences.get(&format!("{b}/{a}")))
+                .copied();
             add(format!("max_abs_difference.{pair}"), limit, v);
         }
         for (pair, &limit) in &e.tail_error_ratio {
             let (a, b) = pair.split_once('/').unwrap_or((pair, pair));
             let v = match (self.observer(a), self.observer(b)) {
-                (Some(x), Some(y)) => x.tail_max_abs_error.zip(y.tail_max_abs_error).map(|(a, b)| a / b),
+                (Some(x), Some(y)) => x
+                    .tail_max_abs_error
+                    .zip(y.tail_max_abs_error)
+                    .map(|(a, b)| a / b),
                 _ => None,
             };
             add(format!("tail_error_ratio.{pair}"), limit, v);
         }
         let d = self.diagnosis.as_ref();
         for (name, &limit) in &e.detection_delay {
-            let v = d.and_then(|d| d.faults.iter().find(|f| &f.name == name)).and_then(|f| f.delay);
+            let v = d
+                .and_then(|d| d.faults.iter().find(|f| &f.name == name))
+                .and_then(|f| f.delay);
             add(format!("detection_delay.{name}"), limit, v);
         }
         if e.correct_isolation == Some(true) {
@@ -267,11 +329,20 @@ impl Summary {
             add("faults_not_isolated_correctly".into(), 0.0, wrong);
         }
         if e.first_isolation_correct == Some(true) {
-            let wrong = d.map(|d| d.faults.iter().filter(|f| !f.first_isolation_correct).count() as f64);
+            let wrong = d.map(|d| {
+                d.faults
+                    .iter()
+                    .filter(|f| !f.first_isolation_correct)
+                    .count() as f64
+            });
             add("faults_first_isolated_wrongly".into(), 0.0, wrong);
         }
         if let Some(limit) = e.false_alarms {
-            add("false_alarms".into(), limit as f64, d.map(|d| d.false_alarms as f64));
+            add(
+                "false_alarms".into(),
+                limit as f64,
+                d.map(|d| d.false_alarms as f64),
+            );
         }
         out
     }
@@ -301,16 +372,39 @@ impl Summary {
             self.wall_s,
             sig(self.steps_per_s.round())
         );
-        let tail = if self.steps < self.steps_planned { "tail of the steps completed" } else { "tail: last quarter" };
-        t += &format!("  {:<14} {:<16} {:>14} {:>14}   ({tail})\n", "observer", "kind", "tail max|e|", "tail max|r|");
+        let tail = if self.steps < self.steps_planned {
+            "tail of the steps completed"
+        } else {
+            "tail: last quarter"
+        };
+        t += &format!(
+            "  {:<14} {:<16} {:>14} {:>14}   ({tail})\n",
+            "observer", "kind", "tail max|e|", "tail max|r|"
+        );
         for o in &self.observers {
-            t += &format!("  {:<14} {:<16} {:>14} {:>14}\n", o.name, o.kind, figure(o.tail_max_abs_error), figure(o.tail_max_abs_residual));
+            t += &format!(
+                "  {:<14} {:<16} {:>14} {:>14}\n",
+                o.name,
+                o.kind,
+                figure(o.tail_max_abs_error),
+                figure(o.tail_max_abs_residual)
+            );
             let unknown_w = self.unmeasured.iter().any(|u| u.starts_with("max|w"));
             if o.tail_max_abs_input_error.is_some() || unknown_w {
-                t += &format!("  {:<31} {:>14}   (its unknown-input estimate)\n", "", format!("max|w − ŵ| {}", figure(o.tail_max_abs_input_error)));
+                t += &format!(
+                    "  {:<31} {:>14}   (its unknown-input estimate)\n",
+                    "",
+                    format!("max|w − ŵ| {}", figure(o.tail_max_abs_input_error))
+                );
             }
             if let Some(ff) = &o.fault_free {
-                t += &format!("  {:<31} {:>14} {:>14}   (tail of the fault-free {} s before the first fault)\n", "", figure(ff.tail_max_abs_error), figure(Some(ff.tail_max_abs_residual)), sig(ff.until));
+                t += &format!(
+                    "  {:<31} {:>14} {:>14}   (tail of the fault-free {} s before the first fault)\n",
+                    "",
+                    figure(ff.tail_max_abs_error),
+                    figure(Some(ff.tail_max_abs_residual)),
+                    sig(ff.until)
+                );
             }
         }
         for why in &self.unmeasured {
@@ -318,36 +412,75 @@ impl Summary {
         }
         let p = &self.latency_ns.step;
         if p.max > 0 {
-            t += &format!("  step latency   p50 {}  p90 {}  p99 {}  p99.9 {}  max {}\n", us(p.p50), us(p.p90), us(p.p99), us(p.p999), us(p.max));
+            t += &format!(
+                "  step latency   p50 {}  p90 {}  p99 {}  p99.9 {}  max {}\n",
+                us(p.p50),
+                us(p.p90),
+                us(p.p99),
+                us(p.p999),
+                us(p.max)
+            );
             for (hop, p) in &self.latency_ns.hops {
-                t += &format!("    {:<30} p50 {}  p99 {}  max {}\n", hop, us(p.p50), us(p.p99), us(p.max));
+                t += &format!(
+                    "    {:<30} p50 {}  p99 {}  max {}\n",
+                    hop,
+                    us(p.p50),
+                    us(p.p99),
+                    us(p.max)
+                );
             }
         }
         if let Some(r) = &self.realtime {
             let off = 100.0 * (r.paced_wall_s / r.scheduled_s.max(1e-12) - 1.0);
-            t += &format!("  real time: {} s paced for {} s scheduled ({off:+.2} %), step period {} s\n", sig(r.paced_wall_s), sig(r.scheduled_s), sig(r.period_s));
+            t += &format!(
+                "  real time: {} s paced for {} s scheduled ({off:+.2} %), step period {} s\n",
+                sig(r.paced_wall_s),
+                sig(r.scheduled_s),
+                sig(r.period_s)
+            );
             t += &if r.overruns == 0 {
                 "  every step ended by its deadline\n".to_string()
             } else {
-                format!("  cannot keep up: {} of {} steps ended after their deadline (latest by {:.1} µs)\n", r.overruns, r.steps, r.max_lateness_us)
+                format!(
+                    "  cannot keep up: {} of {} steps ended after their deadline (latest by {:.1} µs)\n",
+                    r.overruns, r.steps, r.max_lateness_us
+                )
             };
         }
         for w in self.warnings.iter().filter(|w| w.starts_with("diagnoser ")) {
             t += &format!("  note: {w}\n");
         }
         if let Some(d) = &self.diagnosis {
-            t += &format!("  diagnosis: {} false alarm(s) over {} s fault-free ({} step(s) in alarm)\n", d.false_alarms, sig(d.fault_free_time), d.false_alarm_steps);
+            t += &format!(
+                "  diagnosis: {} false alarm(s) over {} s fault-free ({} step(s) in alarm)\n",
+                d.false_alarms,
+                sig(d.fault_free_time),
+                d.false_alarm_steps
+            );
             for f in &d.faults {
-                let at = |v: Option<f64>| v.map_or_else(|| "—".to_string(), |v| format!("{v:.4} s"));
+                let at =
+                    |v: Option<f64>| v.map_or_else(|| "—".to_string(), |v| format!("{v:.4} s"));
                 t += &format!(
                     "    {:<20} start {:>9}  detected {:>11}  first isolated as {:<16} {}\n",
                     f.name,
                     format!("{} s", f.start),
                     at(f.detected_at),
                     f.isolated_as.as_deref().unwrap_or("—"),
-                    if f.isolated_as.is_none() { "" } else if f.first_isolation_correct { "(right)" } else { "(wrong)" }
+                    if f.isolated_as.is_none() {
+                        ""
+                    } else if f.first_isolation_correct {
+                        "(right)"
+                    } else {
+                        "(wrong)"
+                    }
                 );
-                let pct = |x: f64| if f.active_time > 0.0 { format!("{:.1} %", 100.0 * x / f.active_time) } else { "—".into() };
+                let pct = |x: f64| {
+                    if f.active_time > 0.0 {
+                        format!("{:.1} %", 100.0 * x / f.active_time)
+                    } else {
+                        "—".into()
+                    }
+                };
                 t += &format!(
                     "    {:<20} over its {} s: isolated correctly {}, as another channel {}, unknown {}, no alarm {}: {}\n",
                     "",
@@ -356,15 +489,34 @@ impl Summary {
                     pct(f.isolated_otherwise_time),
                     pct(f.unknown_time),
                     pct(f.no_alarm_time),
-                    if f.correct { "correct".to_string() } else { format!("NOT isolated (needs ≥ {} % of its time)", sig(100.0 * d.required_fraction)) }
+                    if f.correct {
+                        "correct".to_string()
+                    } else {
+                        format!(
+                            "NOT isolated (needs ≥ {} % of its time)",
+                            sig(100.0 * d.required_fraction)
+                        )
+                    }
                 );
             }
         }
         for e in &self.expectations {
             t += &match e.value {
-                Some(v) => format!("  expect {} ≤ {:.3e}: {:.3e} {}\n", e.what, e.limit, v, if e.ok { "ok" } else { "MISSED" }),
-                None if self.stopped.is_some() => format!("  expect {} ≤ {:.3e}: not checked (the run did not complete)\n", e.what, e.limit),
-                None => format!("  expect {} ≤ {:.3e}: MISSED (no such figure)\n", e.what, e.limit),
+                Some(v) => format!(
+                    "  expect {} ≤ {:.3e}: {:.3e} {}\n",
+                    e.what,
+                    e.limit,
+                    v,
+                    if e.ok { "ok" } else { "MISSED" }
+                ),
+                None if self.stopped.is_some() => format!(
+                    "  expect {} ≤ {:.3e}: not checked (the run did not complete)\n",
+                    e.what, e.limit
+                ),
+                None => format!(
+                    "  expect {} ≤ {:.3e}: MISSED (no such figure)\n",
+                    e.what, e.limit
+                ),
             };
         }
         if let Some(why) = &self.stopped {

@@ -29,7 +29,10 @@ pub enum LockstepError {
         got: usize,
     },
     /// A sample of another protocol version arrived.
-    #[error("{topic}: sample of protocol version {got}, this component speaks {}", crate::PROTOCOL_VERSION)]
+    #[error(
+        "{topic}: sample of protocol version {got}, this component speaks {}",
+        crate::PROTOCOL_VERSION
+    )]
     Protocol {
         /// The service.
         topic: String,

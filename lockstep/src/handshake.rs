@@ -28,7 +28,10 @@ pub struct Launch {
 pub const EXIT_USAGE: i32 = 2;
 
 /// Parses `--run <id> --name <name> [--wait <w>]`; the error explains how to start a run.
-pub fn parse_launch(component: &str, args: impl IntoIterator<Item = String>) -> Result<Launch, String> {
+pub fn parse_launch(
+    component: &str,
+    args: impl IntoIterator<Item = String>,
+) -> Result<Launch, String> {
     let how = format!(
         "{component}: this program is one process of a co-simulation and is started by the launcher, \
          e.g. `launcher run scenarios/seed002-sine.toml`"
@@ -38,7 +41,10 @@ pub fn parse_launch(component: &str, args: impl IntoIterator<Item = String>) -> 
     let mut wait = Wait::default_for_machine();
     let mut it = args.into_iter();
     while let Some(a) = it.next() {
-        let mut value = || it.next().ok_or_else(|| format!("{how} ({a} needs a value)"));
+        let mut value = || {
+            it.next()
+                .ok_or_else(|| format!("{how} ({a} needs a value)"))
+        };
         match a.as_str() {
             "--run" => run = Some(value()?),
             "--name" => name = Some(value()?),
@@ -48,18 +54,29 @@ pub fn parse_launch(component: &str, args: impl IntoIterator<Item = String>) -> 
         }
     }
     // A component started by a launcher of PROTOCOL.md gets the same in its environment.
-    let run = run.or_else(|| std::env::var("UIO_RUN").ok()).ok_or_else(|| how.clone())?;
+    let run = run
+        .or_else(|| std::env::var("UIO_RUN").ok())
+        .ok_or_else(|| how.clone())?;
     let name = name.or_else(|| std::env::var("UIO_NAME").ok());
     let run = RunSpace::open(&run).map_err(|e| format!("{how} ({e})"))?;
     // SAFETY: getppid has no preconditions.
     let parent = unsafe { libc::getppid() };
     if run.owner() != Some(parent) {
-        return Err(format!("{how} (its parent, pid {parent}, is not the launcher of run '{}')", run.id()));
+        return Err(format!(
+            "{how} (its parent, pid {parent}, is not the launcher of run '{}')",
+            run.id()
+        ));
     }
     if std::io::stdin().is_terminal() {
-        return Err(format!("{how} (stdin is a terminal, not the launcher's pipe)"));
+        return Err(format!(
+            "{how} (stdin is a terminal, not the launcher's pipe)"
+        ));
     }
-    Ok(Launch { run, name: name.unwrap_or_else(|| component.to_string()), wait })
+    Ok(Launch {
+        run,
+        name: name.unwrap_or_else(|| component.to_string()),
+        wait,
+    })
 }
 
 /// Asks the kernel to kill this process when its parent (the launcher) dies.
@@ -75,12 +92,19 @@ pub fn die_with_parent() {
 /// Writes `ready`, then blocks until the launcher writes `go` (or closes the pipe).
 pub fn ready_then_wait_for_go() -> Result<(), LockstepError> {
     let mut out = std::io::stdout().lock();
-    writeln!(out, "ready").and_then(|_| out.flush()).map_err(|e| LockstepError::Io(format!("stdout: {e}")))?;
+    writeln!(out, "ready")
+        .and_then(|_| out.flush())
+        .map_err(|e| LockstepError::Io(format!("stdout: {e}")))?;
     let mut line = String::new();
-    std::io::stdin().lock().read_line(&mut line).map_err(|e| LockstepError::Io(format!("stdin: {e}")))?;
+    std::io::stdin()
+        .lock()
+        .read_line(&mut line)
+        .map_err(|e| LockstepError::Io(format!("stdin: {e}")))?;
     if line.trim() == "go" {
         Ok(())
     } else {
-        Err(LockstepError::Io("the launcher stopped the run before it began".into()))
+        Err(LockstepError::Io(
+            "the launcher stopped the run before it began".into(),
+        ))
     }
 }

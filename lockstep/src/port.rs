@@ -8,18 +8,18 @@ use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
-use iceoryx2::waitset::WaitSetGuard;
 use iceoryx2::service::port_factory::publish_subscribe::PortFactory;
+use iceoryx2::waitset::WaitSetGuard;
 
 use crate::clock::now_ns;
-use crate::service::Service as Ipc;
 use crate::error::LockstepError;
 use crate::run::RunSpace;
-use crate::sample::{Header, WireHeader, PROTOCOL_VERSION};
+use crate::sample::{Header, PROTOCOL_VERSION, WireHeader};
+use crate::service::Service as Ipc;
 use crate::wait::Wait;
 
-pub use crate::settings::{FOLLOWER_LAG, RECORDER_BUFFER};
 use crate::settings::*;
+pub use crate::settings::{FOLLOWER_LAG, RECORDER_BUFFER};
 
 /// A process's node on the run's bus.
 pub struct Bus {
@@ -57,9 +57,14 @@ impl Bus {
             .map_err(LockstepError::ipc)
     }
 
-    fn event(&self, topic: &str) -> Result<iceoryx2::service::port_factory::event::PortFactory<Ipc>, LockstepError> {
+    fn event(
+        &self,
+        topic: &str,
+    ) -> Result<iceoryx2::service::port_factory::event::PortFactory<Ipc>, LockstepError> {
         self.node
-            .service_builder(&ServiceName::new(&format!("{topic}/wake")).map_err(LockstepError::ipc)?)
+            .service_builder(
+                &ServiceName::new(&format!("{topic}/wake")).map_err(LockstepError::ipc)?,
+            )
             .event()
             .max_notifiers(MAX_NOTIFIERS)
             .max_listeners(MAX_LISTENERS)
@@ -79,39 +84,82 @@ impl Bus {
             .create()
             .map_err(LockstepError::ipc)?;
         let notifier = if self.wait.needs_events() {
-            Some(self.event(topic)?.notifier_builder().create().map_err(LockstepError::ipc)?)
+            Some(
+                self.event(topic)?
+                    .notifier_builder()
+                    .create()
+                    .map_err(LockstepError::ipc)?,
+            )
         } else {
             None
         };
-        Ok(Outlet { publisher, notifier, len })
+        Ok(Outlet {
+            publisher,
+            notifier,
+            len,
+        })
     }
 
     /// A lockstep reading end of `topic`.
     pub fn inlet(&self, topic: &str) -> Result<Inlet, LockstepError> {
-        let subscriber = self.service(topic)?.subscriber_builder().buffer_size(LOCKSTEP_BUFFER).create().map_err(LockstepError::ipc)?;
+        let subscriber = self
+            .service(topic)?
+            .subscriber_builder()
+            .buffer_size(LOCKSTEP_BUFFER)
+            .create()
+            .map_err(LockstepError::ipc)?;
         let mut listener = if self.wait.needs_events() {
-            Some(self.event(topic)?.listener_builder().create().map_err(LockstepError::ipc)?)
+            Some(
+                self.event(topic)?
+                    .listener_builder()
+                    .create()
+                    .map_err(LockstepError::ipc)?,
+            )
         } else {
             None
         };
         let waitset = if self.wait == Wait::WaitSet {
             // The WaitSet borrows the listener it watches; both live as long as the process (an
             // inlet is made once per component), so they are leaked to 'static.
-            let listener: &'static Listener<Ipc> = Box::leak(Box::new(listener.take().expect("waitset waits have a listener")));
-            let ws: &'static WaitSet<Ipc> = Box::leak(Box::new(
-                WaitSetBuilder::new().signal_handling_mode(SignalHandlingMode::Disabled).create::<Ipc>().map_err(LockstepError::ipc)?,
+            let listener: &'static Listener<Ipc> = Box::leak(Box::new(
+                listener.take().expect("waitset waits have a listener"),
             ));
-            let guard = ws.attach_notification(listener).map_err(LockstepError::ipc)?;
-            Some(WaitSetWait { ws, listener, _guard: guard })
+            let ws: &'static WaitSet<Ipc> = Box::leak(Box::new(
+                WaitSetBuilder::new()
+                    .signal_handling_mode(SignalHandlingMode::Disabled)
+                    .create::<Ipc>()
+                    .map_err(LockstepError::ipc)?,
+            ));
+            let guard = ws
+                .attach_notification(listener)
+                .map_err(LockstepError::ipc)?;
+            Some(WaitSetWait {
+                ws,
+                listener,
+                _guard: guard,
+            })
         } else {
             None
         };
-        Ok(Inlet { subscriber, listener, waitset, topic: topic.to_string(), wait: self.wait, timeout: Duration::from_secs(10), streak: std::cell::Cell::new(0) })
+        Ok(Inlet {
+            subscriber,
+            listener,
+            waitset,
+            topic: topic.to_string(),
+            wait: self.wait,
+            timeout: Duration::from_secs(10),
+            streak: std::cell::Cell::new(0),
+        })
     }
 
     /// A recording end of `topic` that never makes the publisher drop a sample.
     pub fn reader(&self, topic: &str) -> Result<Reader, LockstepError> {
-        let subscriber = self.service(topic)?.subscriber_builder().buffer_size(RECORDER_BUFFER).create().map_err(LockstepError::ipc)?;
+        let subscriber = self
+            .service(topic)?
+            .subscriber_builder()
+            .buffer_size(RECORDER_BUFFER)
+            .create()
+            .map_err(LockstepError::ipc)?;
         Ok(Reader { subscriber })
     }
 }
@@ -135,11 +183,31 @@ impl Outlet {
     }
 
     /// Loans a sample, writes header and values in place, sends it; returns the send time.
-    pub fn send(&self, step: u64, sim_time: f64, taken_ns: u64, values: &[f64]) -> Result<u64, LockstepError> {
+    pub fn send(
+        &self,
+        step: u64,
+        sim_time: f64,
+        taken_ns: u64,
+        values: &[f64],
+    ) -> Result<u64, LockstepError> {
         if values.len() != self.len {
-            return Err(LockstepError::Length { topic: "own output".into(), expected: self.len, got: values.len() });
+            return Err(LockstepError::Length {
+                topic: "own output".into(),
+                expected: self.len,
+                got: values.len(),
+            });
         }
-        self.send_header(WireHeader { step, sim_time, sent_ns: 0, taken_ns, protocol: PROTOCOL_VERSION, reserved: 0 }, values)
+        self.send_header(
+            WireHeader {
+                step,
+                sim_time,
+                sent_ns: 0,
+                taken_ns,
+                protocol: PROTOCOL_VERSION,
+                reserved: 0,
+            },
+            values,
+        )
     }
 
     /// Sends a sample another host published, header and all (its `sent_ns` kept: the bridge
@@ -152,7 +220,11 @@ impl Outlet {
     /// Sends `values` behind `header` as given (its `sent_ns` set to now), without checking
     /// either against the protocol: for a component that fills its headers itself — or a test
     /// that breaks the protocol on purpose. Returns the send time.
-    pub fn send_header(&self, mut header: WireHeader, values: &[f64]) -> Result<u64, LockstepError> {
+    pub fn send_header(
+        &self,
+        mut header: WireHeader,
+        values: &[f64],
+    ) -> Result<u64, LockstepError> {
         let mut sent_ns = 0;
         self.publish(values, || {
             sent_ns = now_ns();
@@ -164,8 +236,15 @@ impl Outlet {
 
     /// Loans a sample, writes the header `header()` gives once the loan is had (a send time is
     /// taken as late as it can be) and the values, sends it, and notifies when the wait needs it.
-    fn publish(&self, values: &[f64], header: impl FnOnce() -> WireHeader) -> Result<(), LockstepError> {
-        let mut sample = self.publisher.loan_slice_uninit(values.len()).map_err(LockstepError::ipc)?;
+    fn publish(
+        &self,
+        values: &[f64],
+        header: impl FnOnce() -> WireHeader,
+    ) -> Result<(), LockstepError> {
+        let mut sample = self
+            .publisher
+            .loan_slice_uninit(values.len())
+            .map_err(LockstepError::ipc)?;
         *sample.user_header_mut() = header();
         let sample = sample.write_from_slice(values);
         sample.send().map_err(LockstepError::ipc)?;
@@ -214,18 +293,31 @@ impl Inlet {
 
     /// Takes a pending sample, if any, checking its step and copying its values into `out`.
     pub fn try_step(&self, step: u64, out: &mut [f64]) -> Result<Option<Header>, LockstepError> {
-        let Some(sample) = self.subscriber.receive().map_err(LockstepError::ipc)? else { return Ok(None) };
+        let Some(sample) = self.subscriber.receive().map_err(LockstepError::ipc)? else {
+            return Ok(None);
+        };
         let received_ns = now_ns();
         let h = sample.user_header();
         let values = sample.payload();
         if h.protocol != PROTOCOL_VERSION {
-            return Err(LockstepError::Protocol { topic: self.topic.clone(), got: h.protocol });
+            return Err(LockstepError::Protocol {
+                topic: self.topic.clone(),
+                got: h.protocol,
+            });
         }
         if h.step != step {
-            return Err(LockstepError::Step { topic: self.topic.clone(), expected: step, got: h.step });
+            return Err(LockstepError::Step {
+                topic: self.topic.clone(),
+                expected: step,
+                got: h.step,
+            });
         }
         if values.len() != out.len() {
-            return Err(LockstepError::Length { topic: self.topic.clone(), expected: out.len(), got: values.len() });
+            return Err(LockstepError::Length {
+                topic: self.topic.clone(),
+                expected: out.len(),
+                got: values.len(),
+            });
         }
         out.copy_from_slice(values);
         Ok(Some(Header::of(h, received_ns)))
@@ -263,15 +355,14 @@ impl Inlet {
                     }
                     let w = self.waitset.as_ref().expect("waitset waits have a waitset");
                     let slice = Duration::from_nanos((limit - elapsed).min(100_000_000));
-                    w.ws
-                        .wait_and_process_once_with_timeout(
-                            |_| {
-                                let _ = w.listener.try_wait(|_| {});
-                                CallbackProgression::Continue
-                            },
-                            slice,
-                        )
-                        .map_err(LockstepError::ipc)?;
+                    w.ws.wait_and_process_once_with_timeout(
+                        |_| {
+                            let _ = w.listener.try_wait(|_| {});
+                            CallbackProgression::Continue
+                        },
+                        slice,
+                    )
+                    .map_err(LockstepError::ipc)?;
                 }
                 Wait::SpinThenYield(ns) => {
                     if now_ns() - start < ns as u64 {
@@ -308,14 +399,23 @@ impl Inlet {
         if elapsed > limit {
             return Err(self.timed_out(step));
         }
-        let listener = self.listener.as_ref().expect("blocking waits have a listener");
+        let listener = self
+            .listener
+            .as_ref()
+            .expect("blocking waits have a listener");
         let slice = Duration::from_nanos((limit - elapsed).min(100_000_000));
-        listener.timed_wait(|_| {}, slice).map_err(LockstepError::ipc)?;
+        listener
+            .timed_wait(|_| {}, slice)
+            .map_err(LockstepError::ipc)?;
         Ok(())
     }
 
     fn timed_out(&self, step: u64) -> LockstepError {
-        LockstepError::Timeout { topic: self.topic.clone(), step, secs: self.timeout.as_secs() }
+        LockstepError::Timeout {
+            topic: self.topic.clone(),
+            step,
+            secs: self.timeout.as_secs(),
+        }
     }
 }
 
@@ -333,7 +433,11 @@ impl Reader {
     }
 
     /// As [`Reader::drain`], but at most `max` samples.
-    pub fn drain_up_to(&self, max: usize, mut f: impl FnMut(&WireHeader, &[f64])) -> Result<usize, LockstepError> {
+    pub fn drain_up_to(
+        &self,
+        max: usize,
+        mut f: impl FnMut(&WireHeader, &[f64]),
+    ) -> Result<usize, LockstepError> {
         let mut count = 0;
         while count < max
             && let Some(sample) = self.subscriber.receive().map_err(LockstepError::ipc)?

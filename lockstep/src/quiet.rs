@@ -6,7 +6,7 @@
 
 use std::sync::Once;
 
-use iceoryx2::prelude::{set_log_level_from_env_or, LogLevel};
+use iceoryx2::prelude::{LogLevel, set_log_level_from_env_or};
 
 /// Shows only iceoryx2's errors (or the level `IOX2_LOG_LEVEL` names); idempotent.
 pub fn quiet_iceoryx2() {

@@ -18,7 +18,7 @@ use iceoryx2::prelude::*;
 use iceoryx2_bb_system_types::path::Path as IoxPath;
 
 use crate::error::LockstepError;
-use crate::run_dir::{default_runs_dir, ensure_private, id_pid, open_private, Dir};
+use crate::run_dir::{Dir, default_runs_dir, ensure_private, id_pid, open_private};
 
 /// Environment variable naming the directory that holds run directories.
 pub const RUNS_DIR_ENV: &str = "UIO_RUNS_DIR";
@@ -42,7 +42,11 @@ const MAX_ROOT: usize = 56;
 /// too long (a deep `UIO_RUNS_DIR`). A function of the two, so every process finds the same.
 pub fn iox2_root(dir: &Path, id: &str) -> PathBuf {
     let inside = dir.join("iox2");
-    if inside.as_os_str().len() < MAX_ROOT { inside } else { short_roots().join(id) }
+    if inside.as_os_str().len() < MAX_ROOT {
+        inside
+    } else {
+        short_roots().join(id)
+    }
 }
 
 /// A run's identity and its iceoryx2 configuration.
@@ -58,7 +62,10 @@ pub struct RunSpace {
 fn runs_dir() -> PathBuf {
     let dir = std::env::var_os(RUNS_DIR_ENV)
         .filter(|d| !d.is_empty())
-        .map_or_else(|| default_runs_dir(std::env::var_os("XDG_RUNTIME_DIR").as_deref()), PathBuf::from);
+        .map_or_else(
+            || default_runs_dir(std::env::var_os("XDG_RUNTIME_DIR").as_deref()),
+            PathBuf::from,
+        );
     std::path::absolute(&dir).unwrap_or(dir)
 }
 
@@ -89,7 +96,10 @@ fn read_pid(dir: &Dir, name: &str) -> Result<Option<i32>, std::io::Error> {
         Err(e) => return Err(e),
     };
     let mut text = String::new();
-    Ok(f.take(32).read_to_string(&mut text).ok().and_then(|_| text.trim().parse().ok()))
+    Ok(f.take(32)
+        .read_to_string(&mut text)
+        .ok()
+        .and_then(|_| text.trim().parse().ok()))
 }
 
 fn io(what: &str, path: &Path, e: std::io::Error) -> LockstepError {
@@ -111,15 +121,28 @@ impl RunSpace {
         // Built under a hidden name and renamed into place, so a concurrent launcher cleaning
         // up dead runs never sees a run directory without its owner.
         let tmp = base.join(format!(".new-{id}"));
-        fs::DirBuilder::new().mode(0o700).create(&tmp).map_err(|e| io("cannot create", &tmp, e))?;
-        fs::DirBuilder::new().mode(0o700).create(tmp.join("iox2")).map_err(|e| io("cannot create", &tmp, e))?;
-        let mut f = fs::OpenOptions::new().write(true).create_new(true).mode(0o600).open(tmp.join("owner.pid")).map_err(|e| io("cannot write", &tmp, e))?;
+        fs::DirBuilder::new()
+            .mode(0o700)
+            .create(&tmp)
+            .map_err(|e| io("cannot create", &tmp, e))?;
+        fs::DirBuilder::new()
+            .mode(0o700)
+            .create(tmp.join("iox2"))
+            .map_err(|e| io("cannot create", &tmp, e))?;
+        let mut f = fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .mode(0o600)
+            .open(tmp.join("owner.pid"))
+            .map_err(|e| io("cannot write", &tmp, e))?;
         writeln!(f, "{}", std::process::id()).map_err(|e| io("cannot write", &tmp, e))?;
         let dir = base.join(&id);
         let root = iox2_root(&dir, &id);
         if !root.starts_with(&dir) {
             let roots = ensure_private(ROOTS, &short_roots())?;
-            roots.mkdir(OsStr::new(&id)).map_err(|e| io("cannot create", &root, e))?;
+            roots
+                .mkdir(OsStr::new(&id))
+                .map_err(|e| io("cannot create", &root, e))?;
         }
         fs::rename(&tmp, &dir).map_err(|e| io("cannot create", &dir, e))?;
         Self::at(id, dir)
@@ -135,37 +158,54 @@ impl RunSpace {
         let dir = base.join(id);
         let missing = || LockstepError::Io(format!("no run '{id}' in {}", base.display()));
         // No runs directory yet (no launcher has run on this machine): no run either.
-        if std::fs::symlink_metadata(&base).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound) {
+        if std::fs::symlink_metadata(&base).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound)
+        {
             return Err(missing());
         }
         let runs = open_private(RUNS, &base)?;
         let run = match runs.at(OsStr::new(id)) {
             Ok(run) => run,
             Err(e) if e.raw_os_error() == Some(libc::ENOENT) => return Err(missing()),
-            Err(e) => return Err(LockstepError::Io(format!("run directory {}: {e} (a symbolic link or not a directory?); refusing to use it", dir.display()))),
+            Err(e) => {
+                return Err(LockstepError::Io(format!(
+                    "run directory {}: {e} (a symbolic link or not a directory?); refusing to use it",
+                    dir.display()
+                )));
+            }
         };
         if !run.stat().is_ok_and(|s| s.is_ours()) {
-            return Err(LockstepError::Io(format!("run directory {}: not ours; refusing to use it", dir.display())));
+            return Err(LockstepError::Io(format!(
+                "run directory {}: not ours; refusing to use it",
+                dir.display()
+            )));
         }
         match read_pid(&run, "owner.pid") {
             Ok(Some(_)) => Self::at(id.to_string(), dir),
             Ok(None) => Err(missing()),
-            Err(e) => Err(LockstepError::Io(format!("{}: {e}; refusing to use it", dir.join("owner.pid").display()))),
+            Err(e) => Err(LockstepError::Io(format!(
+                "{}: {e}; refusing to use it",
+                dir.join("owner.pid").display()
+            ))),
         }
     }
 
     fn at(id: String, dir: PathBuf) -> Result<Self, LockstepError> {
         // The built-in defaults, not a config file: runs must not depend on what /etc holds.
         let mut config = Config::default();
-        config.global.prefix = FileName::new(format!("uio{id}_").as_bytes()).map_err(LockstepError::ipc)?;
+        config.global.prefix =
+            FileName::new(format!("uio{id}_").as_bytes()).map_err(LockstepError::ipc)?;
         let root = format!("{}/", iox2_root(&dir, &id).display());
-        config.global.set_root_path(&IoxPath::new(root.as_bytes()).map_err(LockstepError::ipc)?);
+        config
+            .global
+            .set_root_path(&IoxPath::new(root.as_bytes()).map_err(LockstepError::ipc)?);
         Ok(Self { id, dir, config })
     }
 
     /// The pid of the launcher that owns the run.
     pub fn owner(&self) -> Option<i32> {
-        read_pid(&Dir::open(&self.dir).ok()?, "owner.pid").ok().flatten()
+        read_pid(&Dir::open(&self.dir).ok()?, "owner.pid")
+            .ok()
+            .flatten()
     }
 
     /// The run id (alphanumeric).
@@ -197,7 +237,8 @@ impl RunSpace {
     pub fn write_config(&self, component: &str, json: &str) -> Result<(), LockstepError> {
         let path = self.config_path(component);
         fs::write(&path, json).map_err(|e| io("cannot write", &path, e))?;
-        fs::set_permissions(&path, fs::Permissions::from_mode(0o600)).map_err(|e| io("cannot chmod", &path, e))
+        fs::set_permissions(&path, fs::Permissions::from_mode(0o600))
+            .map_err(|e| io("cannot chmod", &path, e))
     }
 
     /// Reads a component configuration.
@@ -217,13 +258,18 @@ impl RunSpace {
     /// counter (`…node.<version>.global_mgmt`) with global access (0666). The launcher creates
     /// that segment when it joins the bus, before any component starts, and calls this at once.
     pub fn restrict_shm(&self) -> Result<(), LockstepError> {
-        let Ok(shm) = Dir::open(Path::new(SHM_DIR)) else { return Ok(()) };
+        let Ok(shm) = Dir::open(Path::new(SHM_DIR)) else {
+            return Ok(());
+        };
         for f in self.shm_files() {
             // Through an O_NOFOLLOW descriptor of a regular file of ours: a name planted in
             // /dev/shm cannot make this chmod anything else.
             let name = f.file_name().unwrap_or_default();
-            let file = shm.open_own_file(name).map_err(|e| io("cannot chmod", &f, e))?;
-            file.set_permissions(fs::Permissions::from_mode(0o600)).map_err(|e| io("cannot chmod", &f, e))?;
+            let file = shm
+                .open_own_file(name)
+                .map_err(|e| io("cannot chmod", &f, e))?;
+            file.set_permissions(fs::Permissions::from_mode(0o600))
+                .map_err(|e| io("cannot chmod", &f, e))?;
         }
         Ok(())
     }
@@ -245,7 +291,9 @@ impl RunSpace {
 /// `/dev/shm` files whose name starts with `prefix` and that are regular files of ours: what
 /// another user put there under our name is not ours to chmod or remove.
 fn shm_files_with_prefix(prefix: &str) -> Vec<PathBuf> {
-    let Ok(shm) = Dir::open(Path::new(SHM_DIR)) else { return Vec::new() };
+    let Ok(shm) = Dir::open(Path::new(SHM_DIR)) else {
+        return Vec::new();
+    };
     let names = shm.names().unwrap_or_default();
     names
         .into_iter()
@@ -256,7 +304,9 @@ fn shm_files_with_prefix(prefix: &str) -> Vec<PathBuf> {
 }
 
 fn remove_shm_with_prefix(prefix: &str) {
-    let Ok(shm) = Dir::open(Path::new(SHM_DIR)) else { return };
+    let Ok(shm) = Dir::open(Path::new(SHM_DIR)) else {
+        return;
+    };
     for f in shm_files_with_prefix(prefix) {
         let _ = shm.remove_own_file(f.file_name().unwrap_or_default());
     }
@@ -284,7 +334,9 @@ pub fn cleanup_dead_runs() -> usize {
                 Some(rest) => (rest.to_string(), true),
                 None => (name_str.clone(), false),
             };
-            let Some(id_owner) = id_pid(&id) else { continue };
+            let Some(id_owner) = id_pid(&id) else {
+                continue;
+            };
             let Ok(run) = runs.at(&name) else { continue };
             if !run.stat().is_ok_and(|s| s.is_dir() && s.is_ours()) {
                 continue;
@@ -316,8 +368,12 @@ pub fn cleanup_dead_runs() -> usize {
     // Short iceoryx2 roots are named after their run id, <launcher pid>x…: the owner is in the name.
     if let Ok(roots) = open_private(ROOTS, &short_roots()) {
         for name in roots.names().unwrap_or_default() {
-            let Some(pid) = name.to_str().and_then(id_pid) else { continue };
-            let ours = roots.stat_at(&name).is_ok_and(|s| s.is_dir() && s.is_ours());
+            let Some(pid) = name.to_str().and_then(id_pid) else {
+                continue;
+            };
+            let ours = roots
+                .stat_at(&name)
+                .is_ok_and(|s| s.is_dir() && s.is_ours());
             if ours && !alive(pid) {
                 let _ = roots.remove_tree(&name);
             }
@@ -327,7 +383,11 @@ pub fn cleanup_dead_runs() -> usize {
     if let Ok(shm) = Dir::open(Path::new(SHM_DIR)) {
         for f in shm_files_with_prefix("uio") {
             let name = f.file_name().unwrap_or_default();
-            let id = name.to_str().and_then(|n| n.strip_prefix("uio")).and_then(|r| r.split('_').next()).unwrap_or_default();
+            let id = name
+                .to_str()
+                .and_then(|n| n.strip_prefix("uio"))
+                .and_then(|r| r.split('_').next())
+                .unwrap_or_default();
             if id_pid(id).is_some_and(|p| !alive(p)) {
                 let _ = shm.remove_own_file(name);
             }
@@ -346,7 +406,10 @@ mod tests {
         // A short root's name must be a run id, or cleanup would never recognise it.
         let id = format!("{}x0x123456", std::process::id());
         assert!(is_run_id(&id));
-        let root = iox2_root(&Path::new("/a/very/long/runs/directory/that/is/far/too/long/for").join(&id), &id);
+        let root = iox2_root(
+            &Path::new("/a/very/long/runs/directory/that/is/far/too/long/for").join(&id),
+            &id,
+        );
         assert_eq!(root, short_roots().join(&id));
     }
 }

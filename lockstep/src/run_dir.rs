@@ -28,7 +28,11 @@ fn cstr(name: &OsStr) -> io::Result<CString> {
 }
 
 fn check(ret: libc::c_int) -> io::Result<libc::c_int> {
-    if ret < 0 { Err(io::Error::last_os_error()) } else { Ok(ret) }
+    if ret < 0 {
+        Err(io::Error::last_os_error())
+    } else {
+        Ok(ret)
+    }
 }
 
 /// What `fstat`/`fstatat` say about one file.
@@ -40,7 +44,10 @@ pub(crate) struct Stat {
 
 impl Stat {
     fn of(st: &libc::stat) -> Self {
-        Stat { mode: st.st_mode, uid: st.st_uid }
+        Stat {
+            mode: st.st_mode,
+            uid: st.st_uid,
+        }
     }
 
     fn kind(self) -> u32 {
@@ -69,7 +76,8 @@ pub(crate) struct Dir {
     fd: OwnedFd,
 }
 
-const DIR_FLAGS: libc::c_int = libc::O_RDONLY | libc::O_DIRECTORY | libc::O_NOFOLLOW | libc::O_CLOEXEC;
+const DIR_FLAGS: libc::c_int =
+    libc::O_RDONLY | libc::O_DIRECTORY | libc::O_NOFOLLOW | libc::O_CLOEXEC;
 
 impl Dir {
     /// Opens `path`; a symlink as its last component fails (`ELOOP`), a non-directory too.
@@ -78,7 +86,9 @@ impl Dir {
         // SAFETY: a valid NUL-terminated path; the returned fd is owned below.
         let fd = check(unsafe { libc::open(c.as_ptr(), DIR_FLAGS) })?;
         // SAFETY: fd was just opened and is owned by nobody else.
-        Ok(Dir { fd: unsafe { OwnedFd::from_raw_fd(fd) } })
+        Ok(Dir {
+            fd: unsafe { OwnedFd::from_raw_fd(fd) },
+        })
     }
 
     /// Opens the directory `name` inside this one, never following a symlink.
@@ -87,7 +97,9 @@ impl Dir {
         // SAFETY: valid directory fd and NUL-terminated name.
         let fd = check(unsafe { libc::openat(self.fd.as_raw_fd(), c.as_ptr(), DIR_FLAGS) })?;
         // SAFETY: as in `open`.
-        Ok(Dir { fd: unsafe { OwnedFd::from_raw_fd(fd) } })
+        Ok(Dir {
+            fd: unsafe { OwnedFd::from_raw_fd(fd) },
+        })
     }
 
     /// The directory itself.
@@ -105,7 +117,14 @@ impl Dir {
         // SAFETY: as in `stat`.
         let mut st: libc::stat = unsafe { std::mem::zeroed() };
         // SAFETY: valid fd, name and a writable stat.
-        check(unsafe { libc::fstatat(self.fd.as_raw_fd(), c.as_ptr(), &mut st, libc::AT_SYMLINK_NOFOLLOW) })?;
+        check(unsafe {
+            libc::fstatat(
+                self.fd.as_raw_fd(),
+                c.as_ptr(),
+                &mut st,
+                libc::AT_SYMLINK_NOFOLLOW,
+            )
+        })?;
         Ok(Stat::of(&st))
     }
 
@@ -159,14 +178,18 @@ impl Dir {
     /// on a FIFO or a device (which are refused, as are files of other users).
     pub(crate) fn open_own_file(&self, name: &OsStr) -> io::Result<std::fs::File> {
         let c = cstr(name)?;
-        let flags = libc::O_RDONLY | libc::O_NOFOLLOW | libc::O_NONBLOCK | libc::O_NOCTTY | libc::O_CLOEXEC;
+        let flags =
+            libc::O_RDONLY | libc::O_NOFOLLOW | libc::O_NONBLOCK | libc::O_NOCTTY | libc::O_CLOEXEC;
         // SAFETY: valid fd and name; the returned fd is owned by the File below.
         let fd = check(unsafe { libc::openat(self.fd.as_raw_fd(), c.as_ptr(), flags) })?;
         // SAFETY: fd was just opened and is owned by nobody else.
         let file = unsafe { std::fs::File::from_raw_fd(fd) };
         let meta = file.metadata()?;
         if !meta.file_type().is_file() || meta.uid() != euid() {
-            return Err(io::Error::new(io::ErrorKind::PermissionDenied, "not a regular file of ours"));
+            return Err(io::Error::new(
+                io::ErrorKind::PermissionDenied,
+                "not a regular file of ours",
+            ));
         }
         Ok(file)
     }
@@ -190,7 +213,8 @@ impl Dir {
         }
         drop(sub);
         // SAFETY: valid fd and name.
-        let gone = check(unsafe { libc::unlinkat(self.fd.as_raw_fd(), c.as_ptr(), libc::AT_REMOVEDIR) });
+        let gone =
+            check(unsafe { libc::unlinkat(self.fd.as_raw_fd(), c.as_ptr(), libc::AT_REMOVEDIR) });
         match first {
             Some(e) => Err(e),
             None => gone.map(drop),
@@ -201,7 +225,10 @@ impl Dir {
     pub(crate) fn remove_own_file(&self, name: &OsStr) -> io::Result<()> {
         let st = self.stat_at(name)?;
         if !st.is_file() || !st.is_ours() {
-            return Err(io::Error::new(io::ErrorKind::PermissionDenied, "not a regular file of ours"));
+            return Err(io::Error::new(
+                io::ErrorKind::PermissionDenied,
+                "not a regular file of ours",
+            ));
         }
         let c = cstr(name)?;
         // SAFETY: valid fd and name.
@@ -214,9 +241,16 @@ fn not_private(st: Stat) -> Option<String> {
     if !st.is_dir() {
         Some("is not a directory".into())
     } else if !st.is_ours() {
-        Some(format!("is owned by uid {}, not by us (uid {})", st.uid, euid()))
+        Some(format!(
+            "is owned by uid {}, not by us (uid {})",
+            st.uid,
+            euid()
+        ))
     } else if st.mode & 0o077 != 0 {
-        Some(format!("is accessible to group or others (mode {:04o}, needs 0700)", st.mode & 0o7777))
+        Some(format!(
+            "is accessible to group or others (mode {:04o}, needs 0700)",
+            st.mode & 0o7777
+        ))
     } else {
         None
     }
@@ -228,17 +262,32 @@ fn not_private(st: Stat) -> Option<String> {
 fn unsafe_parent(parent: &Path) -> Option<String> {
     let meta = std::fs::metadata(parent).ok()?;
     if meta.uid() != 0 && meta.uid() != euid() {
-        Some(format!("its parent {} is owned by uid {}, neither root nor us", parent.display(), meta.uid()))
+        Some(format!(
+            "its parent {} is owned by uid {}, neither root nor us",
+            parent.display(),
+            meta.uid()
+        ))
     } else if meta.mode() & 0o022 != 0 && meta.mode() & libc::S_ISVTX == 0 {
-        Some(format!("its parent {} is writable by others and not sticky (mode {:04o})", parent.display(), meta.mode() & 0o7777))
+        Some(format!(
+            "its parent {} is writable by others and not sticky (mode {:04o})",
+            parent.display(),
+            meta.mode() & 0o7777
+        ))
     } else {
         None
     }
 }
 
 fn refuse(what: &str, path: &Path, why: &str) -> LockstepError {
-    let hint = if what == "runs directory" { " (UIO_RUNS_DIR may name another, of yours, mode 0700)" } else { "" };
-    LockstepError::Io(format!("{what} {}: {why}; refusing to use it{hint}", path.display()))
+    let hint = if what == "runs directory" {
+        " (UIO_RUNS_DIR may name another, of yours, mode 0700)"
+    } else {
+        ""
+    };
+    LockstepError::Io(format!(
+        "{what} {}: {why}; refusing to use it{hint}",
+        path.display()
+    ))
 }
 
 /// Opens the existing private directory `path` (a real directory, ours, mode 0700, in a parent
@@ -249,13 +298,17 @@ pub(crate) fn open_private(what: &str, path: &Path) -> Result<Dir, LockstepError
     }
     let dir = Dir::open(path).map_err(|e| match e.raw_os_error() {
         // Linux says ENOTDIR or ELOOP for a symlink opened O_DIRECTORY | O_NOFOLLOW: ask lstat.
-        Some(libc::ELOOP | libc::ENOTDIR) if std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink()) => {
+        Some(libc::ELOOP | libc::ENOTDIR)
+            if std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink()) =>
+        {
             refuse(what, path, "is a symbolic link")
         }
         Some(libc::ELOOP | libc::ENOTDIR) => refuse(what, path, "is not a directory"),
         _ => LockstepError::Io(format!("cannot open {what} {}: {e}", path.display())),
     })?;
-    let st = dir.stat().map_err(|e| LockstepError::Io(format!("cannot stat {what} {}: {e}", path.display())))?;
+    let st = dir
+        .stat()
+        .map_err(|e| LockstepError::Io(format!("cannot stat {what} {}: {e}", path.display())))?;
     match not_private(st) {
         Some(why) => Err(refuse(what, path, &why)),
         None => Ok(dir),
@@ -265,12 +318,18 @@ pub(crate) fn open_private(what: &str, path: &Path) -> Result<Dir, LockstepError
 /// [`open_private`], making the directory (mode 0700, its parents as needed) when it is absent.
 pub(crate) fn ensure_private(what: &str, path: &Path) -> Result<Dir, LockstepError> {
     if let Some(parent) = path.parent() {
-        std::fs::create_dir_all(parent).map_err(|e| LockstepError::Io(format!("cannot create {}: {e}", parent.display())))?;
+        std::fs::create_dir_all(parent)
+            .map_err(|e| LockstepError::Io(format!("cannot create {}: {e}", parent.display())))?;
     }
     let made = match std::fs::DirBuilder::new().mode(0o700).create(path) {
         Ok(()) => true,
         Err(e) if e.kind() == io::ErrorKind::AlreadyExists => false,
-        Err(e) => return Err(LockstepError::Io(format!("cannot create {what} {}: {e}", path.display()))),
+        Err(e) => {
+            return Err(LockstepError::Io(format!(
+                "cannot create {what} {}: {e}",
+                path.display()
+            )));
+        }
     };
     if made {
         // A umask may have taken bits from 0700; what we just made is ours to set right.
@@ -288,9 +347,12 @@ pub(crate) fn ensure_private(what: &str, path: &Path) -> Result<Dir, LockstepErr
 /// `/tmp/uio-observers-<uid>`, one per user (a shared name belongs to whoever makes it first and
 /// would lock every other user out).
 pub(crate) fn default_runs_dir(xdg: Option<&OsStr>) -> PathBuf {
-    let usable = xdg.map(Path::new).filter(|p| p.is_absolute()).is_some_and(|p| {
-        std::fs::symlink_metadata(p).is_ok_and(|m| m.file_type().is_dir() && m.uid() == euid())
-    });
+    let usable = xdg
+        .map(Path::new)
+        .filter(|p| p.is_absolute())
+        .is_some_and(|p| {
+            std::fs::symlink_metadata(p).is_ok_and(|m| m.file_type().is_dir() && m.uid() == euid())
+        });
     match xdg {
         Some(x) if usable => Path::new(x).join("uio-observers"),
         _ => PathBuf::from(format!("/tmp/uio-observers-{}", euid())),
@@ -300,12 +362,19 @@ pub(crate) fn default_runs_dir(xdg: Option<&OsStr>) -> PathBuf {
 /// A run id as [`crate::RunSpace::create`] makes them: `<pid>x<n>x<nonce>`, all decimal.
 pub fn is_run_id(name: &str) -> bool {
     let parts: Vec<&str> = name.split('x').collect();
-    parts.len() == 3 && parts.iter().all(|p| !p.is_empty() && p.len() <= 20 && p.bytes().all(|b| b.is_ascii_digit()))
+    parts.len() == 3
+        && parts
+            .iter()
+            .all(|p| !p.is_empty() && p.len() <= 20 && p.bytes().all(|b| b.is_ascii_digit()))
 }
 
 /// The launcher pid a run id starts with.
 pub(crate) fn id_pid(id: &str) -> Option<i32> {
-    if is_run_id(id) { id.split('x').next()?.parse().ok() } else { None }
+    if is_run_id(id) {
+        id.split('x').next()?.parse().ok()
+    } else {
+        None
+    }
 }
 
 #[cfg(test)]
@@ -328,13 +397,31 @@ mod tests {
         std::fs::write(s.join("file"), "x").unwrap();
         std::fs::create_dir(s.join("open")).unwrap();
         std::fs::set_permissions(s.join("open"), std::fs::Permissions::from_mode(0o755)).unwrap();
-        for (name, why) in [("link", "is a symbolic link"), ("file", "is not a directory"), ("open", "accessible to group or others")] {
-            let e = ensure_private("runs directory", &s.join(name)).unwrap_err().to_string();
-            assert!(e.contains(why) && e.contains(&s.join(name).display().to_string()) && !e.contains('\n'), "{name}: {e}");
+        for (name, why) in [
+            ("link", "is a symbolic link"),
+            ("file", "is not a directory"),
+            ("open", "accessible to group or others"),
+        ] {
+            let e = ensure_private("runs directory", &s.join(name))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains(why)
+                    && e.contains(&s.join(name).display().to_string())
+                    && !e.contains('\n'),
+                "{name}: {e}"
+            );
         }
         // Nothing was changed: the link's target is still there and still 0755-or-whatever.
         assert!(s.join("target").is_dir());
-        assert_eq!(std::fs::metadata(s.join("open")).unwrap().permissions().mode() & 0o777, 0o755);
+        assert_eq!(
+            std::fs::metadata(s.join("open"))
+                .unwrap()
+                .permissions()
+                .mode()
+                & 0o777,
+            0o755
+        );
         std::fs::remove_dir_all(&s).unwrap();
     }
 
@@ -344,7 +431,11 @@ mod tests {
         let d = s.join("a/b/runs");
         ensure_private("runs directory", &d).unwrap();
         let m = std::fs::symlink_metadata(&d).unwrap();
-        assert!(m.is_dir() && m.uid() == euid() && m.mode() & 0o777 == 0o700, "{:o}", m.mode());
+        assert!(
+            m.is_dir() && m.uid() == euid() && m.mode() & 0o777 == 0o700,
+            "{:o}",
+            m.mode()
+        );
         std::fs::remove_dir_all(&s).unwrap();
     }
 
@@ -352,7 +443,9 @@ mod tests {
     fn a_parent_writable_by_others_without_the_sticky_bit_is_refused() {
         let s = scratch("parent");
         std::fs::set_permissions(&s, std::fs::Permissions::from_mode(0o777)).unwrap();
-        let e = ensure_private("runs directory", &s.join("runs")).unwrap_err().to_string();
+        let e = ensure_private("runs directory", &s.join("runs"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("not sticky"), "{e}");
         std::fs::set_permissions(&s, std::fs::Permissions::from_mode(0o1777)).unwrap();
         ensure_private("runs directory", &s.join("runs")).unwrap();
@@ -392,11 +485,22 @@ mod tests {
     fn the_default_is_the_runtime_directory_only_when_it_is_a_real_one_of_ours() {
         let s = scratch("xdg");
         std::os::unix::fs::symlink(&s, s.join("link")).unwrap();
-        assert_eq!(default_runs_dir(Some(s.as_os_str())), s.join("uio-observers"));
+        assert_eq!(
+            default_runs_dir(Some(s.as_os_str())),
+            s.join("uio-observers")
+        );
         for bad in [s.join("link"), s.join("missing"), PathBuf::from("relative")] {
-            assert_eq!(default_runs_dir(Some(bad.as_os_str())), Path::new(&format!("/tmp/uio-observers-{}", euid())), "{}", bad.display());
+            assert_eq!(
+                default_runs_dir(Some(bad.as_os_str())),
+                Path::new(&format!("/tmp/uio-observers-{}", euid())),
+                "{}",
+                bad.display()
+            );
         }
-        assert_eq!(default_runs_dir(None), Path::new(&format!("/tmp/uio-observers-{}", euid())));
+        assert_eq!(
+            default_runs_dir(None),
+            Path::new(&format!("/tmp/uio-observers-{}", euid()))
+        );
         std::fs::remove_dir_all(&s).unwrap();
     }
 

@@ -41,7 +41,10 @@ impl WireHeader {
             return Some(format!("its sample's sim_time is {}", self.sim_time));
         }
         if self.taken_ns > self.sent_ns {
-            return Some(format!("its sample says it took its input at {} ns, after it sent the sample at {} ns (CLOCK_MONOTONIC)", self.taken_ns, self.sent_ns));
+            return Some(format!(
+                "its sample says it took its input at {} ns, after it sent the sample at {} ns (CLOCK_MONOTONIC)",
+                self.taken_ns, self.sent_ns
+            ));
         }
         None
     }
@@ -65,7 +68,13 @@ pub struct Header {
 impl Header {
     /// The header of a received sample, taken at `received_ns`.
     pub fn of(w: &WireHeader, received_ns: u64) -> Self {
-        Header { step: w.step, sim_time: w.sim_time, sent_ns: w.sent_ns, taken_ns: w.taken_ns, received_ns }
+        Header {
+            step: w.step,
+            sim_time: w.sim_time,
+            sent_ns: w.sent_ns,
+            taken_ns: w.taken_ns,
+            received_ns,
+        }
     }
 }
 
@@ -75,11 +84,45 @@ mod tests {
 
     #[test]
     fn forged_stamps_are_named() {
-        let ok = WireHeader { step: 3, sim_time: 0.003, sent_ns: 200, taken_ns: 150, protocol: PROTOCOL_VERSION, reserved: 0 };
+        let ok = WireHeader {
+            step: 3,
+            sim_time: 0.003,
+            sent_ns: 200,
+            taken_ns: 150,
+            protocol: PROTOCOL_VERSION,
+            reserved: 0,
+        };
         assert_eq!(ok.stamp_violation(), None);
-        assert_eq!(WireHeader { taken_ns: 0, ..ok }.stamp_violation(), None, "the plant's k = 0");
-        assert!(WireHeader { taken_ns: u64::MAX, ..ok }.stamp_violation().unwrap().contains("after it sent"));
-        assert!(WireHeader { sim_time: f64::NAN, ..ok }.stamp_violation().unwrap().contains("sim_time is NaN"));
-        assert!(WireHeader { sim_time: f64::INFINITY, ..ok }.stamp_violation().is_some());
+        assert_eq!(
+            WireHeader { taken_ns: 0, ..ok }.stamp_violation(),
+            None,
+            "the plant's k = 0"
+        );
+        assert!(
+            WireHeader {
+                taken_ns: u64::MAX,
+                ..ok
+            }
+            .stamp_violation()
+            .unwrap()
+            .contains("after it sent")
+        );
+        assert!(
+            WireHeader {
+                sim_time: f64::NAN,
+                ..ok
+            }
+            .stamp_violation()
+            .unwrap()
+            .contains("sim_time is NaN")
+        );
+        assert!(
+            WireHeader {
+                sim_time: f64::INFINITY,
+                ..ok
+            }
+            .stamp_violation()
+            .is_some()
+        );
     }
 }

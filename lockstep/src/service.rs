@@ -11,7 +11,7 @@ use core::fmt::Debug;
 use core::marker::PhantomData;
 use core::ops::Deref;
 use core::ptr::NonNull;
-use std::alloc::{alloc, dealloc, handle_alloc_error, Layout};
+use std::alloc::{Layout, alloc, dealloc, handle_alloc_error};
 use std::cell::{Cell, RefCell};
 
 use iceoryx2::prelude::ZeroCopySend;
@@ -28,9 +28,11 @@ pub struct Service;
 impl iceoryx2::service::Service for Service {
     type StaticStorage = static_storage::recommended::Ipc;
     type ConfigSerializer = serialize::recommended::Recommended;
-    type PersistentDynamicStorage<T: Debug + Send + Sync + ZeroCopySend + 'static> = dynamic_storage::recommended::PersistentIpc<T>;
+    type PersistentDynamicStorage<T: Debug + Send + Sync + ZeroCopySend + 'static> =
+        dynamic_storage::recommended::PersistentIpc<T>;
     type Bag = bag::recommended::Recommended;
-    type DynamicStorage<T: Debug + Send + Sync + ZeroCopySend + 'static> = dynamic_storage::recommended::Ipc<T>;
+    type DynamicStorage<T: Debug + Send + Sync + ZeroCopySend + 'static> =
+        dynamic_storage::recommended::Ipc<T>;
     type ServiceNameHasher = hash::recommended::Recommended;
     type SharedMemory = shared_memory::recommended::Ipc<PoolAllocator>;
     type ResizableSharedMemory = resizable_shared_memory::recommended::Ipc<PoolAllocator>;
@@ -39,7 +41,8 @@ impl iceoryx2::service::Service for Service {
     type Monitoring = monitoring::recommended::Ipc;
     type Reactor = reactor::recommended::Ipc;
     type ArcThreadSafetyPolicy<T: Send + Debug + Abandonable> = Recycled<T>;
-    type BlackboardMgmt<KeyType: Send + Sync + Debug + ZeroCopySend + 'static> = dynamic_storage::recommended::Ipc<KeyType>;
+    type BlackboardMgmt<KeyType: Send + Sync + Debug + ZeroCopySend + 'static> =
+        dynamic_storage::recommended::Ipc<KeyType>;
     type BlackboardPayload = shared_memory::recommended::Ipc<BumpAllocator>;
     type UniqueId = iceoryx2::unique_id_generator::unique_system_id::UniqueSystemId;
 }
@@ -58,7 +61,12 @@ thread_local! {
 
 fn take(layout: Layout) -> NonNull<u8> {
     let key = (layout.size(), layout.align());
-    let reused = FREE.with(|f| f.borrow_mut().iter_mut().find(|(k, _)| *k == key).and_then(|(_, v)| v.pop()));
+    let reused = FREE.with(|f| {
+        f.borrow_mut()
+            .iter_mut()
+            .find(|(k, _)| *k == key)
+            .and_then(|(_, v)| v.pop())
+    });
     reused.unwrap_or_else(|| {
         // SAFETY: the layout is that of a non-zero-sized `Slot<T>`.
         let p = unsafe { alloc(layout) };
@@ -102,7 +110,9 @@ impl<T: Send + Debug + Abandonable> Recycled<T> {
 
 impl<T: Send + Debug + Abandonable> Debug for Recycled<T> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.debug_struct("Recycled").field("value", &self.slot().value).finish()
+        f.debug_struct("Recycled")
+            .field("value", &self.slot().value)
+            .finish()
     }
 }
 
@@ -110,7 +120,10 @@ impl<T: Send + Debug + Abandonable> Clone for Recycled<T> {
     fn clone(&self) -> Self {
         let refs = &self.slot().refs;
         refs.set(refs.get() + 1);
-        Self { slot: self.slot, _owns: PhantomData }
+        Self {
+            slot: self.slot,
+            _owns: PhantomData,
+        }
     }
 }
 
@@ -187,14 +200,25 @@ impl<T: Send + Debug + Abandonable> ArcSyncPolicy<T> for Recycled<T> {
     fn new(value: T) -> Result<Self, ArcSyncPolicyCreationError> {
         let slot = take(Layout::new::<Slot<T>>()).cast::<Slot<T>>();
         // SAFETY: the block has the layout of Slot<T> and is not in use.
-        unsafe { slot.as_ptr().write(Slot { refs: Cell::new(1), value }) };
-        Ok(Self { slot, _owns: PhantomData })
+        unsafe {
+            slot.as_ptr().write(Slot {
+                refs: Cell::new(1),
+                value,
+            })
+        };
+        Ok(Self {
+            slot,
+            _owns: PhantomData,
+        })
     }
 
     fn lock(&self) -> Guard<'_, T> {
         let refs = &self.slot().refs;
         refs.set(refs.get() + 1);
-        Guard { slot: self.slot, _parent: PhantomData }
+        Guard {
+            slot: self.slot,
+            _parent: PhantomData,
+        }
     }
 }
 

@@ -16,7 +16,11 @@ pub const LOCKSTEP_BUFFER: usize = FOLLOWER_LAG as usize + 2;
 /// Buffer of the recorder's subscribers: how many steps the launcher may lag behind.
 pub const RECORDER_BUFFER: usize = 4096;
 /// The largest subscriber buffer a service allows.
-pub const SUBSCRIBER_MAX_BUFFER: usize = if RECORDER_BUFFER > LOCKSTEP_BUFFER { RECORDER_BUFFER } else { LOCKSTEP_BUFFER };
+pub const SUBSCRIBER_MAX_BUFFER: usize = if RECORDER_BUFFER > LOCKSTEP_BUFFER {
+    RECORDER_BUFFER
+} else {
+    LOCKSTEP_BUFFER
+};
 /// Notifiers per `<service>/wake` event service.
 pub const MAX_NOTIFIERS: usize = 1;
 /// Listeners per `<service>/wake` event service.

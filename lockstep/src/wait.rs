@@ -47,8 +47,14 @@ impl FromStr for Wait {
             "yield" => Ok(Wait::Yield),
             "block" => Ok(Wait::Block),
             "waitset" => Ok(Wait::WaitSet),
-            _ if s.starts_with("spin-then-yield:") => s["spin-then-yield:".len()..].parse().map(Wait::SpinThenYield).map_err(|_| format!("'{s}': write spin-then-yield:<nanoseconds>")),
-            _ if s.starts_with("sleep:") => s["sleep:".len()..].parse().map(Wait::Sleep).map_err(|_| format!("'{s}': write sleep:<microseconds>")),
+            _ if s.starts_with("spin-then-yield:") => s["spin-then-yield:".len()..]
+                .parse()
+                .map(Wait::SpinThenYield)
+                .map_err(|_| format!("'{s}': write spin-then-yield:<nanoseconds>")),
+            _ if s.starts_with("sleep:") => s["sleep:".len()..]
+                .parse()
+                .map(Wait::Sleep)
+                .map_err(|_| format!("'{s}': write sleep:<microseconds>")),
             _ => match s.strip_prefix("spin-then-block") {
                 Some("") => Ok(Wait::SpinThenBlock(50)),
                 Some(rest) => rest
@@ -56,7 +62,9 @@ impl FromStr for Wait {
                     .and_then(|us| us.parse().ok())
                     .map(Wait::SpinThenBlock)
                     .ok_or_else(|| format!("'{s}': write spin-then-block:<microseconds>")),
-                None => Err(format!("'{s}' is not a wait strategy (yield, block, waitset, spin-then-block[:µs], spin-then-yield:ns, sleep:µs)")),
+                None => Err(format!(
+                    "'{s}' is not a wait strategy (yield, block, waitset, spin-then-block[:µs], spin-then-yield:ns, sleep:µs)"
+                )),
             },
         }
     }

@@ -4,7 +4,7 @@
 
 use std::sync::Mutex;
 
-use lockstep::{Bus, RunSpace, Wait, RUNS_DIR_ENV};
+use lockstep::{Bus, RUNS_DIR_ENV, RunSpace, Wait};
 
 static SEEN: Mutex<Vec<String>> = Mutex::new(Vec::new());
 
@@ -12,8 +12,15 @@ static SEEN: Mutex<Vec<String>> = Mutex::new(Vec::new());
 struct Capture;
 
 impl iceoryx2_log::Log for Capture {
-    fn log(&self, level: iceoryx2_log::LogLevel, origin: std::fmt::Arguments, message: std::fmt::Arguments) {
-        SEEN.lock().unwrap().push(format!("{level:?} {origin}: {message}"));
+    fn log(
+        &self,
+        level: iceoryx2_log::LogLevel,
+        origin: std::fmt::Arguments,
+        message: std::fmt::Arguments,
+    ) {
+        SEEN.lock()
+            .unwrap()
+            .push(format!("{level:?} {origin}: {message}"));
     }
 }
 
@@ -36,5 +43,9 @@ fn a_process_on_the_bus_shows_no_iceoryx2_warning() {
     space.remove();
     let _ = std::fs::remove_dir_all(&runs);
     let seen = SEEN.lock().unwrap();
-    assert!(seen.iter().all(|m| !m.starts_with("Warn") && !m.starts_with("Info")), "{seen:?}");
+    assert!(
+        seen.iter()
+            .all(|m| !m.starts_with("Warn") && !m.starts_with("Info")),
+        "{seen:?}"
+    );
 }

@@ -6,10 +6,13 @@ use std::mem::{align_of, offset_of, size_of};
 
 use iceoryx2::prelude::ZeroCopySend;
 use lockstep::settings::*;
-use lockstep::{WireHeader, PROTOCOL_VERSION};
+use lockstep::{PROTOCOL_VERSION, WireHeader};
 
 fn document() -> String {
-    let root = std::env::var_os("CARGO_MANIFEST_DIR").map_or_else(|| env!("CARGO_MANIFEST_DIR").into(), std::path::PathBuf::from);
+    let root = std::env::var_os("CARGO_MANIFEST_DIR").map_or_else(
+        || env!("CARGO_MANIFEST_DIR").into(),
+        std::path::PathBuf::from,
+    );
     std::fs::read_to_string(root.join("../PROTOCOL.md")).unwrap()
 }
 
@@ -25,14 +28,34 @@ fn the_header_table_is_the_header() {
     let rows: Vec<(usize, usize, String)> = doc
         .lines()
         .filter_map(|l| {
-            let cells: Vec<&str> = l.trim().trim_matches('|').split('|').map(str::trim).collect();
-            let (off, size, field) = (cells.first()?.parse().ok()?, cells.get(1)?.parse().ok()?, cells.get(2)?);
-            let name = field.trim_matches('`').split(':').next()?.trim().to_string();
+            let cells: Vec<&str> = l
+                .trim()
+                .trim_matches('|')
+                .split('|')
+                .map(str::trim)
+                .collect();
+            let (off, size, field) = (
+                cells.first()?.parse().ok()?,
+                cells.get(1)?.parse().ok()?,
+                cells.get(2)?,
+            );
+            let name = field
+                .trim_matches('`')
+                .split(':')
+                .next()?
+                .trim()
+                .to_string();
             Some((off, size, name))
         })
         .collect();
     let names: Vec<&str> = rows.iter().map(|(_, _, n)| n.as_str()).collect();
-    assert_eq!(names, ["step", "sim_time", "sent_ns", "taken_ns", "protocol", "reserved"], "{rows:?}");
+    assert_eq!(
+        names,
+        [
+            "step", "sim_time", "sent_ns", "taken_ns", "protocol", "reserved"
+        ],
+        "{rows:?}"
+    );
     let code = [
         (offset_of!(WireHeader, step), size_of::<u64>()),
         (offset_of!(WireHeader, sim_time), size_of::<f64>()),
@@ -45,19 +68,35 @@ fn the_header_table_is_the_header() {
         assert_eq!((*off, *size), (c_off, c_size), "{name}");
     }
     let flat = flat(&doc);
-    assert!(flat.contains(&format!("{} bytes, align {}", size_of::<WireHeader>(), align_of::<WireHeader>())), "size and alignment");
+    assert!(
+        flat.contains(&format!(
+            "{} bytes, align {}",
+            size_of::<WireHeader>(),
+            align_of::<WireHeader>()
+        )),
+        "size and alignment"
+    );
     // SAFETY: type_name only returns the static name the derive gave the type.
     let type_name = unsafe { <WireHeader as ZeroCopySend>::type_name() };
-    assert!(flat.contains(&format!("**user header** `{type_name}`")), "type name {type_name}");
-    assert!(flat.contains(&format!("| 32 | 4 | `protocol: u32` | {PROTOCOL_VERSION} |")));
-    assert!(flat.starts_with(&format!("# The lockstep protocol, version {PROTOCOL_VERSION}")));
+    assert!(
+        flat.contains(&format!("**user header** `{type_name}`")),
+        "type name {type_name}"
+    );
+    assert!(flat.contains(&format!(
+        "| 32 | 4 | `protocol: u32` | {PROTOCOL_VERSION} |"
+    )));
+    assert!(flat.starts_with(&format!(
+        "# The lockstep protocol, version {PROTOCOL_VERSION}"
+    )));
 }
 
 #[test]
 fn the_service_settings_are_the_code_s() {
     let doc = flat(&document());
     for phrase in [
-        format!("at most {MAX_PUBLISHERS} publisher, {MAX_SUBSCRIBERS} subscribers and {MAX_NODES} nodes; history {HISTORY}"),
+        format!(
+            "at most {MAX_PUBLISHERS} publisher, {MAX_SUBSCRIBERS} subscribers and {MAX_NODES} nodes; history {HISTORY}"
+        ),
         format!("subscriber buffer up to {SUBSCRIBER_MAX_BUFFER} samples"),
         format!("Subscribers of a lockstep input use a buffer of {LOCKSTEP_BUFFER}"),
         format!("({MAX_NOTIFIERS} notifier, {MAX_LISTENERS} listeners, {MAX_NODES} nodes)"),
@@ -70,8 +109,18 @@ fn the_service_settings_are_the_code_s() {
 #[test]
 fn the_environment_table_names_what_the_kit_reads() {
     let doc = document();
-    for var in ["UIO_PROTOCOL", "UIO_RUN", "UIO_NAME", "UIO_ROLE", "UIO_CONFIG", "UIO_RUNS_DIR"] {
-        assert!(doc.contains(&format!("| `{var}` |")), "{var} is not in the table of §1");
+    for var in [
+        "UIO_PROTOCOL",
+        "UIO_RUN",
+        "UIO_NAME",
+        "UIO_ROLE",
+        "UIO_CONFIG",
+        "UIO_RUNS_DIR",
+    ] {
+        assert!(
+            doc.contains(&format!("| `{var}` |")),
+            "{var} is not in the table of §1"
+        );
     }
     assert_eq!(lockstep::RUNS_DIR_ENV, "UIO_RUNS_DIR");
 }

@@ -6,7 +6,7 @@ use std::ffi::CString;
 use std::os::unix::ffi::OsStrExt;
 use std::time::{Duration, Instant};
 
-use lockstep::{RunSpace, RUNS_DIR_ENV};
+use lockstep::{RUNS_DIR_ENV, RunSpace};
 
 #[test]
 fn open_refuses_symlinks_and_a_fifo_owner() {
@@ -31,14 +31,20 @@ fn open_refuses_symlinks_and_a_fifo_owner() {
     assert_eq!(unsafe { libc::mkfifo(fifo.as_ptr(), 0o600) }, 0);
     let t = Instant::now();
     let e = RunSpace::open("999999x0x2").unwrap_err().to_string();
-    assert!(t.elapsed() < Duration::from_secs(2) && e.contains("owner.pid") && e.contains("refusing"), "{e}");
+    assert!(
+        t.elapsed() < Duration::from_secs(2) && e.contains("owner.pid") && e.contains("refusing"),
+        "{e}"
+    );
 
     // The runs directory itself a symlink to the real one.
     std::os::unix::fs::symlink(&runs, scratch.join("link")).unwrap();
     // SAFETY: as above.
     unsafe { std::env::set_var(RUNS_DIR_ENV, scratch.join("link")) };
     let e = RunSpace::open(space.id()).unwrap_err().to_string();
-    assert!(e.contains("is a symbolic link") && e.contains("link"), "{e}");
+    assert!(
+        e.contains("is a symbolic link") && e.contains("link"),
+        "{e}"
+    );
 
     // SAFETY: as above.
     unsafe { std::env::set_var(RUNS_DIR_ENV, &runs) };

@@ -266,7 +266,8 @@ pub fn steady_state_kalman(a: &Mat, c: &Mat, qd: &Mat, r: &Mat) -> Result<Kalman
         .ok_or(LtiError::Singular("the innovation covariance"))?;
     let gain = chol.solve(&(c * &pm)).transpose();
     let i_lc = Mat::identity(n, n) - &gain * c;
-    let p_updated = sym(&(mul(&mul(&i_lc, &pm), &i_lc.transpose()) + &gain * &r * gain.transpose()));
+    let p_updated =
+        sym(&(mul(&mul(&i_lc, &pm), &i_lc.transpose()) + &gain * &r * gain.transpose()));
     Ok(Kalman {
         predictor_gain: a * &gain,
         p: pm,

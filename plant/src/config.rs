@@ -1,7 +1,7 @@
 //! What the launcher tells the plant.
 
-use lti::signal::Signal;
 use lti::MatData;
+use lti::signal::Signal;
 
 use crate::fault::Fault;
 use crate::noise::Noise;
@@ -77,19 +77,33 @@ struct ProtocolSignals {
 /// Rows as a matrix of `nrows` rows (an empty matrix keeps its rows, PROTOCOL.md §3).
 fn rows(r: &[Vec<f64>], nrows: usize) -> MatData {
     let cols = r.first().map_or(0, Vec::len);
-    MatData { rows: nrows, cols, data: r.iter().flat_map(|row| row.iter().copied()).collect() }
+    MatData {
+        rows: nrows,
+        cols,
+        data: r.iter().flat_map(|row| row.iter().copied()).collect(),
+    }
 }
 
 impl PlantConfig {
     /// The plant a component's configuration describes, from the protocol's public fields
     /// alone — `model`, `signals`, `dt`, `steps` (PROTOCOL.md §3) — as any plant must read it.
     pub fn from_protocol(cfg: &lockstep::component::ComponentConfig) -> Result<Self, String> {
-        let m: ProtocolModel = serde_json::from_value(cfg.model.clone()).map_err(|e| format!("model: {e}"))?;
-        let s: ProtocolSignals = serde_json::from_value(cfg.signals.clone()).map_err(|e| format!("signals: {e}"))?;
+        let m: ProtocolModel =
+            serde_json::from_value(cfg.model.clone()).map_err(|e| format!("model: {e}"))?;
+        let s: ProtocolSignals =
+            serde_json::from_value(cfg.signals.clone()).map_err(|e| format!("signals: {e}"))?;
         let (n, p) = (m.A.len(), m.C.len());
-        let ragged = [&m.A, &m.B, &m.C, &m.D, &m.E].iter().any(|x| x.iter().any(|r| r.len() != x[0].len()));
-        let ff_bad = !m.Ff.is_empty() && (m.Ff.len() != n || m.Ff.iter().any(|r| r.len() != m.Ff[0].len()));
-        if ragged || ff_bad || [&m.B, &m.E].iter().any(|x| x.len() != n) || m.D.len() != p || m.A.iter().chain(&m.C).any(|r| r.len() != n) {
+        let ragged = [&m.A, &m.B, &m.C, &m.D, &m.E]
+            .iter()
+            .any(|x| x.iter().any(|r| r.len() != x[0].len()));
+        let ff_bad =
+            !m.Ff.is_empty() && (m.Ff.len() != n || m.Ff.iter().any(|r| r.len() != m.Ff[0].len()));
+        if ragged
+            || ff_bad
+            || [&m.B, &m.E].iter().any(|x| x.len() != n)
+            || m.D.len() != p
+            || m.A.iter().chain(&m.C).any(|r| r.len() != n)
+        {
             return Err("model: the matrices do not conform".into());
         }
         Ok(PlantConfig {

@@ -65,14 +65,18 @@ impl Profile {
     pub fn start(&self) -> f64 {
         match self {
             Profile::Step { start, .. } | Profile::Ramp { start, .. } => *start,
-            Profile::Intermittent { intervals } => intervals.first().map_or(f64::INFINITY, |i| i[0]),
+            Profile::Intermittent { intervals } => {
+                intervals.first().map_or(f64::INFINITY, |i| i[0])
+            }
         }
     }
 
     /// Every [on, off) interval (off = +∞ for no end).
     pub fn intervals(&self) -> Vec<[f64; 2]> {
         match self {
-            Profile::Step { start, end } | Profile::Ramp { start, end } => vec![[*start, end.unwrap_or(f64::INFINITY)]],
+            Profile::Step { start, end } | Profile::Ramp { start, end } => {
+                vec![[*start, end.unwrap_or(f64::INFINITY)]]
+            }
             Profile::Intermittent { intervals } => intervals.clone(),
         }
     }
@@ -96,7 +100,10 @@ pub struct Fault {
 impl Fault {
     /// Whether it acts through a state-equation column (integrated over the step).
     pub fn through_state(&self) -> bool {
-        matches!((self.target, self.kind), (Target::Actuator(_), Kind::Additive) | (Target::Component(_), _))
+        matches!(
+            (self.target, self.kind),
+            (Target::Actuator(_), Kind::Additive) | (Target::Component(_), _)
+        )
     }
 }
 
@@ -104,7 +111,11 @@ impl Fault {
     /// The [k_on, k_off) steps it acts in, on the grid of dt (k_off = u64::MAX for no end).
     pub fn active_steps(&self, dt: f64) -> Vec<(u64, u64)> {
         let sample_of = |t: f64| lti::signal::first_sample_from(t, dt);
-        self.profile.intervals().iter().map(|i| (sample_of(i[0]), sample_of(i[1]))).collect()
+        self.profile
+            .intervals()
+            .iter()
+            .map(|i| (sample_of(i[0]), sample_of(i[1])))
+            .collect()
     }
 }
 
@@ -125,7 +136,12 @@ impl Scheduled {
         let sample_of = |t: f64| lti::signal::first_sample_from(t, dt);
         let steps = fault.active_steps(dt);
         let ramp = matches!(fault.profile, Profile::Ramp { .. }) || fault.kind == Kind::Drift;
-        Scheduled { fault: fault.clone(), steps, k0: sample_of(fault.profile.start()), ramp }
+        Scheduled {
+            fault: fault.clone(),
+            steps,
+            k0: sample_of(fault.profile.start()),
+            ramp,
+        }
     }
 
     /// Whether the fault acts over step k (from t_k on).
@@ -138,6 +154,13 @@ impl Scheduled {
         if !self.active(k) {
             return (0.0, 0.0);
         }
-        if self.ramp { (self.fault.value * ((k - self.k0) as f64 * dt), self.fault.value) } else { (self.fault.value, 0.0) }
+        if self.ramp {
+            (
+                self.fault.value * ((k - self.k0) as f64 * dt),
+                self.fault.value,
+            )
+        } else {
+            (self.fault.value, 0.0)
+        }
     }
 }

@@ -70,7 +70,11 @@ impl Gaussian {
         let e = m.symmetric_eigen();
         let root = e.eigenvalues.map(|l| l.max(0.0).sqrt());
         let s = &e.eigenvectors * DMatrix::from_diagonal(&root);
-        Some(Gaussian { xi: DVector::zeros(s.ncols()), s, stream: Stream::new(seed, stream) })
+        Some(Gaussian {
+            xi: DVector::zeros(s.ncols()),
+            s,
+            stream: Stream::new(seed, stream),
+        })
     }
 
     /// Adds one draw to `out`.

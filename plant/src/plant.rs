@@ -27,7 +27,7 @@ use lockstep::PlantLayout;
 use lti::discretize::exp_upper;
 use lti::kernel::{copy, mul_acc, mul_into};
 use lti::sampled::SampledSignal;
-use lti::signal::{locate, Switch};
+use lti::signal::{Switch, locate};
 use nalgebra::{DMatrix, DVector};
 
 use crate::config::PlantConfig;
@@ -64,9 +64,22 @@ pub struct Divergence {
 impl std::fmt::Display for Divergence {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         if self.value.is_finite() {
-            write!(f, "x{} = {:.6e} left the bound ±{:.3e} at step {}", self.state + 1, self.value, self.bound, self.step + 1)
+            write!(
+                f,
+                "x{} = {:.6e} left the bound ±{:.3e} at step {}",
+                self.state + 1,
+                self.value,
+                self.bound,
+                self.step + 1
+            )
         } else {
-            write!(f, "x{} = {} at step {}", self.state + 1, self.value, self.step + 1)
+            write!(
+                f,
+                "x{} = {} at step {}",
+                self.state + 1,
+                self.value,
+                self.step + 1
+            )
         }
     }
 }
@@ -131,7 +144,13 @@ impl Plant {
             .filter_map(|(i, s)| s.sine().map(|(_, w, ph)| (i, w, ph)))
             .collect();
         let m = l + q + 2 * sines.len();
-        let model = lti::Model { a: a.clone(), b: b.clone(), c: c.clone(), e: e.clone(), d: d.clone() };
+        let model = lti::Model {
+            a: a.clone(),
+            b: b.clone(),
+            c: c.clone(),
+            e: e.clone(),
+            d: d.clone(),
+        };
         // Φ, B_d and E_d exactly as the observer designs compute them (Model::discretize), so
         // plant and observers share the same sampled model to the last bit; only the sine
         // generators' columns need the larger exponential.
@@ -148,7 +167,12 @@ impl Plant {
                 let (_, gj) = exp_upper(&a, &g, &w, h);
                 gamma.columns_mut(l + q + 2 * j, 2).copy_from(&gj);
             }
-            Piece { offset, phi: dm.a, gamma, held: Vec::new() }
+            Piece {
+                offset,
+                phi: dm.a,
+                gamma,
+                held: Vec::new(),
+            }
         };
         let (full, splits) = if cfg.discrete {
             // Φ, Γ_B, Γ_E as given; a sine enters through its value at t_k: a_i·sin(ω_it_k + φ_i)·Γ_E,i.
@@ -159,11 +183,26 @@ impl Plant {
                 let amp = cfg.disturbances[i].sine().map_or(0.0, |s| s.0);
                 gamma.set_column(l + q + 2 * j, &(e.column(i) * amp));
             }
-            (Piece { offset: 0.0, phi: a.clone(), gamma, held: Vec::new() }, Vec::new())
+            (
+                Piece {
+                    offset: 0.0,
+                    phi: a.clone(),
+                    gamma,
+                    held: Vec::new(),
+                },
+                Vec::new(),
+            )
         } else {
             (piece(0.0, cfg.dt), split_steps(cfg, &piece))
         };
-        let layout = PlantLayout { n, p, q, r, l, f: cfg.faults.len() };
+        let layout = PlantLayout {
+            n,
+            p,
+            q,
+            r,
+            l,
+            f: cfg.faults.len(),
+        };
         let ff: DMatrix<f64> = (&cfg.ff).into();
         for f in &cfg.faults {
             let fits = match f.target {
@@ -172,7 +211,10 @@ impl Plant {
                 Target::Component(j) => j < ff.ncols() && ff.nrows() == n,
             };
             if !fits {
-                return Err(format!("fault '{}': its target does not exist in this plant", f.name));
+                return Err(format!(
+                    "fault '{}': its target does not exist in this plant",
+                    f.name
+                ));
             }
         }
         // [Γ₀ Γ₁] of a column f: exp([[A, f, 0], [0, 0, 1], [0, 0, 0]]·dt), see crate::fault.
@@ -195,11 +237,17 @@ impl Plant {
                 let mut g = DMatrix::<f64>::zeros(n, 2);
                 g.set_column(0, &column);
                 let (_, gamma) = exp_upper(&a, &g, &ramp_generator, cfg.dt);
-                (i, gamma.column(0).into_owned(), gamma.column(1).into_owned())
+                (
+                    i,
+                    gamma.column(0).into_owned(),
+                    gamma.column(1).into_owned(),
+                )
             })
             .collect();
         let process_noise = match &cfg.noise {
-            Some(z) if (z.qd.rows, z.qd.cols) != (n, n) => return Err("plant configuration: the noise covariances do not conform".into()),
+            Some(z) if (z.qd.rows, z.qd.cols) != (n, n) => {
+                return Err("plant configuration: the noise covariances do not conform".into());
+            }
             Some(z) => Gaussian::new(&z.qd, z.seed, PROCESS),
             None => None,
         };
@@ -269,7 +317,11 @@ impl Plant {
         let (head, tail) = out.split_at_mut(lay.w().start);
         let y = &mut head[lay.y()];
         mul_into(y, &self.c, self.x.as_slice());
-        mul_acc(y, &self.d, &tail[lay.v().start - lay.w().start..lay.v().end - lay.w().start]);
+        mul_acc(
+            y,
+            &self.d,
+            &tail[lay.v().start - lay.w().start..lay.v().end - lay.w().start],
+        );
         let slots = lay.faults().start - lay.w().start;
         self.sensing.sense(k, y, &mut tail[slots..]);
         &self.out
@@ -308,7 +360,16 @@ impl Plant {
             } else {
                 copy(held, &piece.held);
             }
-            integrate(piece, t, u, &self.sines, at_tk, &mut self.xi, &mut self.x, &mut self.x_next);
+            integrate(
+                piece,
+                t,
+                u,
+                &self.sines,
+                at_tk,
+                &mut self.xi,
+                &mut self.x,
+                &mut self.x_next,
+            );
         }
         // Faults through the state equation, over the whole step (superposition: the split of
         // a step at a disturbance's switching time does not concern them).
@@ -324,7 +385,12 @@ impl Plant {
         }
         for (i, &v) in self.x.as_slice().iter().enumerate() {
             if !v.is_finite() || v.abs() > self.bound {
-                return Err(Divergence { step: k, state: i, value: v, bound: self.bound });
+                return Err(Divergence {
+                    step: k,
+                    state: i,
+                    value: v,
+                    bound: self.bound,
+                });
             }
         }
         Ok(())
@@ -367,10 +433,17 @@ fn integrate(
 fn split_steps(cfg: &PlantConfig, piece: &dyn Fn(f64, f64) -> Piece) -> Vec<(u64, Vec<Piece>)> {
     let dt = cfg.dt;
     let inside = |tb: f64| match locate(tb, dt) {
-        Switch::Inside { step, offset } if step < cfg.steps && offset > 0.0 && offset < dt => Some((step, offset)),
+        Switch::Inside { step, offset } if step < cfg.steps && offset > 0.0 && offset < dt => {
+            Some((step, offset))
+        }
         _ => None, // on a sample (the sampling rule makes it there) or outside the run
     };
-    let mut cuts: Vec<(u64, f64)> = cfg.disturbances.iter().flat_map(|s| s.breakpoints()).filter_map(inside).collect();
+    let mut cuts: Vec<(u64, f64)> = cfg
+        .disturbances
+        .iter()
+        .flat_map(|s| s.breakpoints())
+        .filter_map(inside)
+        .collect();
     cuts.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
     cuts.dedup();
     let mut out: Vec<(u64, Vec<Piece>)> = Vec::new();
@@ -391,7 +464,9 @@ fn split_steps(cfg: &PlantConfig, piece: &dyn Fn(f64, f64) -> Piece) -> Vec<(u64
                     .disturbances
                     .iter()
                     .map(|s| {
-                        let switched = s.breakpoints().iter().rposition(|&tb| inside(tb).is_some_and(|(st, off)| st == k && off <= w[0]));
+                        let switched = s.breakpoints().iter().rposition(|&tb| {
+                            inside(tb).is_some_and(|(st, off)| st == k && off <= w[0])
+                        });
                         switched.map_or_else(|| s.held_at_step(k, dt), |j| s.held_after(j))
                     })
                     .collect();

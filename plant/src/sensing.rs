@@ -7,7 +7,7 @@
 
 use crate::config::PlantConfig;
 use crate::fault::{Kind, Scheduled, Target};
-use crate::noise::{Gaussian, Stream, FAULT_BASE, MEASUREMENT};
+use crate::noise::{FAULT_BASE, Gaussian, MEASUREMENT, Stream};
 
 /// Faults and measurement noise of one run.
 #[derive(Debug, Clone)]
@@ -24,13 +24,29 @@ impl Sensing {
     pub fn new(cfg: &PlantConfig) -> Result<Self, String> {
         let p = cfg.c.rows;
         let seed = cfg.noise.as_ref().map_or(0, |z| z.seed);
-        let bursts = cfg.faults.iter().enumerate().map(|(i, f)| (f.kind == Kind::Noise).then(|| Stream::new(seed, FAULT_BASE + i as u64))).collect();
+        let bursts = cfg
+            .faults
+            .iter()
+            .enumerate()
+            .map(|(i, f)| (f.kind == Kind::Noise).then(|| Stream::new(seed, FAULT_BASE + i as u64)))
+            .collect();
         let measurement_noise = match &cfg.noise {
-            Some(z) if (z.r.rows, z.r.cols) != (p, p) => return Err("plant configuration: the noise covariances do not conform".into()),
+            Some(z) if (z.r.rows, z.r.cols) != (p, p) => {
+                return Err("plant configuration: the noise covariances do not conform".into());
+            }
             Some(z) => Gaussian::new(&z.r, z.seed, MEASUREMENT),
             None => None,
         };
-        Ok(Sensing { dt: cfg.dt, faults: cfg.faults.iter().map(|f| Scheduled::new(f, cfg.dt)).collect(), bursts, measurement_noise })
+        Ok(Sensing {
+            dt: cfg.dt,
+            faults: cfg
+                .faults
+                .iter()
+                .map(|f| Scheduled::new(f, cfg.dt))
+                .collect(),
+            bursts,
+            measurement_noise,
+        })
     }
 
     /// The input acting over step k: the commanded `u` with stuck actuators held and lost gain
@@ -41,7 +57,9 @@ impl Sensing {
             match (f.fault.target, f.fault.kind) {
                 (Target::Actuator(i), Kind::Stuck) => applied[i] = f.fault.value,
                 (Target::Actuator(i), Kind::Gain) => applied[i] *= 1.0 - f.fault.value,
-                (Target::Actuator(i), Kind::Additive) if additive => applied[i] += f.magnitude(k, self.dt).0,
+                (Target::Actuator(i), Kind::Additive) if additive => {
+                    applied[i] += f.magnitude(k, self.dt).0
+                }
                 _ => {}
             }
         }
@@ -57,7 +75,9 @@ impl Sensing {
             if let (Target::Sensor(j), true) = (f.fault.target, f.active(k)) {
                 match f.fault.kind {
                     Kind::Stuck => y[j] = f.fault.value,
-                    Kind::Noise => y[j] += f.fault.value * self.bursts[i].as_mut().map_or(0.0, Stream::normal),
+                    Kind::Noise => {
+                        y[j] += f.fault.value * self.bursts[i].as_mut().map_or(0.0, Stream::normal)
+                    }
                     _ => y[j] += f.magnitude(k, self.dt).0,
                 }
             }

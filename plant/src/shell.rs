@@ -24,7 +24,11 @@ impl Component for PlantComponent {
         let pc = PlantConfig::from_protocol(cfg)?;
         let plant = Plant::new(&pc)?;
         let l = plant.layout().l;
-        Ok(PlantComponent { plant, controller: cfg.read_index("controller"), u: vec![0.0; l] })
+        Ok(PlantComponent {
+            plant,
+            controller: cfg.read_index("controller"),
+            u: vec![0.0; l],
+        })
     }
 
     fn step(&mut self, k: u64, inputs: &Inputs, out: &mut [f64]) -> Result<(), StepError> {
@@ -33,7 +37,10 @@ impl Component for PlantComponent {
                 Some(i) => self.u.copy_from_slice(inputs.get(i)),
                 None => self.u.copy_from_slice(self.plant.reference()),
             }
-            self.plant.advance(k - 1, &self.u).map_err(|d| StepError { code: EXIT_DIVERGED, message: format!("diverged: {d}") })?;
+            self.plant.advance(k - 1, &self.u).map_err(|d| StepError {
+                code: EXIT_DIVERGED,
+                message: format!("diverged: {d}"),
+            })?;
         }
         out.copy_from_slice(self.plant.sample(k));
         Ok(())

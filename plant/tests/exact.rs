@@ -23,13 +23,25 @@ fn sinusoidal_disturbance_matches_scipy() {
         e: md(3, 1, &[2.0, 0.0, 0.5]),
         d: md(2, 0, &[]),
         x0: vec![1.0, -1.0, 2.0],
-        disturbances: vec![Signal::Sine { amplitude: 1.0, frequency_hz: 0.5, phase: 0.3, offset: 0.25 }],
+        disturbances: vec![Signal::Sine {
+            amplitude: 1.0,
+            frequency_hz: 0.5,
+            phase: 0.3,
+            offset: 0.25,
+        }],
         measurement_disturbances: vec![],
-        inputs: vec![Signal::Constant { value: 0.5 }, Signal::Constant { value: -0.2 }],
+        inputs: vec![
+            Signal::Constant { value: 0.5 },
+            Signal::Constant { value: -0.2 },
+        ],
         dt: 1e-3,
         steps: 1000,
         state_bound: 1e9,
-        ff: lti::MatData { rows: 0, cols: 0, data: vec![] },
+        ff: lti::MatData {
+            rows: 0,
+            cols: 0,
+            data: vec![],
+        },
         faults: vec![],
         noise: None,
         discrete: false,
@@ -53,7 +65,13 @@ fn sinusoidal_disturbance_matches_scipy() {
 /// lands on x(t) = 1 − e^{−(t − t_b)} exactly.
 #[test]
 fn switching_inside_a_step_is_integrated_exactly() {
-    let cfg = scalar(Signal::Piecewise { times: vec![0.0, 1.5e-3, 2.7e-3], values: vec![0.0, 1.0, -2.0] }, 10);
+    let cfg = scalar(
+        Signal::Piecewise {
+            times: vec![0.0, 1.5e-3, 2.7e-3],
+            values: vec![0.0, 1.0, -2.0],
+        },
+        10,
+    );
     let mut plant = Plant::new(&cfg).unwrap();
     let exact = |t: f64| {
         let x_at = 1.0 - (-(2.7e-3f64 - 1.5e-3)).exp();
@@ -67,7 +85,11 @@ fn switching_inside_a_step_is_integrated_exactly() {
     };
     for k in 0..10u64 {
         let x = plant.sample(k)[0];
-        assert!((x - exact(k as f64 * 1e-3)).abs() < 1e-15, "k = {k}: {x} vs {}", exact(k as f64 * 1e-3));
+        assert!(
+            (x - exact(k as f64 * 1e-3)).abs() < 1e-15,
+            "k = {k}: {x} vs {}",
+            exact(k as f64 * 1e-3)
+        );
         plant.advance(k, &[0.0]).unwrap();
     }
 }
@@ -87,7 +109,11 @@ fn divergence_names_the_state_and_step() {
         dt: 1e-2,
         steps: 100,
         state_bound: 1e6,
-        ff: lti::MatData { rows: 0, cols: 0, data: vec![] },
+        ff: lti::MatData {
+            rows: 0,
+            cols: 0,
+            data: vec![],
+        },
         faults: vec![],
         noise: None,
         discrete: false,
@@ -122,7 +148,11 @@ fn scalar(w: Signal, steps: u64) -> PlantConfig {
         dt: 1e-3,
         steps,
         state_bound: 1e9,
-        ff: lti::MatData { rows: 0, cols: 0, data: vec![] },
+        ff: lti::MatData {
+            rows: 0,
+            cols: 0,
+            data: vec![],
+        },
         faults: vec![],
         noise: None,
         discrete: false,
@@ -131,7 +161,14 @@ fn scalar(w: Signal, steps: u64) -> PlantConfig {
 
 /// [`scalar`] with w a step 0 → 1 at `time`, run to sample 5001.
 fn scalar_step_plant(time: f64) -> (Vec<f64>, Vec<f64>) {
-    let cfg = scalar(Signal::Step { time, before: 0.0, after: 1.0 }, 5002);
+    let cfg = scalar(
+        Signal::Step {
+            time,
+            before: 0.0,
+            after: 1.0,
+        },
+        5002,
+    );
     let mut plant = Plant::new(&cfg).unwrap();
     let w_at = plant.layout().w().start;
     let (mut x, mut w) = (Vec::new(), Vec::new());
@@ -151,11 +188,18 @@ fn scalar_step_plant(time: f64) -> (Vec<f64>, Vec<f64>) {
 #[test]
 fn a_switch_just_after_a_sample_is_made_inside_the_step() {
     let (x, w) = scalar_step_plant(5.0000000000001);
-    assert_eq!(w[5000], 0.0, "w at sample 5000 is the value before the switch");
+    assert_eq!(
+        w[5000], 0.0,
+        "w at sample 5000 is the value before the switch"
+    );
     assert_eq!(w[5001], 1.0);
     assert_eq!(x[5000], 0.0);
     let exact = -(-(1e-3 - 1e-13f64)).exp_m1();
-    assert!((x[5001] - exact).abs() < 1e-18, "x(t_5001) = {:e}, exact {exact:e}", x[5001]);
+    assert!(
+        (x[5001] - exact).abs() < 1e-18,
+        "x(t_5001) = {:e}, exact {exact:e}",
+        x[5001]
+    );
 }
 
 /// A switching time written 5.0 with dt = 0.001 is on sample 5000 (5000 × 0.001 as decimals),
@@ -166,5 +210,9 @@ fn a_switch_on_a_sample_is_made_at_that_sample() {
     assert_eq!((w[4999], w[5000]), (0.0, 1.0));
     assert_eq!(x[5000], 0.0);
     let exact = -(-1e-3f64).exp_m1();
-    assert!((x[5001] - exact).abs() < 1e-18, "x(t_5001) = {:e}, exact {exact:e}", x[5001]);
+    assert!(
+        (x[5001] - exact).abs() < 1e-18,
+        "x(t_5001) = {:e}, exact {exact:e}",
+        x[5001]
+    );
 }

@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 
 use launcher::run::{Mode, Options, Stop};
-use launcher::{design_report, shipped, LaunchError};
+use launcher::{LaunchError, design_report, shipped};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
@@ -37,7 +37,11 @@ fn scenario(path: &str, text: Option<&str>) -> Result<Scenario, LaunchError> {
 fn design(path: &str, text: Option<&str>) -> PyResult<(bool, String, String)> {
     let s = scenario(path, text).map_err(raise)?;
     let r = design_report::report(&s);
-    Ok((r.ok, serde_json::to_string(&r.json).expect("serialises"), r.text))
+    Ok((
+        r.ok,
+        serde_json::to_string(&r.json).expect("serialises"),
+        r.text,
+    ))
 }
 
 /// `launcher run --mode in-process --out OUT`: (the recording, the summary JSON, completed and
@@ -47,7 +51,8 @@ fn design(path: &str, text: Option<&str>) -> PyResult<(bool, String, String)> {
 fn run(py: Python<'_>, path: &str, out: &str, force: bool) -> PyResult<(String, String, bool)> {
     let s = scenario(path, None).map_err(raise)?;
     let p = launcher::calibrate::planned(&s).map_err(raise)?;
-    let select = recording::write::Selection::new(1, &[]).map_err(|e| raise(LaunchError::BadInput(e)))?;
+    let select =
+        recording::write::Selection::new(1, &[]).map_err(|e| raise(LaunchError::BadInput(e)))?;
     let opts = Options {
         out: PathBuf::from(out),
         mode: Mode::InProcess,
@@ -61,9 +66,16 @@ fn run(py: Python<'_>, path: &str, out: &str, force: bool) -> PyResult<(String, 
         realtime: None,
     };
     // The run holds no Python object: other Python threads may go on meanwhile.
-    let o = py.detach(|| launcher::run::run(&s, &p, &opts)).map_err(raise)?;
-    let rrd = o.rrd.as_ref().map(|r| r.display().to_string()).unwrap_or_default();
-    let summary = serde_json::to_string(&o.summary).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+    let o = py
+        .detach(|| launcher::run::run(&s, &p, &opts))
+        .map_err(raise)?;
+    let rrd = o
+        .rrd
+        .as_ref()
+        .map(|r| r.display().to_string())
+        .unwrap_or_default();
+    let summary =
+        serde_json::to_string(&o.summary).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
     let ok = matches!(o.stop, Stop::Completed) && o.summary.expectations_met();
     Ok((rrd, summary, ok))
 }
@@ -74,17 +86,29 @@ type Group<'py> = (String, Vec<String>, Vec<String>, Bound<'py, PyBytes>);
 
 /// A recording as the exports see it: (the steps, dt if known, the groups).
 #[pyfunction]
-fn read<'py>(py: Python<'py>, path: &str) -> PyResult<(Bound<'py, PyBytes>, Option<f64>, Vec<Group<'py>>)> {
+fn read<'py>(
+    py: Python<'py>,
+    path: &str,
+) -> PyResult<(Bound<'py, PyBytes>, Option<f64>, Vec<Group<'py>>)> {
     let r = recording::read(Path::new(path)).map_err(|e| PyValueError::new_err(e.to_string()))?;
     if let recording::Integrity::Damaged(what) = &r.integrity {
         return Err(PyValueError::new_err(format!("{path}: damaged: {what}")));
     }
     let groups = recording::export::table::labelled(&r);
     let steps = recording::export::table::all_steps(&groups);
-    let bytes = |v: &[f64]| PyBytes::new(py, &v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>());
+    let bytes = |v: &[f64]| {
+        PyBytes::new(
+            py,
+            &v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>(),
+        )
+    };
     let mut out = Vec::with_capacity(groups.len());
     for g in &groups {
-        let cols: Vec<Vec<Option<f64>>> = g.members.iter().map(|m| recording::export::table::aligned(&steps, m.series).collect()).collect();
+        let cols: Vec<Vec<Option<f64>>> = g
+            .members
+            .iter()
+            .map(|m| recording::export::table::aligned(&steps, m.series).collect())
+            .collect();
         let mut values = Vec::with_capacity(steps.len() * cols.len());
         for k in 0..steps.len() {
             values.extend(cols.iter().map(|c| c[k].unwrap_or(f64::NAN)));
@@ -93,7 +117,13 @@ fn read<'py>(py: Python<'py>, path: &str) -> PyResult<(Bound<'py, PyBytes>, Opti
         let labels = g.members.iter().map(|m| m.label.clone()).collect();
         out.push((g.path.clone(), names, labels, bytes(&values)));
     }
-    let steps = PyBytes::new(py, &steps.iter().flat_map(|k| k.to_le_bytes()).collect::<Vec<u8>>());
+    let steps = PyBytes::new(
+        py,
+        &steps
+            .iter()
+            .flat_map(|k| k.to_le_bytes())
+            .collect::<Vec<u8>>(),
+    );
     Ok((steps, recording::tools::recorded_dt(&r), out))
 }
 

@@ -25,17 +25,36 @@ impl std::fmt::Display for Difference {
 }
 
 /// Compares `a` with `b`; `None` tolerances mean bit equality.
-pub fn compare(a: &Recording, b: &Recording, abs_tol: Option<f64>, rel_tol: Option<f64>) -> Result<usize, Difference> {
-    let signals = |r: &Recording| r.series.keys().filter(|k| !k.starts_with("/latency")).cloned().collect::<Vec<_>>();
+pub fn compare(
+    a: &Recording,
+    b: &Recording,
+    abs_tol: Option<f64>,
+    rel_tol: Option<f64>,
+) -> Result<usize, Difference> {
+    let signals = |r: &Recording| {
+        r.series
+            .keys()
+            .filter(|k| !k.starts_with("/latency"))
+            .cloned()
+            .collect::<Vec<_>>()
+    };
     let (sa, sb) = (signals(a), signals(b));
     for s in &sa {
         if !sb.contains(s) {
-            return Err(Difference { signal: s.clone(), step: None, what: "only in the first recording".into() });
+            return Err(Difference {
+                signal: s.clone(),
+                step: None,
+                what: "only in the first recording".into(),
+            });
         }
     }
     for s in &sb {
         if !sa.contains(s) {
-            return Err(Difference { signal: s.clone(), step: None, what: "only in the second recording".into() });
+            return Err(Difference {
+                signal: s.clone(),
+                step: None,
+                what: "only in the second recording".into(),
+            });
         }
     }
     let exact = abs_tol.is_none() && rel_tol.is_none();
@@ -46,15 +65,31 @@ pub fn compare(a: &Recording, b: &Recording, abs_tol: Option<f64>, rel_tol: Opti
         for i in 0..x.values.len().max(y.values.len()) {
             let (Some(&kx), Some(&ky)) = (x.steps.get(i), y.steps.get(i)) else {
                 let k = x.steps.get(i).or(y.steps.get(i)).copied();
-                return Err(Difference { signal: s.clone(), step: k, what: format!("{} values against {}", x.values.len(), y.values.len()) });
+                return Err(Difference {
+                    signal: s.clone(),
+                    step: k,
+                    what: format!("{} values against {}", x.values.len(), y.values.len()),
+                });
             };
             if kx != ky {
-                return Err(Difference { signal: s.clone(), step: Some(kx.min(ky)), what: format!("steps differ ({kx} against {ky})") });
+                return Err(Difference {
+                    signal: s.clone(),
+                    step: Some(kx.min(ky)),
+                    what: format!("steps differ ({kx} against {ky})"),
+                });
             }
             let (va, vb) = (x.values[i], y.values[i]);
-            let same = if exact { va.to_bits() == vb.to_bits() } else { (va - vb).abs() <= abs_tol.max(rel_tol * va.abs()) || (va.is_nan() && vb.is_nan()) };
+            let same = if exact {
+                va.to_bits() == vb.to_bits()
+            } else {
+                (va - vb).abs() <= abs_tol.max(rel_tol * va.abs()) || (va.is_nan() && vb.is_nan())
+            };
             if !same {
-                return Err(Difference { signal: s.clone(), step: Some(kx), what: format!("{va:e} against {vb:e} (difference {:e})", va - vb) });
+                return Err(Difference {
+                    signal: s.clone(),
+                    step: Some(kx),
+                    what: format!("{va:e} against {vb:e} (difference {:e})", va - vb),
+                });
             }
             compared += 1;
         }

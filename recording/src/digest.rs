@@ -100,13 +100,24 @@ pub fn to_json(entities: &BTreeMap<String, String>) -> String {
 /// Checks what was read — each entity's running digest over its rows in file order, and the
 /// scenario text — against the stored digest text.
 pub fn verify(read: &BTreeMap<String, Running>, scenario: Option<&str>, stored: &str) -> Integrity {
-    let Some(expected) = serde_json::from_str::<serde_json::Value>(stored).ok().and_then(|v| {
-        v.get("entities")?.as_object().map(|m| m.iter().map(|(k, v)| (k.clone(), v.as_str().unwrap_or("").to_string())).collect::<BTreeMap<_, _>>())
-    }) else {
+    let Some(expected) = serde_json::from_str::<serde_json::Value>(stored)
+        .ok()
+        .and_then(|v| {
+            v.get("entities")?.as_object().map(|m| {
+                m.iter()
+                    .map(|(k, v)| (k.clone(), v.as_str().unwrap_or("").to_string()))
+                    .collect::<BTreeMap<_, _>>()
+            })
+        })
+    else {
         return Integrity::Damaged("its digest cannot be read".into());
     };
     for (entity, hex) in &expected {
-        let actual = if entity == SCENARIO_KEY { scenario.map(of_text) } else { read.get(entity).map(Running::hex) };
+        let actual = if entity == SCENARIO_KEY {
+            scenario.map(of_text)
+        } else {
+            read.get(entity).map(Running::hex)
+        };
         if actual.as_deref() != Some(hex.as_str()) {
             return Integrity::Damaged(named(entity));
         }
@@ -125,7 +136,10 @@ fn named(key: &str) -> String {
     if key.starts_with('/') || key == SCENARIO_KEY {
         key.to_string()
     } else {
-        format!("its digest lists {}, which is no signal of a recording", scenario::untrusted::quoted(key))
+        format!(
+            "its digest lists {}, which is no signal of a recording",
+            scenario::untrusted::quoted(key)
+        )
     }
 }
 
@@ -145,8 +159,17 @@ mod tests {
         }
         assert_eq!(whole.hex(), parts.hex());
         // The definition: XXH64 (seed 0) of the rows' little-endian words, in one piece.
-        let bytes: Vec<u8> = steps.iter().zip(&values).flat_map(|(k, v)| [k.to_le_bytes(), k.to_le_bytes(), v.to_bits().to_le_bytes()].concat()).collect();
-        assert_eq!(whole.hex(), format!("{:016x}", XxHash64::oneshot(0, &bytes)));
+        let bytes: Vec<u8> = steps
+            .iter()
+            .zip(&values)
+            .flat_map(|(k, v)| {
+                [k.to_le_bytes(), k.to_le_bytes(), v.to_bits().to_le_bytes()].concat()
+            })
+            .collect();
+        assert_eq!(
+            whole.hex(),
+            format!("{:016x}", XxHash64::oneshot(0, &bytes))
+        );
         // One bit of one value.
         let mut flipped = values.clone();
         flipped[500] = f64::from_bits(flipped[500].to_bits() ^ 1);
@@ -163,13 +186,21 @@ mod tests {
         assert_eq!(Running::default().hex(), "ef46db3751d8e999");
         // Shared rows, refilled by a second signal, and a column shorter than its rows.
         let mut rows = Rows::new(&steps, Some(&steps));
-        let (mut a, mut b, mut short) = (Running::default(), Running::default(), Running::default());
+        let (mut a, mut b, mut short) =
+            (Running::default(), Running::default(), Running::default());
         a.update_rows(&mut rows, flipped.iter().copied());
         b.update_rows(&mut rows, values.iter().copied());
         short.update_rows(&mut rows, values[..10].iter().copied());
         let mut short_by_update = Running::default();
         short_by_update.update(&steps, Some(&steps), &values[..10]);
-        assert_eq!((a.hex(), b.hex(), short.hex()), (other_hex(&steps, &flipped), whole.hex(), short_by_update.hex()));
+        assert_eq!(
+            (a.hex(), b.hex(), short.hex()),
+            (
+                other_hex(&steps, &flipped),
+                whole.hex(),
+                short_by_update.hex()
+            )
+        );
     }
 
     fn other_hex(steps: &[i64], values: &[f64]) -> String {

@@ -6,10 +6,10 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use crate::write::{histogram, nan_max, Latency, Percentiles};
 use crate::read::Recording;
 use crate::signals::figure;
 use crate::tools::recorded_scenario;
+use crate::write::{Latency, Percentiles, histogram, nan_max};
 
 /// One entity.
 #[derive(Debug, Clone, Serialize)]
@@ -74,10 +74,18 @@ pub struct Inspection {
 pub fn inspect(file: &str, r: &Recording) -> Inspection {
     let scenario = recorded_scenario(r);
     let dt = scenario.as_ref().map(|s| s.dt);
-    let steps_recorded = r.series.get(&crate::signals::state(0)).map_or(0, |s| s.values.len() as u64);
+    let steps_recorded = r
+        .series
+        .get(&crate::signals::state(0))
+        .map_or(0, |s| s.values.len() as u64);
     // What the run completed: as its writer stored it, else (a killed writer's file) the last
     // step anything was recorded at — a thinned or filtered recording holds fewer rows.
-    let last_step = r.series.values().filter_map(|s| s.steps.last()).max().map_or(0, |&k| k.max(-1) + 1) as u64;
+    let last_step = r
+        .series
+        .values()
+        .filter_map(|s| s.steps.last())
+        .max()
+        .map_or(0, |&k| k.max(-1) + 1) as u64;
     let steps_completed = r.steps_completed.unwrap_or(last_step);
     let steps_planned = scenario.as_ref().map(|s| s.steps);
     let mut warnings = Vec::new();
@@ -90,25 +98,43 @@ pub fn inspect(file: &str, r: &Recording) -> Inspection {
     if let Some(planned) = steps_planned
         && steps_completed < planned
     {
-        warnings.push(format!("the run stopped early: {steps_completed} of {planned} steps completed"));
+        warnings.push(format!(
+            "the run stopped early: {steps_completed} of {planned} steps completed"
+        ));
     }
     let entities = r
         .series
         .iter()
         .map(|(path, s)| {
-            let steps = [s.steps.first().copied().unwrap_or(0), s.steps.last().copied().unwrap_or(0)];
-            EntityInfo { path: path.clone(), rows: s.values.len(), steps, sim_time: dt.map(|dt| [steps[0] as f64 * dt, steps[1] as f64 * dt]) }
+            let steps = [
+                s.steps.first().copied().unwrap_or(0),
+                s.steps.last().copied().unwrap_or(0),
+            ];
+            EntityInfo {
+                path: path.clone(),
+                rows: s.values.len(),
+                steps,
+                sim_time: dt.map(|dt| [steps[0] as f64 * dt, steps[1] as f64 * dt]),
+            }
         })
         .collect();
     // The tail as the run defined it: the last quarter of the steps it completed.
-    let tail_start = crate::write::tail::tail_start(steps_completed, steps_planned.unwrap_or(steps_completed)).map(|s| s as i64);
+    let tail_start =
+        crate::write::tail::tail_start(steps_completed, steps_planned.unwrap_or(steps_completed))
+            .map(|s| s as i64);
     let tail_max = |prefix: &str| -> Option<f64> {
         let start = tail_start?;
         Some(
             r.series
                 .iter()
                 .filter(|(p, _)| p.starts_with(prefix))
-                .flat_map(|(_, s)| s.steps.iter().zip(&s.values).filter(|(k, _)| **k >= start).map(|(_, v)| v.abs()))
+                .flat_map(|(_, s)| {
+                    s.steps
+                        .iter()
+                        .zip(&s.values)
+                        .filter(|(k, _)| **k >= start)
+                        .map(|(_, v)| v.abs())
+                })
                 .fold(0.0, nan_max),
         )
     };
@@ -133,7 +159,15 @@ pub fn inspect(file: &str, r: &Recording) -> Inspection {
         .series
         .keys()
         .filter(|p| p.starts_with("/latency/") && p.as_str() != "/latency/step")
-        .map(|p| (r.names.get(p).cloned().unwrap_or_else(|| p.trim_start_matches("/latency/").to_string()), percentiles(p)))
+        .map(|p| {
+            (
+                r.names
+                    .get(p)
+                    .cloned()
+                    .unwrap_or_else(|| p.trim_start_matches("/latency/").to_string()),
+                percentiles(p),
+            )
+        })
         .collect();
     Inspection {
         file: file.to_string(),
@@ -144,7 +178,10 @@ pub fn inspect(file: &str, r: &Recording) -> Inspection {
         steps_completed,
         entities,
         observers,
-        latency_ns: LatencyFigures { step: percentiles("/latency/step"), hops },
+        latency_ns: LatencyFigures {
+            step: percentiles("/latency/step"),
+            hops,
+        },
         warnings,
     }
 }
@@ -156,26 +193,53 @@ impl Inspection {
             "{}: {} ({}), {} steps completed{}, {} recorded\n",
             self.file,
             self.scenario.as_deref().unwrap_or("unknown scenario"),
-            if self.complete { "complete" } else { "INCOMPLETE" },
+            if self.complete {
+                "complete"
+            } else {
+                "INCOMPLETE"
+            },
             self.steps_completed,
-            self.steps_planned.map_or(String::new(), |p| format!(" of {p}")),
+            self.steps_planned
+                .map_or(String::new(), |p| format!(" of {p}")),
             self.steps_recorded
         );
         for w in &self.warnings {
             t += &format!("warning: {w}\n");
         }
-        t += &format!("  {:<42} {:>8} {:>18} {:>22}\n", "entity", "rows", "steps", "sim_time [s]");
+        t += &format!(
+            "  {:<42} {:>8} {:>18} {:>22}\n",
+            "entity", "rows", "steps", "sim_time [s]"
+        );
         for e in &self.entities {
-            let time = e.sim_time.map_or("-".to_string(), |[a, b]| format!("{a} … {b}"));
-            t += &format!("  {:<42} {:>8} {:>18} {:>22}\n", e.path, e.rows, format!("{} … {}", e.steps[0], e.steps[1]), time);
+            let time = e
+                .sim_time
+                .map_or("-".to_string(), |[a, b]| format!("{a} … {b}"));
+            t += &format!(
+                "  {:<42} {:>8} {:>18} {:>22}\n",
+                e.path,
+                e.rows,
+                format!("{} … {}", e.steps[0], e.steps[1]),
+                time
+            );
         }
-        t += &format!("  {:<14} {:>14} {:>14}\n", "observer", "tail max|e|", "tail max|r|");
+        t += &format!(
+            "  {:<14} {:>14} {:>14}\n",
+            "observer", "tail max|e|", "tail max|r|"
+        );
         for o in &self.observers {
-            t += &format!("  {:<14} {:>14} {:>14}\n", o.name, figure(o.tail_max_abs_error), figure(o.tail_max_abs_residual));
+            t += &format!(
+                "  {:<14} {:>14} {:>14}\n",
+                o.name,
+                figure(o.tail_max_abs_error),
+                figure(o.tail_max_abs_residual)
+            );
         }
         let p = &self.latency_ns.step;
         if p.max > 0 {
-            t += &format!("  step latency [ns]: p50 {}  p90 {}  p99 {}  p99.9 {}  max {}\n", p.p50, p.p90, p.p99, p.p999, p.max);
+            t += &format!(
+                "  step latency [ns]: p50 {}  p90 {}  p99 {}  p99.9 {}  max {}\n",
+                p.p50, p.p90, p.p99, p.p999, p.max
+            );
             for (h, p) in &self.latency_ns.hops {
                 t += &format!("    {h:<30} p50 {}  p99 {}  max {}\n", p.p50, p.p99, p.max);
             }

@@ -17,4 +17,4 @@ pub mod tools;
 pub mod write;
 
 pub use digest::Integrity;
-pub use read::{read, Recording, Series};
+pub use read::{Recording, Series, read};

@@ -35,7 +35,12 @@ pub fn shade(base: Rgb, i: usize) -> Rgb {
     let t = T[i % T.len()];
     base.map(|c| {
         let c = c as f64;
-        (if t < 0.0 { c * (1.0 + t) } else { c + (255.0 - c) * t }).round() as u8
+        (if t < 0.0 {
+            c * (1.0 + t)
+        } else {
+            c + (255.0 - c) * t
+        })
+        .round() as u8
     })
 }
 
@@ -84,17 +89,38 @@ pub fn viewer_width(path: &str, observers: &[String]) -> f32 {
 pub fn line(path: &str, observers: &[String]) -> Line {
     let thin = |color| Line { color, width: THIN };
     let parts: Vec<&str> = path.trim_start_matches('/').split('/').collect();
-    let k = parts.last().and_then(|s| s.parse::<usize>().ok()).map_or(0, |k| k.saturating_sub(1));
-    let observer = |name: &str| color(observers.iter().position(|o| o == name).unwrap_or(observers.len()));
+    let k = parts
+        .last()
+        .and_then(|s| s.parse::<usize>().ok())
+        .map_or(0, |k| k.saturating_sub(1));
+    let observer = |name: &str| {
+        color(
+            observers
+                .iter()
+                .position(|o| o == name)
+                .unwrap_or(observers.len()),
+        )
+    };
     match parts.as_slice() {
-        ["plant", "x", _] => Line { color: TRUE_STATE, width: nested(observers.len().saturating_sub(1)) + TRUE_MARGIN },
+        ["plant", "x", _] => Line {
+            color: TRUE_STATE,
+            width: nested(observers.len().saturating_sub(1)) + TRUE_MARGIN,
+        },
         ["observer", o, "xhat", _] => {
-            let later = observers.iter().position(|x| x == o).map_or(0, |i| observers.len() - 1 - i);
-            Line { color: observer(o), width: nested(later) }
+            let later = observers
+                .iter()
+                .position(|x| x == o)
+                .map_or(0, |i| observers.len() - 1 - i);
+            Line {
+                color: observer(o),
+                width: nested(later),
+            }
         }
         ["plant", "y", _] | ["disturbance", _] | ["input", _] => thin(color(k)),
         // Beside w and r in their views, from the other end of the palette.
-        ["measurement_disturbance", _] | ["controller", "u", _] => thin(color(PALETTE.len() - 1 - k)),
+        ["measurement_disturbance", _] | ["controller", "u", _] => {
+            thin(color(PALETTE.len() - 1 - k))
+        }
         ["observer", o, "error" | "residual", _] => thin(shade(observer(o), k)),
         // ŵ_k beside w_k (which has the palette's k-th colour): the observer's colour, darkened.
         ["observer", o, "what", _] => thin(shade(observer(o), 1 + k)),
@@ -103,7 +129,9 @@ pub fn line(path: &str, observers: &[String]) -> Line {
         ["latency", hop] => {
             // plant_to_observer_<o>, observer_<o>_to_controller, controller_to_plant.
             let to_observer = hop.strip_prefix("plant_to_observer_");
-            let from_observer = hop.strip_prefix("observer_").and_then(|h| h.strip_suffix("_to_controller"));
+            let from_observer = hop
+                .strip_prefix("observer_")
+                .and_then(|h| h.strip_suffix("_to_controller"));
             match (to_observer, from_observer) {
                 (Some(o), _) => thin(observer(o)),
                 (_, Some(o)) => thin(shade(observer(o), 1)),
@@ -123,7 +151,11 @@ mod tests {
     fn every_colour_contrasts_with_white() {
         let lin = |c: u8| {
             let c = c as f64 / 255.0;
-            if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+            if c <= 0.04045 {
+                c / 12.92
+            } else {
+                ((c + 0.055) / 1.055).powf(2.4)
+            }
         };
         let lum = |c: Rgb| 0.2126 * lin(c[0]) + 0.7152 * lin(c[1]) + 0.0722 * lin(c[2]);
         for c in PALETTE.iter().copied().chain([TRUE_STATE]) {
@@ -142,19 +174,32 @@ mod tests {
         let obs = ["uio".to_string(), "luenberger".to_string()];
         let c = line("/observer/luenberger/xhat/2", &obs).color;
         assert_eq!(c, color(1));
-        assert_eq!(line("/observer/luenberger/log10_max_abs_error", &obs).color, c);
+        assert_eq!(
+            line("/observer/luenberger/log10_max_abs_error", &obs).color,
+            c
+        );
         assert_eq!(line("/observer/luenberger/error/1", &obs).color, c);
-        assert_ne!(line("/observer/luenberger/error/2", &obs).color, line("/observer/luenberger/error/3", &obs).color);
+        assert_ne!(
+            line("/observer/luenberger/error/2", &obs).color,
+            line("/observer/luenberger/error/3", &obs).color
+        );
         assert_eq!(line("/latency/plant_to_observer_luenberger", &obs).color, c);
         assert_eq!(line("/plant/x/1", &obs).color, TRUE_STATE);
-        assert_ne!(line("/input/1", &obs).color, line("/controller/u/1", &obs).color);
+        assert_ne!(
+            line("/input/1", &obs).color,
+            line("/controller/u/1", &obs).color
+        );
     }
 
     /// What is drawn first is wider than what is drawn over it: in a PNG the truth, then the
     /// observers in scenario order; in the viewer the observers in name order, then the truth.
     #[test]
     fn lines_drawn_first_are_wider() {
-        let obs = ["uio".to_string(), "luenberger".to_string(), "dgo".to_string()];
+        let obs = [
+            "uio".to_string(),
+            "luenberger".to_string(),
+            "dgo".to_string(),
+        ];
         let png = |p: &str| line(p, &obs).width;
         assert!(png("/plant/x/1") > png("/observer/uio/xhat/1"));
         assert!(png("/observer/uio/xhat/1") > png("/observer/luenberger/xhat/1"));

@@ -14,7 +14,7 @@ use std::sync::Once;
 use plotters::style::FontStyle;
 use scenario::{Named, Scenario};
 
-pub use figure::{Curve, Figure, Scale, SIZE};
+pub use figure::{Curve, Figure, SIZE, Scale};
 pub use select::{Matcher, PlotSelection};
 
 use crate::palette;
@@ -74,8 +74,16 @@ fn decimate(points: &[(f64, f64)], width: usize) -> Vec<(f64, f64)> {
 /// that every k here has a component k − 1.
 fn members(r: &Recording, group: &str) -> Vec<(usize, String)> {
     let prefix = format!("{group}/");
-    let mut v: Vec<(usize, String)> =
-        r.series.keys().filter_map(|p| p.strip_prefix(&prefix).and_then(|m| m.parse().ok()).filter(|&k: &usize| k >= 1).map(|k| (k, p.clone()))).collect();
+    let mut v: Vec<(usize, String)> = r
+        .series
+        .keys()
+        .filter_map(|p| {
+            p.strip_prefix(&prefix)
+                .and_then(|m| m.parse().ok())
+                .filter(|&k: &usize| k >= 1)
+                .map(|k| (k, p.clone()))
+        })
+        .collect();
     v.sort();
     v
 }
@@ -93,44 +101,128 @@ fn common_unit(what: &str, units: &[String]) -> String {
 /// write nothing, "File name too long"). The files stay distinct by their index or by names
 /// that are distinct within their 64 first characters (observers' and diagnosers' are at most 64).
 fn sanitize(s: &str) -> String {
-    s.chars().take(NAME_IN_FILE).map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect()
+    s.chars()
+        .take(NAME_IN_FILE)
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
 }
 
 /// The longest name a plot's file name carries.
 const NAME_IN_FILE: usize = 64;
 
 fn views(r: &Recording, s: Option<&Scenario>, observers: &[String]) -> Vec<View> {
-    let named = |path: &str| signals::named(s, path).unwrap_or_else(|| Named { name: r.names.get(path).cloned().unwrap_or_else(|| path.to_string()), unit: String::new() });
+    let named = |path: &str| {
+        signals::named(s, path).unwrap_or_else(|| Named {
+            name: r
+                .names
+                .get(path)
+                .cloned()
+                .unwrap_or_else(|| path.to_string()),
+            unit: String::new(),
+        })
+    };
     let legend = |path: &str| named(path).with_unit();
     // "e3: eta [rad]" for a named state, "e3 [rad]" for one with the default name.
-    let tagged = |tag: String, of: Named, default: String| match (of.name == default, of.unit.is_empty()) {
-        (true, true) => tag,
-        (true, false) => format!("{tag} [{}]", of.unit),
-        (false, _) => format!("{tag}: {}", of.with_unit()),
-    };
+    let tagged =
+        |tag: String, of: Named, default: String| match (of.name == default, of.unit.is_empty()) {
+            (true, true) => tag,
+            (true, false) => format!("{tag} [{}]", of.unit),
+            (false, _) => format!("{tag}: {}", of.with_unit()),
+        };
     let mut out = Vec::new();
     for (k, path) in members(r, "/plant/x") {
         let x = named(&path);
         let mut series = vec![(format!("{} (true)", x.name), path.clone())];
-        series.extend(observers.iter().map(|o| (format!("{} ({o})", x.name), signals::estimate(o, k - 1))));
-        let title = if x.name == format!("x{k}") { format!("x{k} — true and estimated") } else { format!("x{k}: {} — true and estimated", x.name) };
-        out.push(View { file: format!("state_{k}_{}.png", sanitize(&x.name)), title, y_label: x.with_unit(), scale: Scale::Linear, series });
+        series.extend(
+            observers
+                .iter()
+                .map(|o| (format!("{} ({o})", x.name), signals::estimate(o, k - 1))),
+        );
+        let title = if x.name == format!("x{k}") {
+            format!("x{k} — true and estimated")
+        } else {
+            format!("x{k}: {} — true and estimated", x.name)
+        };
+        out.push(View {
+            file: format!("state_{k}_{}.png", sanitize(&x.name)),
+            title,
+            y_label: x.with_unit(),
+            scale: Scale::Linear,
+            series,
+        });
     }
-    let state_units: Vec<String> = members(r, "/plant/x").iter().map(|(_, p)| named(p).unit).collect();
+    let state_units: Vec<String> = members(r, "/plant/x")
+        .iter()
+        .map(|(_, p)| named(p).unit)
+        .collect();
     if !observers.is_empty() {
-        let series = observers.iter().map(|o| (format!("max |e| ({o})"), signals::log_error(o))).collect();
-        let title = format!("max_i |e_i| of every observer, log scale (0 drawn at {:e})", signals::LOG_FLOOR);
-        out.push(View { file: "errors_log.png".into(), title, y_label: common_unit("max |e|", &state_units), scale: Scale::Log, series });
+        let series = observers
+            .iter()
+            .map(|o| (format!("max |e| ({o})"), signals::log_error(o)))
+            .collect();
+        let title = format!(
+            "max_i |e_i| of every observer, log scale (0 drawn at {:e})",
+            signals::LOG_FLOOR
+        );
+        out.push(View {
+            file: "errors_log.png".into(),
+            title,
+            y_label: common_unit("max |e|", &state_units),
+            scale: Scale::Log,
+            series,
+        });
     }
     for o in observers {
         let errors = members(r, &format!("/observer/{o}/error"));
         let units: Vec<String> = errors.iter().map(|(_, p)| named(p).unit).collect();
-        let series = errors.iter().map(|(k, p)| (tagged(format!("e{k}"), named(&signals::state(k - 1)), format!("x{k}")), p.clone())).collect();
-        out.push(View { file: format!("error_{}.png", sanitize(o)), title: format!("estimation error e = x − xhat ({o})"), y_label: common_unit("e", &units), scale: Scale::Linear, series });
+        let series = errors
+            .iter()
+            .map(|(k, p)| {
+                (
+                    tagged(
+                        format!("e{k}"),
+                        named(&signals::state(k - 1)),
+                        format!("x{k}"),
+                    ),
+                    p.clone(),
+                )
+            })
+            .collect();
+        out.push(View {
+            file: format!("error_{}.png", sanitize(o)),
+            title: format!("estimation error e = x − xhat ({o})"),
+            y_label: common_unit("e", &units),
+            scale: Scale::Linear,
+            series,
+        });
         let residuals = members(r, &format!("/observer/{o}/residual"));
         let units: Vec<String> = residuals.iter().map(|(_, p)| named(p).unit).collect();
-        let series = residuals.iter().map(|(k, p)| (tagged(format!("r{k}"), named(&signals::output(k - 1)), format!("y{k}")), p.clone())).collect();
-        out.push(View { file: format!("residual_{}.png", sanitize(o)), title: format!("residual r = y − C·xhat ({o})"), y_label: common_unit("r", &units), scale: Scale::Linear, series });
+        let series = residuals
+            .iter()
+            .map(|(k, p)| {
+                (
+                    tagged(
+                        format!("r{k}"),
+                        named(&signals::output(k - 1)),
+                        format!("y{k}"),
+                    ),
+                    p.clone(),
+                )
+            })
+            .collect();
+        out.push(View {
+            file: format!("residual_{}.png", sanitize(o)),
+            title: format!("residual r = y − C·xhat ({o})"),
+            y_label: common_unit("r", &units),
+            scale: Scale::Linear,
+            series,
+        });
         // A UIO's ŵ beside the true w it estimates.
         let estimates = members(r, &format!("/observer/{o}/what"));
         if !estimates.is_empty() {
@@ -142,28 +234,82 @@ fn views(r: &Recording, s: Option<&Scenario>, observers: &[String]) -> Vec<View>
                 series.push((format!("{} estimate ({o})", w.name), p.clone()));
                 units.push(w.unit);
             }
-            out.push(View { file: format!("input_estimate_{}.png", sanitize(o)), title: format!("unknown inputs w and their estimate ŵ ({o}; ŵ_k is known at t_(k+1))"), y_label: common_unit("w", &units), scale: Scale::Linear, series });
+            out.push(View {
+                file: format!("input_estimate_{}.png", sanitize(o)),
+                title: format!(
+                    "unknown inputs w and their estimate ŵ ({o}; ŵ_k is known at t_(k+1))"
+                ),
+                y_label: common_unit("w", &units),
+                scale: Scale::Linear,
+                series,
+            });
         }
     }
     let group = |groups: &[&str]| -> (Vec<(String, String)>, Vec<String>) {
-        let paths: Vec<String> = groups.iter().flat_map(|g| members(r, g)).map(|(_, p)| p).collect();
-        (paths.iter().map(|p| (legend(p), p.clone())).collect(), paths.iter().map(|p| named(p).unit).collect())
+        let paths: Vec<String> = groups
+            .iter()
+            .flat_map(|g| members(r, g))
+            .map(|(_, p)| p)
+            .collect();
+        (
+            paths.iter().map(|p| (legend(p), p.clone())).collect(),
+            paths.iter().map(|p| named(p).unit).collect(),
+        )
     };
     let (series, units) = group(&["/disturbance", "/measurement_disturbance"]);
-    out.push(View { file: "unknown_inputs.png".into(), title: "unknown inputs w (state) and v (measurement)".into(), y_label: common_unit("w, v", &units), scale: Scale::Linear, series });
+    out.push(View {
+        file: "unknown_inputs.png".into(),
+        title: "unknown inputs w (state) and v (measurement)".into(),
+        y_label: common_unit("w, v", &units),
+        scale: Scale::Linear,
+        series,
+    });
     let (series, units) = group(&["/input", "/controller/u"]);
-    out.push(View { file: "inputs.png".into(), title: "known inputs r and controller output u".into(), y_label: common_unit("r, u", &units), scale: Scale::Linear, series });
+    out.push(View {
+        file: "inputs.png".into(),
+        title: "known inputs r and controller output u".into(),
+        y_label: common_unit("r, u", &units),
+        scale: Scale::Linear,
+        series,
+    });
     let (series, units) = group(&["/plant/y"]);
-    out.push(View { file: "outputs.png".into(), title: "measured outputs y".into(), y_label: common_unit("y", &units), scale: Scale::Linear, series });
+    out.push(View {
+        file: "outputs.png".into(),
+        title: "measured outputs y".into(),
+        y_label: common_unit("y", &units),
+        scale: Scale::Linear,
+        series,
+    });
     // Diagnosis: per bank its evaluations against their thresholds and its decisions, then the
     // injected faults (legends as recorded).
     let recorded = |prefix: &str| -> Vec<(String, String)> {
-        r.series.keys().filter(|p| p.starts_with(prefix)).map(|p| (r.names.get(p).cloned().unwrap_or_else(|| p.clone()), p.clone())).collect()
+        r.series
+            .keys()
+            .filter(|p| p.starts_with(prefix))
+            .map(|p| {
+                (
+                    r.names.get(p).cloned().unwrap_or_else(|| p.clone()),
+                    p.clone(),
+                )
+            })
+            .collect()
     };
-    let mut banks: Vec<&str> = r.series.keys().filter_map(|p| p.strip_prefix("/diagnosis/").and_then(|x| x.split_once('/')).map(|(d, _)| d)).collect();
+    let mut banks: Vec<&str> = r
+        .series
+        .keys()
+        .filter_map(|p| {
+            p.strip_prefix("/diagnosis/")
+                .and_then(|x| x.split_once('/'))
+                .map(|(d, _)| d)
+        })
+        .collect();
     banks.dedup();
     for d in banks {
-        let series = [recorded(&format!("/diagnosis/{d}/evaluation/")), recorded(&format!("/diagnosis/{d}/threshold/"))].concat();
+        let series = [
+            recorded(&format!("/diagnosis/{d}/evaluation/")),
+            recorded(&format!("/diagnosis/{d}/threshold/")),
+        ]
+        .concat();
         out.push(View {
             file: format!("diagnosis_{}.png", sanitize(d)),
             title: format!("residual evaluations J (solid) and their thresholds (dashed, same colour), log scale ({d})"),
@@ -171,24 +317,68 @@ fn views(r: &Recording, s: Option<&Scenario>, observers: &[String]) -> Vec<View>
             scale: Scale::Log,
             series,
         });
-        let series = [recorded(&format!("/diagnosis/{d}/alarm/")), recorded(&format!("/diagnosis/{d}/isolated"))].concat();
-        out.push(View { file: format!("alarms_{}.png", sanitize(d)), title: format!("alarms and isolated channel ({d}; 0 none, −1 unknown)"), y_label: "alarm, channel".into(), scale: Scale::Linear, series });
+        let series = [
+            recorded(&format!("/diagnosis/{d}/alarm/")),
+            recorded(&format!("/diagnosis/{d}/isolated")),
+        ]
+        .concat();
+        out.push(View {
+            file: format!("alarms_{}.png", sanitize(d)),
+            title: format!("alarms and isolated channel ({d}; 0 none, −1 unknown)"),
+            y_label: "alarm, channel".into(),
+            scale: Scale::Linear,
+            series,
+        });
     }
-    let faults: Vec<(String, String)> = recorded("/fault/").into_iter().filter(|(_, p)| p.ends_with("/value")).collect();
+    let faults: Vec<(String, String)> = recorded("/fault/")
+        .into_iter()
+        .filter(|(_, p)| p.ends_with("/value"))
+        .collect();
     if !faults.is_empty() {
-        out.push(View { file: "faults.png".into(), title: "injected faults (magnitude while active)".into(), y_label: "fault".into(), scale: Scale::Linear, series: faults });
+        out.push(View {
+            file: "faults.png".into(),
+            title: "injected faults (magnitude while active)".into(),
+            y_label: "fault".into(),
+            scale: Scale::Linear,
+            series: faults,
+        });
     }
-    let latency = r.series.keys().filter(|p| p.starts_with("/latency/")).map(|p| (r.names.get(p).cloned().unwrap_or_else(|| p.trim_start_matches("/latency/").to_string()), p.clone())).collect();
-    out.push(View { file: "latency.png".into(), title: "lockstep latency, log scale".into(), y_label: "latency [µs]".into(), scale: Scale::Log, series: latency });
+    let latency = r
+        .series
+        .keys()
+        .filter(|p| p.starts_with("/latency/"))
+        .map(|p| {
+            (
+                r.names
+                    .get(p)
+                    .cloned()
+                    .unwrap_or_else(|| p.trim_start_matches("/latency/").to_string()),
+                p.clone(),
+            )
+        })
+        .collect();
+    out.push(View {
+        file: "latency.png".into(),
+        title: "lockstep latency, log scale".into(),
+        y_label: "latency [µs]".into(),
+        scale: Scale::Log,
+        series: latency,
+    });
     out
 }
 
 /// max_i |e_i| of `o` per step, as log10 (zeros at the floor); from the recorded errors, so
 /// it works for any recording.
 fn log_max_error(r: &Recording, o: &str) -> Option<Series> {
-    let errors: Vec<&Series> = members(r, &format!("/observer/{o}/error")).iter().filter_map(|(_, p)| r.series.get(p)).collect();
+    let errors: Vec<&Series> = members(r, &format!("/observer/{o}/error"))
+        .iter()
+        .filter_map(|(_, p)| r.series.get(p))
+        .collect();
     let first = errors.first()?;
-    let mut out = Series { steps: first.steps.clone(), values: vec![0.0; first.steps.len()] };
+    let mut out = Series {
+        steps: first.steps.clone(),
+        values: vec![0.0; first.steps.len()],
+    };
     for e in &errors {
         // Series of one group share their steps; a shorter one (a killed writer) cuts the rest.
         let n = out.values.len().min(e.values.len());
@@ -198,7 +388,9 @@ fn log_max_error(r: &Recording, o: &str) -> Option<Series> {
             *m = crate::write::nan_max(*m, v.abs());
         }
     }
-    out.values.iter_mut().for_each(|v| *v = signals::log10_floored(*v));
+    out.values
+        .iter_mut()
+        .for_each(|v| *v = signals::log10_floored(*v));
     Some(out)
 }
 
@@ -213,16 +405,31 @@ pub fn figures(r: &Recording, selection: &PlotSelection) -> Result<Vec<(String, 
     let x_label = if dt.is_some() { "t [s]" } else { "step" };
     let observers = crate::signals::observers_of(r.series.keys(), s);
     // The scenario's order gives each observer its colour.
-    let order: Vec<String> = s.map(|s| s.observers.iter().map(|o| o.name.clone()).collect()).unwrap_or_default();
-    let colours: Vec<String> = if order.is_empty() { observers.clone() } else { order };
+    let order: Vec<String> = s
+        .map(|s| s.observers.iter().map(|o| o.name.clone()).collect())
+        .unwrap_or_default();
+    let colours: Vec<String> = if order.is_empty() {
+        observers.clone()
+    } else {
+        order
+    };
     let width = (SIZE.0 as usize).saturating_sub(400);
     let mut out = Vec::new();
     for view in views(r, s, &observers) {
         let mut curves = Vec::new();
         for (label, path) in &view.series {
             let derived = path.ends_with("/log10_max_abs_error");
-            let observer = path.strip_prefix("/observer/").and_then(|p| p.split_once('/')).map(|(o, _)| o);
-            let chosen = sel.entity(path) || (derived && observer.is_some_and(|o| members(r, &format!("/observer/{o}/error")).iter().any(|(_, p)| sel.entity(p))));
+            let observer = path
+                .strip_prefix("/observer/")
+                .and_then(|p| p.split_once('/'))
+                .map(|(o, _)| o);
+            let chosen = sel.entity(path)
+                || (derived
+                    && observer.is_some_and(|o| {
+                        members(r, &format!("/observer/{o}/error"))
+                            .iter()
+                            .any(|(_, p)| sel.entity(p))
+                    }));
             if !chosen {
                 continue;
             }
@@ -243,20 +450,56 @@ pub fn figures(r: &Recording, selection: &PlotSelection) -> Result<Vec<(String, 
             let latency = path.starts_with("/latency/");
             // J spans decades (rounding before a fault, its size after): on a log axis, 0 at the floor.
             let threshold = path.starts_with("/diagnosis/") && path.contains("/threshold/");
-            let evaluation = threshold || (path.starts_with("/diagnosis/") && path.contains("/evaluation/"));
-            let y = |v: f64| if latency { (v * 1e-3).max(LATENCY_FLOOR_US).log10() } else if evaluation { signals::log10_floored(v) } else { v };
-            let points: Vec<(f64, f64)> = series.steps.iter().zip(&series.values).map(|(&k, &v)| (x_of(k), y(v))).filter(|p| sel.time(p.0) && p.1.is_finite()).collect();
+            let evaluation =
+                threshold || (path.starts_with("/diagnosis/") && path.contains("/evaluation/"));
+            let y = |v: f64| {
+                if latency {
+                    (v * 1e-3).max(LATENCY_FLOOR_US).log10()
+                } else if evaluation {
+                    signals::log10_floored(v)
+                } else {
+                    v
+                }
+            };
+            let points: Vec<(f64, f64)> = series
+                .steps
+                .iter()
+                .zip(&series.values)
+                .map(|(&k, &v)| (x_of(k), y(v)))
+                .filter(|p| sel.time(p.0) && p.1.is_finite())
+                .collect();
             if points.is_empty() {
                 continue;
             }
-            curves.push(Curve { label: label.clone(), line: palette::line(path, &colours), points: decimate(&points, width), dashed: threshold });
+            curves.push(Curve {
+                label: label.clone(),
+                line: palette::line(path, &colours),
+                points: decimate(&points, width),
+                dashed: threshold,
+            });
         }
         if !curves.is_empty() {
-            out.push((view.file, Figure { title: view.title, y_label: view.y_label, x_label: x_label.into(), scale: view.scale, curves }));
+            out.push((
+                view.file,
+                Figure {
+                    title: view.title,
+                    y_label: view.y_label,
+                    x_label: x_label.into(),
+                    scale: view.scale,
+                    curves,
+                },
+            ));
         }
     }
     if out.is_empty() {
-        return Err(format!("nothing to plot: no selected signal has data{}", if selection.from.is_some() || selection.to.is_some() { " in the time window" } else { "" }));
+        return Err(format!(
+            "nothing to plot: no selected signal has data{}",
+            if selection.from.is_some() || selection.to.is_some() {
+                " in the time window"
+            } else {
+                ""
+            }
+        ));
     }
     Ok(out)
 }
@@ -283,15 +526,39 @@ mod tests {
     #[test]
     fn a_member_numbered_0_is_left_out_so_no_index_wraps() {
         let mut r = Recording::default();
-        for p in ["/plant/x/0", "/plant/x/1", "/plant/x/2", "/observer/uio/error/0", "/observer/uio/xhat/0"] {
-            r.series.insert(p.into(), Series { steps: vec![0], values: vec![1.0] });
+        for p in [
+            "/plant/x/0",
+            "/plant/x/1",
+            "/plant/x/2",
+            "/observer/uio/error/0",
+            "/observer/uio/xhat/0",
+        ] {
+            r.series.insert(
+                p.into(),
+                Series {
+                    steps: vec![0],
+                    values: vec![1.0],
+                },
+            );
         }
-        assert_eq!(members(&r, "/plant/x"), [(1, "/plant/x/1".to_string()), (2, "/plant/x/2".to_string())]);
+        assert_eq!(
+            members(&r, "/plant/x"),
+            [(1, "/plant/x/1".to_string()), (2, "/plant/x/2".to_string())]
+        );
         assert!(members(&r, "/observer/uio/error").is_empty());
         // Every view of such a recording is built without an index k − 1 wrapping.
         let views = views(&r, None, &["uio".to_string()]);
-        let states: Vec<&str> = views.iter().filter(|v| v.file.starts_with("state_")).map(|v| v.file.as_str()).collect();
+        let states: Vec<&str> = views
+            .iter()
+            .filter(|v| v.file.starts_with("state_"))
+            .map(|v| v.file.as_str())
+            .collect();
         assert_eq!(states.len(), 2, "{states:?}");
-        assert!(views.iter().find(|v| v.file == "error_uio.png").is_some_and(|v| v.series.is_empty()));
+        assert!(
+            views
+                .iter()
+                .find(|v| v.file == "error_uio.png")
+                .is_some_and(|v| v.series.is_empty())
+        );
     }
 }

@@ -14,7 +14,9 @@ use std::fs::File;
 use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
 
-use re_log_encoding::{CachingApplicationIdInjector, CrateVersion, MessageKind, ToApplication as _};
+use re_log_encoding::{
+    CachingApplicationIdInjector, CrateVersion, MessageKind, ToApplication as _,
+};
 use rerun::external::re_log_types::LogMsg;
 use rerun::log::Chunk;
 use rerun::{Scalars, SeriesLines, TextDocument};
@@ -70,7 +72,10 @@ pub struct ReadError {
 /// decoder is caught ([`unwind`]): any damage gives [`Integrity::Damaged`] for a file its
 /// writer finished, or an incomplete recording of what was read for one it did not.
 pub fn read(path: &Path) -> Result<Recording, ReadError> {
-    let err = |reason: String| ReadError { path: path.display().to_string(), reason };
+    let err = |reason: String| ReadError {
+        path: path.display().to_string(),
+        reason,
+    };
     let (mut file, len) = scenario::untrusted::open_regular(path).map_err(err)?;
     let tail_footer = has_stream_footer(&mut file, len);
     let mut frames = Frames::new(BufReader::new(file), len);
@@ -95,16 +100,27 @@ pub fn read(path: &Path) -> Result<Recording, ReadError> {
         let item = match unwind::quietly(|| decode(&msg, frames.version(), &mut injector)) {
             Ok(Ok(item)) => item,
             Ok(Err(e)) => {
-                fault = Some(Fault::Bad(format!("the message at byte {} cannot be decoded: {e}", msg.at)));
+                fault = Some(Fault::Bad(format!(
+                    "the message at byte {} cannot be decoded: {e}",
+                    msg.at
+                )));
                 break;
             }
             Err(panic) => {
-                fault = Some(Fault::Bad(format!("the message at byte {} cannot be decoded (the decoder failed: {panic})", msg.at)));
+                fault = Some(Fault::Bad(format!(
+                    "the message at byte {} cannot be decoded (the decoder failed: {panic})",
+                    msg.at
+                )));
                 break;
             }
         };
         match item {
-            Some(Item::Static { path, text, legends, signals }) => {
+            Some(Item::Static {
+                path,
+                text,
+                legends,
+                signals,
+            }) => {
                 if let Some(s) = text {
                     if path.starts_with("/__properties") && path.ends_with("/digest") {
                         stored_digest = Some(s);
@@ -113,10 +129,18 @@ pub fn read(path: &Path) -> Result<Recording, ReadError> {
                     } else if path.starts_with("/__properties") && path.ends_with("/layout") {
                         match s.trim().parse::<u32>() {
                             Ok(v) if (1..=crate::write::LAYOUT).contains(&v) => {}
-                            Ok(v) => return Err(err(format!("recording layout {v} is newer than this reader reads (1 to {}): read it with the version of uio-observers that wrote it", crate::write::LAYOUT))),
+                            Ok(v) => {
+                                return Err(err(format!(
+                                    "recording layout {v} is newer than this reader reads (1 to {}): read it with the version of uio-observers that wrote it",
+                                    crate::write::LAYOUT
+                                )));
+                            }
                             // Not a number: the bytes were damaged.
                             Err(_) => {
-                                fault = Some(Fault::Bad(format!("its layout property '{}' is not a layout number", shown(&s))));
+                                fault = Some(Fault::Bad(format!(
+                                    "its layout property '{}' is not a layout number",
+                                    shown(&s)
+                                )));
                                 break;
                             }
                         }
@@ -124,7 +148,11 @@ pub fn read(path: &Path) -> Result<Recording, ReadError> {
                         rec.scenario = Some(s);
                     }
                 }
-                let names = if signals.is_empty() { vec![path.clone()] } else { signals.clone() };
+                let names = if signals.is_empty() {
+                    vec![path.clone()]
+                } else {
+                    signals.clone()
+                };
                 for (signal, legend) in names.iter().zip(legends) {
                     rec.names.insert(signal.clone(), legend);
                 }
@@ -132,13 +160,22 @@ pub fn read(path: &Path) -> Result<Recording, ReadError> {
                     instances.insert(path, signals);
                 }
             }
-            Some(Item::Rows { path, steps, times, values, width }) => {
+            Some(Item::Rows {
+                path,
+                steps,
+                times,
+                values,
+                width,
+            }) => {
                 let lone = [path.clone()];
                 let signals = instances.get(&path).map_or(&lone[..], |v| &v[..]);
                 let mut digest_rows = Rows::new(&steps, times.as_deref());
                 for (i, signal) in signals.iter().enumerate().take(width) {
                     let column: Vec<f64> = values.iter().skip(i).step_by(width).copied().collect();
-                    read_digests.entry(signal.clone()).or_default().update_rows(&mut digest_rows, column.iter().copied());
+                    read_digests
+                        .entry(signal.clone())
+                        .or_default()
+                        .update_rows(&mut digest_rows, column.iter().copied());
                     let series = rec.series.entry(signal.clone()).or_default();
                     series.steps.extend_from_slice(&steps);
                     series.values.extend(column);
@@ -151,13 +188,17 @@ pub fn read(path: &Path) -> Result<Recording, ReadError> {
     // wrong) after the RRD footer only a finishing writer writes counts as finished too.
     let finished = tail_footer || frames.closing() && matches!(fault, Some(Fault::Bad(_)));
     let problem = match fault {
-        Some(Fault::NotRrd(e)) if !finished => return Err(err(format!("not a Rerun recording: {e}"))),
+        Some(Fault::NotRrd(e)) if !finished => {
+            return Err(err(format!("not a Rerun recording: {e}")));
+        }
         Some(Fault::NotRrd(e)) => Some(format!("its stream header is not Rerun's ({e})")),
         Some(Fault::Bad(what)) => Some(what),
         Some(Fault::Cut(what)) if finished => Some(what),
         // A killed writer's file: read as far as it goes, nothing wrong in it.
         Some(Fault::Cut(_)) => None,
-        None if finished && !frames.footer_ok() => Some("its stream footer is not where the stream ends".into()),
+        None if finished && !frames.footer_ok() => {
+            Some("its stream footer is not where the stream ends".into())
+        }
         None => None,
     }
     .map(|p| shown(&p));
@@ -171,7 +212,9 @@ pub fn read(path: &Path) -> Result<Recording, ReadError> {
     }
     rec.integrity = match (&problem, &stored_digest) {
         // A finished writer's file decodes to its end: anything else is damage.
-        (Some(what), _) if finished => Integrity::Damaged(format!("its writer finished it, but {what}")),
+        (Some(what), _) if finished => {
+            Integrity::Damaged(format!("its writer finished it, but {what}"))
+        }
         (Some(_), _) | (None, None) => Integrity::Absent,
         (None, Some(d)) => digest::verify(&read_digests, rec.scenario.as_deref(), d),
     };
@@ -196,14 +239,29 @@ fn shown(text: &str) -> String {
 enum Item {
     /// A static chunk: a property or the scenario text, and an entity's legends and (layout 2)
     /// the signal behind each instance.
-    Static { path: String, text: Option<String>, legends: Vec<String>, signals: Vec<String> },
+    Static {
+        path: String,
+        text: Option<String>,
+        legends: Vec<String>,
+        signals: Vec<String>,
+    },
     /// Rows of one entity: steps, sim_time in ns where recorded, and `width` values a row
     /// (row-major; a short row is padded with NaN).
-    Rows { path: String, steps: Vec<i64>, times: Option<Vec<i64>>, values: Vec<f64>, width: usize },
+    Rows {
+        path: String,
+        steps: Vec<i64>,
+        times: Option<Vec<i64>>,
+        values: Vec<f64>,
+        width: usize,
+    },
 }
 
 /// Decodes one message, its lengths checked first; None for what is not a recording's chunk.
-fn decode(msg: &Message, version: Option<CrateVersion>, injector: &mut CachingApplicationIdInjector) -> Result<Option<Item>, String> {
+fn decode(
+    msg: &Message,
+    version: Option<CrateVersion>,
+    injector: &mut CachingApplicationIdInjector,
+) -> Result<Option<Item>, String> {
     use re_log_encoding::Decodable as _;
     use re_protos::log_msg::v1alpha1 as proto;
     let e = |e: re_log_encoding::CodecError| e.to_string();
@@ -213,11 +271,17 @@ fn decode(msg: &Message, version: Option<CrateVersion>, injector: &mut CachingAp
             payload::check(&arrow)?;
             proto::log_msg::Msg::ArrowMsg(arrow)
         }
-        MessageKind::SetStoreInfo => proto::log_msg::Msg::SetStoreInfo(proto::SetStoreInfo::from_rrd_bytes(&msg.payload).map_err(e)?),
-        MessageKind::BlueprintActivationCommand => proto::log_msg::Msg::BlueprintActivationCommand(proto::BlueprintActivationCommand::from_rrd_bytes(&msg.payload).map_err(e)?),
+        MessageKind::SetStoreInfo => proto::log_msg::Msg::SetStoreInfo(
+            proto::SetStoreInfo::from_rrd_bytes(&msg.payload).map_err(e)?,
+        ),
+        MessageKind::BlueprintActivationCommand => proto::log_msg::Msg::BlueprintActivationCommand(
+            proto::BlueprintActivationCommand::from_rrd_bytes(&msg.payload).map_err(e)?,
+        ),
         MessageKind::End => return Ok(None),
     };
-    let LogMsg::ArrowMsg(store, arrow) = transport.to_application((injector, version)).map_err(e)? else {
+    let LogMsg::ArrowMsg(store, arrow) =
+        transport.to_application((injector, version)).map_err(e)?
+    else {
         return Ok(None);
     };
     if !store.is_recording() {
@@ -226,19 +290,43 @@ fn decode(msg: &Message, version: Option<CrateVersion>, injector: &mut CachingAp
     let chunk = Chunk::from_arrow_msg(&arrow).map_err(|e| format!("bad chunk: {e}"))?;
     let path = chunk.entity_path().to_string();
     if chunk.is_static() {
-        let all = |c| chunk.iter_slices::<String>(c).next().map(|v| v.into_iter().map(|s| s.to_string()).collect::<Vec<_>>()).unwrap_or_default();
-        let text = all(TextDocument::descriptor_text().component).into_iter().next();
-        return Ok(Some(Item::Static { path, text, legends: all(SeriesLines::descriptor_names().component), signals: all(crate::write::SERIES_COMPONENT.into()) }));
+        let all = |c| {
+            chunk
+                .iter_slices::<String>(c)
+                .next()
+                .map(|v| v.into_iter().map(|s| s.to_string()).collect::<Vec<_>>())
+                .unwrap_or_default()
+        };
+        let text = all(TextDocument::descriptor_text().component)
+            .into_iter()
+            .next();
+        return Ok(Some(Item::Static {
+            path,
+            text,
+            legends: all(SeriesLines::descriptor_names().component),
+            signals: all(crate::write::SERIES_COMPONENT.into()),
+        }));
     }
-    let timeline = |name: &str| chunk.timelines().iter().find(|(n, _)| n.as_str() == name).map(|(_, c)| c.times_raw().to_vec());
+    let timeline = |name: &str| {
+        chunk
+            .timelines()
+            .iter()
+            .find(|(n, _)| n.as_str() == name)
+            .map(|(_, c)| c.times_raw().to_vec())
+    };
     let Some(mut steps) = timeline("step") else {
         return Ok(None);
     };
-    let rows: Vec<&[f64]> = match chunk.components().get_array(crate::write::VALUES_COMPONENT.into()) {
+    let rows: Vec<&[f64]> = match chunk
+        .components()
+        .get_array(crate::write::VALUES_COMPONENT.into())
+    {
         // Layout 2: a list of doubles in each row.
         Some(outer) => lists(outer)?,
         // Layout 1: one scalar in each row.
-        None => chunk.iter_slices::<f64>(Scalars::descriptor_scalars().component).collect(),
+        None => chunk
+            .iter_slices::<f64>(Scalars::descriptor_scalars().component)
+            .collect(),
     };
     if rows.is_empty() {
         return Ok(None);
@@ -251,15 +339,30 @@ fn decode(msg: &Message, version: Option<CrateVersion>, injector: &mut CachingAp
         values.extend_from_slice(r);
         values.extend(std::iter::repeat_n(f64::NAN, width - r.len()));
     }
-    Ok(Some(Item::Rows { path, steps, times: timeline("sim_time"), values, width }))
+    Ok(Some(Item::Rows {
+        path,
+        steps,
+        times: timeline("sim_time"),
+        values,
+        width,
+    }))
 }
 
 /// Each row's list of doubles in a column of layout 2 (its first instance; a row without one is
 /// empty).
 fn lists(outer: &rerun::external::arrow::array::ListArray) -> Result<Vec<&[f64]>, String> {
     use rerun::external::arrow::array::{Array as _, Float64Array, ListArray};
-    let inner = outer.values().as_any().downcast_ref::<ListArray>().ok_or("its values are not lists of lists")?;
-    let doubles = inner.values().as_any().downcast_ref::<Float64Array>().ok_or("its values are not doubles")?.values();
+    let inner = outer
+        .values()
+        .as_any()
+        .downcast_ref::<ListArray>()
+        .ok_or("its values are not lists of lists")?;
+    let doubles = inner
+        .values()
+        .as_any()
+        .downcast_ref::<Float64Array>()
+        .ok_or("its values are not doubles")?
+        .values();
     let (outer_at, inner_at) = (outer.value_offsets(), inner.value_offsets());
     let mut rows = Vec::with_capacity(outer.len());
     for r in 0..outer.len() {
@@ -269,7 +372,11 @@ fn lists(outer: &rerun::external::arrow::array::ListArray) -> Result<Vec<&[f64]>
             continue;
         }
         let (from, to) = (inner_at[a] as usize, inner_at[a + 1] as usize);
-        rows.push(doubles.get(from..to).ok_or("a row's values lie beyond its column")?);
+        rows.push(
+            doubles
+                .get(from..to)
+                .ok_or("a row's values lie beyond its column")?,
+        );
     }
     Ok(rows)
 }
@@ -278,7 +385,9 @@ fn lists(outer: &rerun::external::arrow::array::ListArray) -> Result<Vec<&[f64]>
 /// finished writer leaves.
 fn has_stream_footer(file: &mut File, len: u64) -> bool {
     let mut tail = [0u8; 12];
-    let ok = len >= 12 && file.seek(SeekFrom::Start(len - 12)).is_ok() && file.read_exact(&mut tail).is_ok();
+    let ok = len >= 12
+        && file.seek(SeekFrom::Start(len - 12)).is_ok()
+        && file.read_exact(&mut tail).is_ok();
     let _ = file.seek(SeekFrom::Start(0));
     ok && &tail[..8] == b"RRF2FOOT"
 }
@@ -286,24 +395,37 @@ fn has_stream_footer(file: &mut File, len: u64) -> bool {
 /// Writes series to a new `.rrd` (timeline `step` only) with their digest, e.g. to make a test
 /// recording; a file already at `path` is replaced (a link there removed, not followed).
 pub fn write(path: &Path, rec: &Recording) -> Result<(), String> {
-    use rerun::time::Timeline;
     use rerun::TimeColumn;
+    use rerun::time::Timeline;
     if std::fs::symlink_metadata(path).is_ok() {
-        std::fs::remove_file(path).map_err(|e| format!("{}: cannot replace: {e}", path.display()))?;
+        std::fs::remove_file(path)
+            .map_err(|e| format!("{}: cannot replace: {e}", path.display()))?;
     }
     let sink = crate::write::UncompressedFileSink::create(path)?;
-    let stream = rerun::RecordingStreamBuilder::new("uio-observers").buffered().map_err(|e| e.to_string())?;
+    let stream = rerun::RecordingStreamBuilder::new("uio-observers")
+        .buffered()
+        .map_err(|e| e.to_string())?;
     stream.set_sink(Box::new(sink));
     let mut digests = BTreeMap::new();
     for (entity, series) in &rec.series {
-        let steps = TimeColumn::new(Some(true), Timeline::new_sequence("step"), series.steps.clone().into());
-        let columns = Scalars::new(series.values.iter().copied()).columns_of_unit_batches().map_err(|e| e.to_string())?;
-        stream.send_columns(entity.as_str(), [steps], columns).map_err(|e| e.to_string())?;
+        let steps = TimeColumn::new(
+            Some(true),
+            Timeline::new_sequence("step"),
+            series.steps.clone().into(),
+        );
+        let columns = Scalars::new(series.values.iter().copied())
+            .columns_of_unit_batches()
+            .map_err(|e| e.to_string())?;
+        stream
+            .send_columns(entity.as_str(), [steps], columns)
+            .map_err(|e| e.to_string())?;
         let mut d = digest::Running::default();
         d.update(&series.steps, None, &series.values);
         digests.insert(entity.clone(), d.hex());
     }
-    stream.send_property("digest", &TextDocument::new(digest::to_json(&digests))).map_err(|e| e.to_string())?;
+    stream
+        .send_property("digest", &TextDocument::new(digest::to_json(&digests)))
+        .map_err(|e| e.to_string())?;
     stream.flush_blocking().map_err(|e| e.to_string())?;
     drop(stream);
     Ok(())

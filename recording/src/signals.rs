@@ -67,11 +67,23 @@ pub const LOG_FLOOR: f64 = 1e-18;
 
 /// The observers a recording holds (from its `/observer/<name>/…` entities), in the scenario's
 /// order where it is known — the order that gives each observer its colour — else by name.
-pub fn observers_of<'a>(paths: impl IntoIterator<Item = &'a String>, s: Option<&Scenario>) -> Vec<String> {
-    let mut names: Vec<String> = paths.into_iter().filter_map(|p| p.strip_prefix("/observer/").and_then(|x| x.split_once('/')).map(|(n, _)| n.to_string())).collect();
+pub fn observers_of<'a>(
+    paths: impl IntoIterator<Item = &'a String>,
+    s: Option<&Scenario>,
+) -> Vec<String> {
+    let mut names: Vec<String> = paths
+        .into_iter()
+        .filter_map(|p| {
+            p.strip_prefix("/observer/")
+                .and_then(|x| x.split_once('/'))
+                .map(|(n, _)| n.to_string())
+        })
+        .collect();
     names.sort();
     names.dedup();
-    let order: Vec<&str> = s.map(|s| s.observers.iter().map(|o| o.name.as_str()).collect()).unwrap_or_default();
+    let order: Vec<&str> = s
+        .map(|s| s.observers.iter().map(|o| o.name.as_str()).collect())
+        .unwrap_or_default();
     names.sort_by_key(|n| order.iter().position(|o| o == n).unwrap_or(usize::MAX));
     names
 }
@@ -84,7 +96,11 @@ pub fn figure(v: Option<f64>) -> String {
 
 /// log10 of a max |e|, zeros at the floor (NaN stays NaN: a diverged run shows as a gap).
 pub fn log10_floored(v: f64) -> f64 {
-    if v.is_nan() { v } else { v.max(LOG_FLOOR).log10() }
+    if v.is_nan() {
+        v
+    } else {
+        v.max(LOG_FLOOR).log10()
+    }
 }
 
 /// The name and unit of the signal at `path` in a run of `s`, for CSV headers and axis labels:
@@ -96,7 +112,10 @@ pub fn log10_floored(v: f64) -> f64 {
 pub fn named(s: Option<&Scenario>, path: &str) -> Option<Named> {
     let (group, index) = path.rsplit_once('/')?;
     let i = index.parse::<usize>().ok()?.checked_sub(1)?;
-    let kind = group.strip_prefix("/observer/").and_then(|g| g.split_once('/')).map_or(group, |(_, kind)| kind);
+    let kind = group
+        .strip_prefix("/observer/")
+        .and_then(|g| g.split_once('/'))
+        .map_or(group, |(_, kind)| kind);
     let Some(s) = s else {
         let letter = match kind {
             "/plant/x" | "xhat" => "x",
@@ -108,7 +127,10 @@ pub fn named(s: Option<&Scenario>, path: &str) -> Option<Named> {
             "error" => "e",
             _ => return None,
         };
-        return Some(Named { name: format!("{letter}{}", i + 1), unit: String::new() });
+        return Some(Named {
+            name: format!("{letter}{}", i + 1),
+            unit: String::new(),
+        });
     };
     let n = &s.names;
     let get = |v: &[Named]| v.get(i).cloned();
@@ -119,9 +141,18 @@ pub fn named(s: Option<&Scenario>, path: &str) -> Option<Named> {
         "/disturbance" | "what" => get(&n.disturbance),
         "/measurement_disturbance" => get(&n.measurement_disturbance),
         "/input" => get(&n.input),
-        "/controller/u" => n.input.get(i).map(|r| Named { name: control_name(s, i), unit: r.unit.clone() }),
-        "error" => n.state.get(i).map(|x| Named { name: format!("e{}", i + 1), unit: x.unit.clone() }),
-        "residual" => n.output.get(i).map(|y| Named { name: format!("r{}", i + 1), unit: y.unit.clone() }),
+        "/controller/u" => n.input.get(i).map(|r| Named {
+            name: control_name(s, i),
+            unit: r.unit.clone(),
+        }),
+        "error" => n.state.get(i).map(|x| Named {
+            name: format!("e{}", i + 1),
+            unit: x.unit.clone(),
+        }),
+        "residual" => n.output.get(i).map(|y| Named {
+            name: format!("r{}", i + 1),
+            unit: y.unit.clone(),
+        }),
         _ => None,
     }
 }
@@ -182,7 +213,9 @@ pub fn entity_of(path: &str) -> String {
             Some(name) => format!("/{first}/{name}"),
             None => format!("/{first}"),
         },
-        "plant" | "disturbance" | "measurement_disturbance" | "input" | "fault" => "/plant".to_string(),
+        "plant" | "disturbance" | "measurement_disturbance" | "input" | "fault" => {
+            "/plant".to_string()
+        }
         _ => format!("/{first}"),
     }
 }

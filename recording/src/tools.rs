@@ -6,7 +6,12 @@ use scenario::Scenario;
 /// The scenario text stored in a recording.
 pub fn recorded_text(r: &Recording) -> Option<&str> {
     let text = r.scenario.as_ref()?;
-    Some(text.trim().strip_prefix("```toml")?.strip_suffix("```")?.trim_start_matches('\n'))
+    Some(
+        text.trim()
+            .strip_prefix("```toml")?
+            .strip_suffix("```")?
+            .trim_start_matches('\n'),
+    )
 }
 
 /// The scenario stored in a recording, parsed, if it is there and still valid (a scenario whose
@@ -18,5 +23,11 @@ pub fn recorded_scenario(r: &Recording) -> Option<Scenario> {
 /// The sample period of a recording: its scenario's `dt`, read alone when the whole scenario
 /// cannot be parsed again.
 pub fn recorded_dt(r: &Recording) -> Option<f64> {
-    recorded_scenario(r).map(|s| s.dt).or_else(|| recorded_text(r)?.parse::<toml::Table>().ok()?.get("dt")?.as_float())
+    recorded_scenario(r).map(|s| s.dt).or_else(|| {
+        recorded_text(r)?
+            .parse::<toml::Table>()
+            .ok()?
+            .get("dt")?
+            .as_float()
+    })
 }

@@ -10,7 +10,10 @@ pub fn main() -> ExitCode {
     let run = std::io::stdin()
         .read_to_string(&mut text)
         .map_err(|e| format!("replay_plant --check: stdin: {e}"))
-        .and_then(|_| serde_json::from_str::<replay::Params>(&text).map_err(|e| format!("replay_plant --check: parameters: {e}")))
+        .and_then(|_| {
+            serde_json::from_str::<replay::Params>(&text)
+                .map_err(|e| format!("replay_plant --check: parameters: {e}"))
+        })
         .and_then(|p| replay::load(&p));
     match run {
         Ok(t) => {

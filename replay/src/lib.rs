@@ -21,6 +21,9 @@ pub fn load(p: &Params) -> Result<Table, String> {
         "csv" => csv::load(p),
         "mcap" => mcap::load(p),
         "rrd" => rrd::load(p),
-        other => Err(format!("{}: format {other:?}: a .csv or .mcap log or a run's .rrd", p.path)),
+        other => Err(format!(
+            "{}: format {other:?}: a .csv or .mcap log or a run's .rrd",
+            p.path
+        )),
     }
 }

@@ -45,6 +45,8 @@ pub struct Params {
 impl Params {
     /// The file's name, for messages.
     pub fn file(&self) -> String {
-        std::path::Path::new(&self.path).file_name().map_or(self.path.clone(), |f| f.to_string_lossy().into_owned())
+        std::path::Path::new(&self.path)
+            .file_name()
+            .map_or(self.path.clone(), |f| f.to_string_lossy().into_owned())
     }
 }

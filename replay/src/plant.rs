@@ -5,8 +5,8 @@
 //! slots are computed from `[[fault]]` as the built-in plant computes them (plant::Sensing),
 //! so that detection delays are measured against the fault the data is said to hold.
 
-use lockstep::component::{Component, ComponentConfig, Inputs, StepError};
 use lockstep::PlantLayout;
+use lockstep::component::{Component, ComponentConfig, Inputs, StepError};
 use plant::{PlantConfig, Sensing};
 use replay::{Params, Table};
 
@@ -21,12 +21,39 @@ impl Component for ReplayPlant {
     fn new(cfg: &ComponentConfig) -> Result<Self, String> {
         let p: Params = cfg.params()?;
         let s = PlantConfig::from_protocol(cfg)?;
-        let lay = PlantLayout { n: s.a.rows, p: s.c.rows, q: s.e.cols, r: s.d.cols, l: s.b.cols, f: s.faults.len() };
-        if (p.n, p.p, p.q, p.r, p.l) != (lay.n, lay.p, lay.q, lay.r, lay.l) || p.steps != cfg.steps {
-            return Err(format!("{}: the parameters are for n = {}, p = {}, l = {}, q = {}, r = {}, {} steps; the run has n = {}, p = {}, l = {}, q = {}, r = {}, {} steps", p.file(), p.n, p.p, p.l, p.q, p.r, p.steps, lay.n, lay.p, lay.l, lay.q, lay.r, cfg.steps));
+        let lay = PlantLayout {
+            n: s.a.rows,
+            p: s.c.rows,
+            q: s.e.cols,
+            r: s.d.cols,
+            l: s.b.cols,
+            f: s.faults.len(),
+        };
+        if (p.n, p.p, p.q, p.r, p.l) != (lay.n, lay.p, lay.q, lay.r, lay.l) || p.steps != cfg.steps
+        {
+            return Err(format!(
+                "{}: the parameters are for n = {}, p = {}, l = {}, q = {}, r = {}, {} steps; the run has n = {}, p = {}, l = {}, q = {}, r = {}, {} steps",
+                p.file(),
+                p.n,
+                p.p,
+                p.l,
+                p.q,
+                p.r,
+                p.steps,
+                lay.n,
+                lay.p,
+                lay.l,
+                lay.q,
+                lay.r,
+                cfg.steps
+            ));
         }
         let table = replay::load(&p)?;
-        Ok(ReplayPlant { table, sensing: Sensing::new(&s)?, lay })
+        Ok(ReplayPlant {
+            table,
+            sensing: Sensing::new(&s)?,
+            lay,
+        })
     }
 
     fn step(&mut self, k: u64, _inputs: &Inputs, out: &mut [f64]) -> Result<(), StepError> {

@@ -57,7 +57,9 @@ impl Table {
 /// Refuses data shorter than the run: every step k = 0 … K − 1 needs its own sample.
 pub fn enough(file: &str, have: u64, what: &str, steps: u64) -> Result<(), String> {
     if have < steps {
-        return Err(format!("{file}: {have} {what}; the scenario runs {steps} steps (duration / dt) and needs one per step"));
+        return Err(format!(
+            "{file}: {have} {what}; the scenario runs {steps} steps (duration / dt) and needs one per step"
+        ));
     }
     Ok(())
 }

@@ -4,14 +4,14 @@
 use std::collections::BTreeSet;
 
 use diagnosis::{Channels, DiagnoserSpec, Evaluation, MemberKind, Scheme, Threshold};
-use lti::signal::{locate, Switch};
+use lti::signal::{Switch, locate};
 use lti::{Mat, Model};
 use plant::fault::{Fault, Kind, Profile, Target};
 
 use super::limits::{MAX_CALIBRATION_RUNS, MAX_WINDOW};
 use super::raw::{RawDiagnoser, RawFault, RawNoise};
 use super::untrusted::quoted;
-use super::validate::{bad, check_name, definite, finite, matrix, placement, poles, Bad};
+use super::validate::{Bad, bad, check_name, definite, finite, matrix, placement, poles};
 
 /// The run's noise: the per-step covariances the plant draws from and the Kalman filter uses.
 #[derive(Debug, Clone, PartialEq)]
@@ -24,30 +24,66 @@ pub struct NoiseSpec {
 
 /// A covariance named `symbol` (Q_c, Q_d, R): of the size asked, and symmetric ⪰ 0 by the rule
 /// the Riccati and Van Loan code applies to its arguments ([`lti::dare::symmetric`]).
-fn covariance(field: &str, symbol: &str, rows: &super::raw::Rows, size: Option<usize>, why: &str) -> Result<Mat, Bad> {
+fn covariance(
+    field: &str,
+    symbol: &str,
+    rows: &super::raw::Rows,
+    size: Option<usize>,
+    why: &str,
+) -> Result<Mat, Bad> {
     let m = matrix(field, rows, (size, size), why)?;
     definite(field, symbol, &m, lti::dare::Definite::Semi)
 }
 
 /// `[noise]`, with Q_d computed from the continuous intensity by Van Loan's method.
-pub(crate) fn noise(raw: &Option<RawNoise>, model: &Model, dt: f64) -> Result<Option<NoiseSpec>, Bad> {
+pub(crate) fn noise(
+    raw: &Option<RawNoise>,
+    model: &Model,
+    dt: f64,
+) -> Result<Option<NoiseSpec>, Bad> {
     let Some(z) = raw else { return Ok(None) };
     let (n, p) = (model.n(), model.p());
     let qd = match (&z.process, &z.process_discrete) {
-        (Some(_), Some(_)) => return Err(bad("noise.process_discrete", "give process (continuous intensity) or process_discrete, not both")),
+        (Some(_), Some(_)) => {
+            return Err(bad(
+                "noise.process_discrete",
+                "give process (continuous intensity) or process_discrete, not both",
+            ));
+        }
         (Some(qc), None) => {
             let g = match &z.g {
-                Some(g) => matrix("noise.G", g, (Some(n), None), "n rows, one column per process-noise input")?,
+                Some(g) => matrix(
+                    "noise.G",
+                    g,
+                    (Some(n), None),
+                    "n rows, one column per process-noise input",
+                )?,
                 None => Mat::identity(n, n),
             };
-            let qc = covariance("noise.process", "Q_c", qc, Some(g.ncols()), "one row and column per column of noise.G")?;
-            lti::process_noise_covariance(&model.a, &g, &qc, dt).map_err(|e| bad("noise.process", e.to_string()))?
+            let qc = covariance(
+                "noise.process",
+                "Q_c",
+                qc,
+                Some(g.ncols()),
+                "one row and column per column of noise.G",
+            )?;
+            lti::process_noise_covariance(&model.a, &g, &qc, dt)
+                .map_err(|e| bad("noise.process", e.to_string()))?
         }
         (None, Some(qd)) => {
             if z.g.is_some() {
-                return Err(bad("noise.G", "G shapes the continuous intensity `process`; process_discrete is the state's own covariance"));
+                return Err(bad(
+                    "noise.G",
+                    "G shapes the continuous intensity `process`; process_discrete is the state's own covariance",
+                ));
             }
-            covariance("noise.process_discrete", "Q_d", qd, Some(n), "n×n, the covariance of the state's noise per step")?
+            covariance(
+                "noise.process_discrete",
+                "Q_d",
+                qd,
+                Some(n),
+                "n×n, the covariance of the state's noise per step",
+            )?
         }
         (None, None) => {
             if z.g.is_some() {
@@ -57,7 +93,13 @@ pub(crate) fn noise(raw: &Option<RawNoise>, model: &Model, dt: f64) -> Result<Op
         }
     };
     let r = match &z.measurement {
-        Some(r) => covariance("noise.measurement", "R", r, Some(p), "p×p, one row and column per output")?,
+        Some(r) => covariance(
+            "noise.measurement",
+            "R",
+            r,
+            Some(p),
+            "p×p, one row and column per output",
+        )?,
         None => Mat::zeros(p, p),
     };
     Ok(Some(NoiseSpec { qd, r }))
@@ -71,28 +113,51 @@ fn on_sample(field: &str, t: f64, dt: f64) -> Result<f64, Bad> {
     }
     match locate(t, dt) {
         Switch::OnSample(_) | Switch::Beyond => Ok(t),
-        Switch::Inside { .. } => Err(bad(field, format!("{t} is not a sample time of dt = {dt} (faults switch at samples)"))),
+        Switch::Inside { .. } => Err(bad(
+            field,
+            format!("{t} is not a sample time of dt = {dt} (faults switch at samples)"),
+        )),
     }
 }
 
 /// `[[fault]]`.
-pub(crate) fn faults(raw: &[RawFault], model: &Model, ff: &Mat, dt: f64) -> Result<Vec<Fault>, Bad> {
+pub(crate) fn faults(
+    raw: &[RawFault],
+    model: &Model,
+    ff: &Mat,
+    dt: f64,
+) -> Result<Vec<Fault>, Bad> {
     let mut seen = BTreeSet::new();
     let mut out = Vec::new();
     for (i, f) in raw.iter().enumerate() {
         let at = |key: &str| format!("fault[{}].{key}", i + 1);
         check_name(&at("name"), &f.name, "it names the fault's signals")?;
         if !seen.insert(f.name.clone()) {
-            return Err(bad(at("name"), format!("two faults are named {}", quoted(&f.name))));
+            return Err(bad(
+                at("name"),
+                format!("two faults are named {}", quoted(&f.name)),
+            ));
         }
         let (count, what) = match f.target.as_str() {
             "actuator" => (model.l(), "known inputs (columns of B)"),
             "sensor" => (model.p(), "outputs (rows of C)"),
             "component" => (ff.ncols(), "columns of plant.Ff"),
-            other => return Err(bad(at("target"), format!("{} is not a fault target (actuator, sensor, component){}", quoted(other), crate::suggest::did_you_mean(other, ["actuator", "sensor", "component"])))),
+            other => {
+                return Err(bad(
+                    at("target"),
+                    format!(
+                        "{} is not a fault target (actuator, sensor, component){}",
+                        quoted(other),
+                        crate::suggest::did_you_mean(other, ["actuator", "sensor", "component"])
+                    ),
+                ));
+            }
         };
         if f.channel < 1 || f.channel as usize > count {
-            return Err(bad(at("channel"), format!("{} does not exist: the plant has {count} {what}", f.channel)));
+            return Err(bad(
+                at("channel"),
+                format!("{} does not exist: the plant has {count} {what}", f.channel),
+            ));
         }
         let ch = f.channel as usize - 1;
         let target = match f.target.as_str() {
@@ -106,7 +171,16 @@ pub(crate) fn faults(raw: &[RawFault], model: &Model, ff: &Mat, dt: f64) -> Resu
             Target::Component(_) => &["additive"],
         };
         if !kinds.contains(&f.kind.as_str()) {
-            return Err(bad(at("kind"), format!("{} is not a kind of {} fault ({}){}", quoted(&f.kind), f.target, kinds.join(", "), crate::suggest::did_you_mean(&f.kind, kinds.iter().copied()))));
+            return Err(bad(
+                at("kind"),
+                format!(
+                    "{} is not a kind of {} fault ({}){}",
+                    quoted(&f.kind),
+                    f.target,
+                    kinds.join(", "),
+                    crate::suggest::did_you_mean(&f.kind, kinds.iter().copied())
+                ),
+            ));
         }
         let kind = match f.kind.as_str() {
             "additive" => Kind::Additive,
@@ -118,30 +192,57 @@ pub(crate) fn faults(raw: &[RawFault], model: &Model, ff: &Mat, dt: f64) -> Resu
         };
         let value = finite(&at("value"), f.value)?;
         if kind == Kind::Gain && !(0.0..=1.0).contains(&value) {
-            return Err(bad(at("value"), format!("{value}: the fraction of gain lost is between 0 and 1")));
+            return Err(bad(
+                at("value"),
+                format!("{value}: the fraction of gain lost is between 0 and 1"),
+            ));
         }
         if kind == Kind::Noise && value < 0.0 {
-            return Err(bad(at("value"), format!("{value}: a standard deviation is ≥ 0")));
+            return Err(bad(
+                at("value"),
+                format!("{value}: a standard deviation is ≥ 0"),
+            ));
         }
         let default = if kind == Kind::Drift { "ramp" } else { "step" };
         let profile_name = f.profile.as_deref().unwrap_or(default);
         let ramps = matches!(kind, Kind::Additive | Kind::Bias | Kind::Drift);
         if kind == Kind::Drift && profile_name != "ramp" {
-            return Err(bad(at("profile"), "a drift is a ramp (profile = \"ramp\", or no profile)"));
+            return Err(bad(
+                at("profile"),
+                "a drift is a ramp (profile = \"ramp\", or no profile)",
+            ));
         }
         let profile = match profile_name {
             "step" | "ramp" => {
                 if f.intervals.is_some() {
-                    return Err(bad(at("intervals"), format!("a {profile_name} profile has start and end, not intervals")));
+                    return Err(bad(
+                        at("intervals"),
+                        format!("a {profile_name} profile has start and end, not intervals"),
+                    ));
                 }
-                let start = on_sample(&at("start"), f.start.ok_or_else(|| bad(at("start"), format!("a {profile_name} fault needs start")))?, dt)?;
+                let start = on_sample(
+                    &at("start"),
+                    f.start.ok_or_else(|| {
+                        bad(at("start"), format!("a {profile_name} fault needs start"))
+                    })?,
+                    dt,
+                )?;
                 let end = f.end.map(|e| on_sample(&at("end"), e, dt)).transpose()?;
                 if end.is_some_and(|e| e <= start) {
-                    return Err(bad(at("end"), format!("{} must be after start = {start}", end.unwrap_or(0.0))));
+                    return Err(bad(
+                        at("end"),
+                        format!("{} must be after start = {start}", end.unwrap_or(0.0)),
+                    ));
                 }
                 if profile_name == "ramp" {
                     if !ramps {
-                        return Err(bad(at("profile"), format!("a {} fault cannot ramp (only additive, bias and drift)", f.kind)));
+                        return Err(bad(
+                            at("profile"),
+                            format!(
+                                "a {} fault cannot ramp (only additive, bias and drift)",
+                                f.kind
+                            ),
+                        ));
                     }
                     Profile::Ramp { start, end }
                 } else {
@@ -150,9 +251,21 @@ pub(crate) fn faults(raw: &[RawFault], model: &Model, ff: &Mat, dt: f64) -> Resu
             }
             "intermittent" => {
                 if f.start.is_some() || f.end.is_some() {
-                    return Err(bad(at("start"), "an intermittent fault has intervals = [[on, off], …], not start and end"));
+                    return Err(bad(
+                        at("start"),
+                        "an intermittent fault has intervals = [[on, off], …], not start and end",
+                    ));
                 }
-                let list = f.intervals.as_ref().filter(|l| !l.is_empty()).ok_or_else(|| bad(at("intervals"), "an intermittent fault needs intervals = [[on, off], …]"))?;
+                let list = f
+                    .intervals
+                    .as_ref()
+                    .filter(|l| !l.is_empty())
+                    .ok_or_else(|| {
+                        bad(
+                            at("intervals"),
+                            "an intermittent fault needs intervals = [[on, off], …]",
+                        )
+                    })?;
                 let mut ivs: Vec<[f64; 2]> = Vec::new();
                 for (j, iv) in list.iter().enumerate() {
                     let fj = format!("fault[{}].intervals[{}]", i + 1, j + 1);
@@ -161,35 +274,83 @@ pub(crate) fn faults(raw: &[RawFault], model: &Model, ff: &Mat, dt: f64) -> Resu
                     };
                     let (on, off) = (on_sample(&fj, *on, dt)?, on_sample(&fj, *off, dt)?);
                     if off <= on || ivs.last().is_some_and(|l| on < l[1]) {
-                        return Err(bad(fj, format!("[{on}, {off}] must end after it starts and after the previous interval")));
+                        return Err(bad(
+                            fj,
+                            format!(
+                                "[{on}, {off}] must end after it starts and after the previous interval"
+                            ),
+                        ));
                     }
                     ivs.push([on, off]);
                 }
                 Profile::Intermittent { intervals: ivs }
             }
-            other => return Err(bad(at("profile"), format!("{} is not a profile (step, ramp, intermittent){}", quoted(other), crate::suggest::did_you_mean(other, ["step", "ramp", "intermittent"])))),
+            other => {
+                return Err(bad(
+                    at("profile"),
+                    format!(
+                        "{} is not a profile (step, ramp, intermittent){}",
+                        quoted(other),
+                        crate::suggest::did_you_mean(other, ["step", "ramp", "intermittent"])
+                    ),
+                ));
+            }
         };
-        out.push(Fault { name: f.name.clone(), target, kind, value, profile });
+        out.push(Fault {
+            name: f.name.clone(),
+            target,
+            kind,
+            value,
+            profile,
+        });
     }
     Ok(out)
 }
 
 /// `[[diagnoser]]`; the banks themselves are designed with the observers (launcher `plan`).
-pub(crate) fn diagnosers(raw: &[RawDiagnoser], model: &Model, ff: &Mat, noise: Option<&NoiseSpec>, taken: &mut BTreeSet<String>) -> Result<Vec<DiagnoserSpec>, Bad> {
+pub(crate) fn diagnosers(
+    raw: &[RawDiagnoser],
+    model: &Model,
+    ff: &Mat,
+    noise: Option<&NoiseSpec>,
+    taken: &mut BTreeSet<String>,
+) -> Result<Vec<DiagnoserSpec>, Bad> {
     let mut out = Vec::new();
     for (i, d) in raw.iter().enumerate() {
         let at = |key: &str| format!("diagnoser[{}].{key}", i + 1);
-        check_name(&at("name"), &d.name, "it names the bank's observers and signals")?;
+        check_name(
+            &at("name"),
+            &d.name,
+            "it names the bank's observers and signals",
+        )?;
         let scheme = match d.scheme.as_str() {
             "generalized" => Scheme::Generalized,
             "dedicated" => Scheme::Dedicated,
-            other => return Err(bad(at("scheme"), format!("{} is not a scheme (generalized, dedicated){}", quoted(other), crate::suggest::did_you_mean(other, ["generalized", "dedicated"])))),
+            other => {
+                return Err(bad(
+                    at("scheme"),
+                    format!(
+                        "{} is not a scheme (generalized, dedicated){}",
+                        quoted(other),
+                        crate::suggest::did_you_mean(other, ["generalized", "dedicated"])
+                    ),
+                ));
+            }
         };
         let channels = match d.faults.as_str() {
             "actuator" => Channels::Actuator,
             "sensor" => Channels::Sensor,
             "component" => Channels::Component,
-            other => return Err(bad(at("faults"), format!("{} is not a channel class (actuator, sensor, component){}", quoted(other), crate::suggest::did_you_mean(other, ["actuator", "sensor", "component"])))),
+            other => {
+                return Err(bad(
+                    at("faults"),
+                    format!(
+                        "{} is not a channel class (actuator, sensor, component){}",
+                        quoted(other),
+                        crate::suggest::did_you_mean(other, ["actuator", "sensor", "component"])
+                    ),
+                ));
+            }
         };
         let all = diagnosis::bank::channel_labels(channels, model, ff);
         let subset = match &d.channels {
@@ -198,7 +359,15 @@ pub(crate) fn diagnosers(raw: &[RawDiagnoser], model: &Model, ff: &Mat, noise: O
                 let mut ids = Vec::with_capacity(list.len());
                 for &c in list {
                     if c < 1 || c as usize > all.len() {
-                        return Err(bad(at("channels"), format!("{c} is not a {} channel: they are 1 … {} ({})", channels.name(), all.len(), all.join(", "))));
+                        return Err(bad(
+                            at("channels"),
+                            format!(
+                                "{c} is not a {} channel: they are 1 … {} ({})",
+                                channels.name(),
+                                all.len(),
+                                all.join(", ")
+                            ),
+                        ));
                     }
                     if ids.contains(&(c as usize - 1)) {
                         return Err(bad(at("channels"), format!("{c} is listed twice")));
@@ -206,7 +375,13 @@ pub(crate) fn diagnosers(raw: &[RawDiagnoser], model: &Model, ff: &Mat, noise: O
                     ids.push(c as usize - 1);
                 }
                 if ids.len() < 2 {
-                    return Err(bad(at("channels"), format!("a bank needs at least two channels to isolate between, {} given", ids.len())));
+                    return Err(bad(
+                        at("channels"),
+                        format!(
+                            "a bank needs at least two channels to isolate between, {} given",
+                            ids.len()
+                        ),
+                    ));
                 }
                 ids.sort_unstable();
                 Some(ids)
@@ -218,10 +393,20 @@ pub(crate) fn diagnosers(raw: &[RawDiagnoser], model: &Model, ff: &Mat, noise: O
             let member = format!("{}-{j}", d.name);
             check_name(&at("name"), &member, "it names the bank's observers")?;
             if !taken.insert(member.clone()) {
-                return Err(bad(at("name"), format!("its member {} would share a name with an observer or another member", quoted(&member))));
+                return Err(bad(
+                    at("name"),
+                    format!(
+                        "its member {} would share a name with an observer or another member",
+                        quoted(&member)
+                    ),
+                ));
             }
         }
-        let default = if channels == Channels::Sensor { "luenberger" } else { "chen-patton-uio" };
+        let default = if channels == Channels::Sensor {
+            "luenberger"
+        } else {
+            "chen-patton-uio"
+        };
         let kind = d.observer.as_deref().unwrap_or(default);
         let pole_list = || match &d.poles {
             Some(p) => poles(&at("poles"), p),
@@ -229,21 +414,48 @@ pub(crate) fn diagnosers(raw: &[RawDiagnoser], model: &Model, ff: &Mat, noise: O
         };
         let method = placement(&at("placement"), &d.placement)?;
         let member = match kind {
-            "chen-patton-uio" => MemberKind::ChenPatton { poles: pole_list()?, placement: method },
-            "luenberger" => MemberKind::Luenberger { poles: pole_list()?, placement: method },
+            "chen-patton-uio" => MemberKind::ChenPatton {
+                poles: pole_list()?,
+                placement: method,
+            },
+            "luenberger" => MemberKind::Luenberger {
+                poles: pole_list()?,
+                placement: method,
+            },
             "kalman" => {
                 if d.poles.is_some() {
-                    return Err(bad(at("poles"), "kalman members take no poles (the noise sets them)"));
+                    return Err(bad(
+                        at("poles"),
+                        "kalman members take no poles (the noise sets them)",
+                    ));
                 }
                 if noise.is_none() {
                     return Err(bad(at("observer"), "kalman members need [noise]"));
                 }
                 MemberKind::Kalman
             }
-            other => return Err(bad(at("observer"), format!("{} is not a member design (chen-patton-uio, luenberger, kalman){}", quoted(other), crate::suggest::did_you_mean(other, ["chen-patton-uio", "luenberger", "kalman"])))),
+            other => {
+                return Err(bad(
+                    at("observer"),
+                    format!(
+                        "{} is not a member design (chen-patton-uio, luenberger, kalman){}",
+                        quoted(other),
+                        crate::suggest::did_you_mean(
+                            other,
+                            ["chen-patton-uio", "luenberger", "kalman"]
+                        )
+                    ),
+                ));
+            }
         };
         if channels != Channels::Sensor && kind != "chen-patton-uio" {
-            return Err(bad(at("observer"), format!("{kind} cannot be blind to a {} channel: use chen-patton-uio", channels.name())));
+            return Err(bad(
+                at("observer"),
+                format!(
+                    "{kind} cannot be blind to a {} channel: use chen-patton-uio",
+                    channels.name()
+                ),
+            ));
         }
         let structure = d
             .structure
@@ -253,7 +465,16 @@ pub(crate) fn diagnosers(raw: &[RawDiagnoser], model: &Model, ff: &Mat, noise: O
                     .enumerate()
                     .map(|(r, row)| {
                         row.iter()
-                            .map(|&v| if v == 0 || v == 1 { Ok(v as u8) } else { Err(bad(format!("diagnoser[{}].structure[{}]", i + 1, r + 1), format!("{v}: entries are 0 or 1"))) })
+                            .map(|&v| {
+                                if v == 0 || v == 1 {
+                                    Ok(v as u8)
+                                } else {
+                                    Err(bad(
+                                        format!("diagnoser[{}].structure[{}]", i + 1, r + 1),
+                                        format!("{v}: entries are 0 or 1"),
+                                    ))
+                                }
+                            })
                             .collect::<Result<Vec<u8>, Bad>>()
                     })
                     .collect::<Result<Vec<_>, Bad>>()
@@ -264,50 +485,114 @@ pub(crate) fn diagnosers(raw: &[RawDiagnoser], model: &Model, ff: &Mat, noise: O
             "rms" => {
                 let w = d.window.unwrap_or(10);
                 if w < 1 {
-                    return Err(bad(at("window"), format!("{w} must be a whole number of samples ≥ 1")));
+                    return Err(bad(
+                        at("window"),
+                        format!("{w} must be a whole number of samples ≥ 1"),
+                    ));
                 }
                 if w > MAX_WINDOW {
-                    return Err(bad(at("window"), format!("{w} samples: at most {MAX_WINDOW} (each member keeps its window in memory, 8 bytes a sample)")));
+                    return Err(bad(
+                        at("window"),
+                        format!(
+                            "{w} samples: at most {MAX_WINDOW} (each member keeps its window in memory, 8 bytes a sample)"
+                        ),
+                    ));
                 }
                 Evaluation::Rms { window: w as usize }
             }
             "forgetting" => {
-                let l = finite(&at("forgetting"), d.forgetting.ok_or_else(|| bad(at("forgetting"), "evaluation = \"forgetting\" needs forgetting = λ, 0 < λ < 1"))?)?;
+                let l = finite(
+                    &at("forgetting"),
+                    d.forgetting.ok_or_else(|| {
+                        bad(
+                            at("forgetting"),
+                            "evaluation = \"forgetting\" needs forgetting = λ, 0 < λ < 1",
+                        )
+                    })?,
+                )?;
                 if !(l > 0.0 && l < 1.0) {
-                    return Err(bad(at("forgetting"), format!("{l} must be between 0 and 1")));
+                    return Err(bad(
+                        at("forgetting"),
+                        format!("{l} must be between 0 and 1"),
+                    ));
                 }
                 Evaluation::Forgetting { lambda: l }
             }
             "chi2" => Evaluation::Chi2,
-            other => return Err(bad(at("evaluation"), format!("{} is not an evaluation (norm, rms, forgetting, chi2){}", quoted(other), crate::suggest::did_you_mean(other, ["norm", "rms", "forgetting", "chi2"])))),
+            other => {
+                return Err(bad(
+                    at("evaluation"),
+                    format!(
+                        "{} is not an evaluation (norm, rms, forgetting, chi2){}",
+                        quoted(other),
+                        crate::suggest::did_you_mean(other, ["norm", "rms", "forgetting", "chi2"])
+                    ),
+                ));
+            }
         };
         if d.window.is_some() && !matches!(evaluation, Evaluation::Rms { .. }) {
-            return Err(bad(at("window"), "only evaluation = \"rms\" takes a window"));
+            return Err(bad(
+                at("window"),
+                "only evaluation = \"rms\" takes a window",
+            ));
         }
         if d.forgetting.is_some() && !matches!(evaluation, Evaluation::Forgetting { .. }) {
-            return Err(bad(at("forgetting"), "only evaluation = \"forgetting\" takes forgetting"));
+            return Err(bad(
+                at("forgetting"),
+                "only evaluation = \"forgetting\" takes forgetting",
+            ));
         }
-        let given = [d.threshold.is_some(), d.false_alarm.is_some(), d.calibrate.is_some()].iter().filter(|&&g| g).count();
+        let given = [
+            d.threshold.is_some(),
+            d.false_alarm.is_some(),
+            d.calibrate.is_some(),
+        ]
+        .iter()
+        .filter(|&&g| g)
+        .count();
         if given > 1 {
-            return Err(bad(at("threshold"), "give one of threshold, false_alarm and calibrate"));
+            return Err(bad(
+                at("threshold"),
+                "give one of threshold, false_alarm and calibrate",
+            ));
         }
         let threshold = match (d.threshold, d.false_alarm) {
             _ if d.calibrate.is_some() => {
                 let c = d.calibrate.as_ref().expect("given");
                 if c.runs < 1 {
-                    return Err(bad(at("calibrate.runs"), format!("{} must be a whole number of realisations ≥ 1", c.runs)));
+                    return Err(bad(
+                        at("calibrate.runs"),
+                        format!("{} must be a whole number of realisations ≥ 1", c.runs),
+                    ));
                 }
                 if c.runs > MAX_CALIBRATION_RUNS {
-                    return Err(bad(at("calibrate.runs"), format!("{} realisations: at most {MAX_CALIBRATION_RUNS} (each is a whole run of the scenario, made before the run starts)", c.runs)));
+                    return Err(bad(
+                        at("calibrate.runs"),
+                        format!(
+                            "{} realisations: at most {MAX_CALIBRATION_RUNS} (each is a whole run of the scenario, made before the run starts)",
+                            c.runs
+                        ),
+                    ));
                 }
                 let margin = finite(&at("calibrate.margin"), c.margin.unwrap_or(1.2))?;
                 if margin < 1.0 {
-                    return Err(bad(at("calibrate.margin"), format!("{margin} must be ≥ 1 (the threshold is margin × the largest fault-free J)")));
+                    return Err(bad(
+                        at("calibrate.margin"),
+                        format!(
+                            "{margin} must be ≥ 1 (the threshold is margin × the largest fault-free J)"
+                        ),
+                    ));
                 }
                 if noise.is_none() {
-                    return Err(bad(at("calibrate"), "calibration runs fault-free noisy realisations: the scenario has no [noise]"));
+                    return Err(bad(
+                        at("calibrate"),
+                        "calibration runs fault-free noisy realisations: the scenario has no [noise]",
+                    ));
                 }
-                Threshold::Calibrated { runs: c.runs as usize, margin }
+                Threshold::Calibrated {
+                    runs: c.runs as usize,
+                    margin,
+                }
             }
             (Some(t), None) => {
                 let t = finite(&at("threshold"), t)?;
@@ -319,28 +604,64 @@ pub(crate) fn diagnosers(raw: &[RawDiagnoser], model: &Model, ff: &Mat, noise: O
             (None, Some(a)) => {
                 let a = finite(&at("false_alarm"), a)?;
                 if !(a > 0.0 && a < 0.5) {
-                    return Err(bad(at("false_alarm"), format!("{a}: a false-alarm probability per sample is between 0 and 0.5")));
+                    return Err(bad(
+                        at("false_alarm"),
+                        format!("{a}: a false-alarm probability per sample is between 0 and 0.5"),
+                    ));
                 }
                 if evaluation != Evaluation::Chi2 {
-                    return Err(bad(at("false_alarm"), "a false-alarm probability sets a χ² threshold: it needs evaluation = \"chi2\""));
+                    return Err(bad(
+                        at("false_alarm"),
+                        "a false-alarm probability sets a χ² threshold: it needs evaluation = \"chi2\"",
+                    ));
                 }
                 if noise.is_none() {
-                    return Err(bad(at("false_alarm"), "a χ² threshold needs the noise statistics: the scenario has no [noise]"));
+                    return Err(bad(
+                        at("false_alarm"),
+                        "a χ² threshold needs the noise statistics: the scenario has no [noise]",
+                    ));
                 }
                 Threshold::FalseAlarm(a)
             }
-            (Some(_), Some(_)) => return Err(bad(at("false_alarm"), "give threshold or false_alarm, not both")),
-            (None, None) => return Err(bad(at("threshold"), "a diagnoser needs threshold = value, false_alarm = probability or calibrate = { runs = N }")),
+            (Some(_), Some(_)) => {
+                return Err(bad(
+                    at("false_alarm"),
+                    "give threshold or false_alarm, not both",
+                ));
+            }
+            (None, None) => {
+                return Err(bad(
+                    at("threshold"),
+                    "a diagnoser needs threshold = value, false_alarm = probability or calibrate = { runs = N }",
+                ));
+            }
         };
         let persistence = d.persistence.unwrap_or(1);
         if persistence < 1 {
-            return Err(bad(at("persistence"), format!("{persistence} must be a whole number of samples ≥ 1")));
+            return Err(bad(
+                at("persistence"),
+                format!("{persistence} must be a whole number of samples ≥ 1"),
+            ));
         }
         let ignore_before = finite(&at("ignore_before"), d.ignore_before.unwrap_or(0.0))?;
         if ignore_before < 0.0 {
-            return Err(bad(at("ignore_before"), format!("{ignore_before} must be ≥ 0")));
+            return Err(bad(
+                at("ignore_before"),
+                format!("{ignore_before} must be ≥ 0"),
+            ));
         }
-        out.push(DiagnoserSpec { name: d.name.clone(), scheme, channels, subset, member, structure, evaluation, threshold, persistence: persistence.min(u32::MAX as i64) as u32, ignore_before });
+        out.push(DiagnoserSpec {
+            name: d.name.clone(),
+            scheme,
+            channels,
+            subset,
+            member,
+            structure,
+            evaluation,
+            threshold,
+            persistence: persistence.min(u32::MAX as i64) as u32,
+            ignore_before,
+        });
     }
     Ok(out)
 }

@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 
 use super::raw::RawScenario;
 use super::untrusted::quoted;
-use super::validate::{bad, check_name, Bad};
+use super::validate::{Bad, bad, check_name};
 
 /// Where a component runs when not on the launcher's host.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -27,23 +27,62 @@ pub(crate) fn placements(raw: &RawScenario) -> Result<BTreeMap<String, Remote>, 
         endpoint_ok(endpoint).map_err(|why| bad(&f, format!("{}: {why}", quoted(endpoint))))?;
     }
     let mut out = BTreeMap::new();
-    let mut place = |field: String, component: &str, host: &Option<String>, external: bool| -> Result<(), Bad> {
+    let mut place = |field: String,
+                     component: &str,
+                     host: &Option<String>,
+                     external: bool|
+     -> Result<(), Bad> {
         let Some(h) = host else { return Ok(()) };
         let Some(endpoint) = hosts.get(h) else {
-            return Err(bad(field, format!("{} is not in [hosts] ({})", quoted(h), if hosts.is_empty() { "there is none".to_string() } else { hosts.keys().cloned().collect::<Vec<_>>().join(", ") })));
+            return Err(bad(
+                field,
+                format!(
+                    "{} is not in [hosts] ({})",
+                    quoted(h),
+                    if hosts.is_empty() {
+                        "there is none".to_string()
+                    } else {
+                        hosts.keys().cloned().collect::<Vec<_>>().join(", ")
+                    }
+                ),
+            ));
         };
         if external {
-            return Err(bad(field, "only built-in components run on another host: an external command is a program on the launcher's machine"));
+            return Err(bad(
+                field,
+                "only built-in components run on another host: an external command is a program on the launcher's machine",
+            ));
         }
-        out.insert(component.to_string(), Remote { host: h.clone(), endpoint: endpoint.clone() });
+        out.insert(
+            component.to_string(),
+            Remote {
+                host: h.clone(),
+                endpoint: endpoint.clone(),
+            },
+        );
         Ok(())
     };
-    place("plant.host".into(), "plant", &raw.plant.host, raw.plant.process.is_some() || raw.plant.fmu.is_some())?;
+    place(
+        "plant.host".into(),
+        "plant",
+        &raw.plant.host,
+        raw.plant.process.is_some() || raw.plant.fmu.is_some(),
+    )?;
     for (i, o) in raw.observer.iter().enumerate() {
-        place(format!("observer[{}].host", i + 1), &o.name, &o.host, o.kind == "process")?;
+        place(
+            format!("observer[{}].host", i + 1),
+            &o.name,
+            &o.host,
+            o.kind == "process",
+        )?;
     }
     if let Some(c) = &raw.controller {
-        place("controller.host".into(), "controller", &c.host, c.kind == "process")?;
+        place(
+            "controller.host".into(),
+            "controller",
+            &c.host,
+            c.kind == "process",
+        )?;
     }
     Ok(out)
 }
@@ -53,12 +92,16 @@ pub(crate) fn placements(raw: &RawScenario) -> Result<BTreeMap<String, Remote>, 
 /// connects to it). `tls/…` is refused: Zenoh 1.10's TLS link drops busy links (see the bridge).
 fn endpoint_ok(e: &str) -> Result<(), &'static str> {
     if e.starts_with("tls/") {
-        return Err("tls/ links are not used (Zenoh 1.10's TLS link closes under concurrent reads and writes); use quic/<address>:<port>, the same mutual TLS over QUIC");
+        return Err(
+            "tls/ links are not used (Zenoh 1.10's TLS link closes under concurrent reads and writes); use quic/<address>:<port>, the same mutual TLS over QUIC",
+        );
     }
     let Some(rest) = e.strip_prefix("quic/").or_else(|| e.strip_prefix("tcp/")) else {
         return Err("a Zenoh endpoint is quic/<address>:<port> (or tcp/… for an --insecure agent)");
     };
-    let Some((addr, port)) = rest.rsplit_once(':') else { return Err("no port") };
+    let Some((addr, port)) = rest.rsplit_once(':') else {
+        return Err("no port");
+    };
     if addr.is_empty() || port.parse::<u16>().is_err() {
         return Err("the address or the port is missing or malformed");
     }

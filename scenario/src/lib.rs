@@ -5,15 +5,15 @@
 
 mod fault_diagnosis;
 mod fmu_plant;
-mod plant_file;
 mod hosts;
-pub mod linearized;
 pub mod limits;
-pub use observer_processes::{observer_processes, ObserverProcess};
+pub mod linearized;
+mod plant_file;
+pub use observer_processes::{ObserverProcess, observer_processes};
 mod locate;
+pub mod matrix_file;
 mod observer_processes;
 mod operating_point;
-pub mod matrix_file;
 mod raw;
 mod replay_plant;
 pub mod suggest;
@@ -32,8 +32,8 @@ pub use fault_diagnosis::NoiseSpec;
 pub use fmu_plant::FMU_PLANT_PROGRAM;
 pub use hosts::Remote;
 pub use raw::RawExpect;
-pub use replay_plant::{replay_has_states, REPLAY_PLANT_PROGRAM};
-pub use untrusted::{quoted, MAX_SCENARIO_BYTES};
+pub use replay_plant::{REPLAY_PLANT_PROGRAM, replay_has_states};
+pub use untrusted::{MAX_SCENARIO_BYTES, quoted};
 
 /// A scenario that passed every check.
 #[derive(Debug, Clone)]
@@ -132,7 +132,11 @@ pub struct Named {
 impl Named {
     /// "eta [rad]", or "eta" without a unit.
     pub fn with_unit(&self) -> String {
-        if self.unit.is_empty() { self.name.clone() } else { format!("{} [{}]", self.name, self.unit) }
+        if self.unit.is_empty() {
+            self.name.clone()
+        } else {
+            format!("{} [{}]", self.name, self.unit)
+        }
     }
 }
 
@@ -227,8 +231,14 @@ impl std::error::Error for ScenarioError {}
 
 /// A [`ScenarioError`] for `field` of a validated scenario, located in its text.
 pub fn locate_error(s: &Scenario, field: &str, reason: String) -> ScenarioError {
-    let at = locate::offset(&s.source, &locate::parse_path(field)).map(|o| locate::line_col(&s.source, o));
-    ScenarioError { file: s.path.clone(), at, field: field.to_string(), reason }
+    let at = locate::offset(&s.source, &locate::parse_path(field))
+        .map(|o| locate::line_col(&s.source, o));
+    ScenarioError {
+        file: s.path.clone(),
+        at,
+        field: field.to_string(),
+        reason,
+    }
 }
 
 impl Scenario {
@@ -243,7 +253,14 @@ impl Scenario {
     pub fn sampled_model(&self) -> lti::Discrete {
         if self.discrete {
             let m = &self.model;
-            lti::Discrete { a: m.a.clone(), b: m.b.clone(), c: m.c.clone(), e: m.e.clone(), d: m.d.clone(), dt: self.dt }
+            lti::Discrete {
+                a: m.a.clone(),
+                b: m.b.clone(),
+                c: m.c.clone(),
+                e: m.e.clone(),
+                d: m.d.clone(),
+                dt: self.dt,
+            }
         } else {
             self.model.discretize(self.dt)
         }
@@ -251,12 +268,13 @@ impl Scenario {
 
     /// Reads and validates a scenario file: a regular file of at most [`MAX_SCENARIO_BYTES`].
     pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
-        let text = untrusted::read_bounded(path, MAX_SCENARIO_BYTES).map_err(|reason| ScenarioError {
-            file: path.to_path_buf(),
-            at: None,
-            field: String::new(),
-            reason,
-        })?;
+        let text =
+            untrusted::read_bounded(path, MAX_SCENARIO_BYTES).map_err(|reason| ScenarioError {
+                file: path.to_path_buf(),
+                at: None,
+                field: String::new(),
+                reason,
+            })?;
         Self::parse(path, &text)
     }
 

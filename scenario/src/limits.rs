@@ -36,6 +36,8 @@ pub fn stall_timeout(v: f64) -> Result<f64, String> {
     if v.is_finite() && (5.0..=MAX_STALL_TIMEOUT).contains(&v) {
         Ok(v)
     } else {
-        Err(format!("{v} s must be between 5 s (when a stopped or blocked component is named) and {MAX_STALL_TIMEOUT} s"))
+        Err(format!(
+            "{v} s must be between 5 s (when a stopped or blocked component is named) and {MAX_STALL_TIMEOUT} s"
+        ))
     }
 }

@@ -14,8 +14,8 @@ use serde_json::json;
 
 use super::plant_file::Sizes;
 use super::raw::{RawFmu, RawOperatingPoint};
-use super::validate::{bad, check_name, finite, Bad};
-use super::{untrusted, ScenarioError, MAX_SCENARIO_BYTES};
+use super::validate::{Bad, bad, check_name, finite};
+use super::{MAX_SCENARIO_BYTES, ScenarioError, untrusted};
 
 /// What `fmu_plant --linearize` is asked.
 #[derive(Debug, Clone)]
@@ -42,35 +42,108 @@ impl Request {
 
 /// Reads what `launcher linearize` needs from the scenario at `path`.
 pub fn request(path: &Path) -> Result<Request, ScenarioError> {
-    let err = |(field, reason): Bad| ScenarioError { file: path.to_path_buf(), at: None, field, reason };
-    let text = untrusted::read_bounded(path, MAX_SCENARIO_BYTES).map_err(|r| err((String::new(), r)))?;
-    let table: toml::Table = text.parse().map_err(|e: toml::de::Error| err((String::new(), format!("malformed TOML: {}", e.message().lines().next().unwrap_or("")))))?;
-    let dt = table.get("dt").and_then(|v| v.as_float().or(v.as_integer().map(|i| i as f64))).ok_or_else(|| err(bad("dt", "missing: the sample period the model is made for")))?;
+    let err = |(field, reason): Bad| ScenarioError {
+        file: path.to_path_buf(),
+        at: None,
+        field,
+        reason,
+    };
+    let text =
+        untrusted::read_bounded(path, MAX_SCENARIO_BYTES).map_err(|r| err((String::new(), r)))?;
+    let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
+        err((
+            String::new(),
+            format!(
+                "malformed TOML: {}",
+                e.message().lines().next().unwrap_or("")
+            ),
+        ))
+    })?;
+    let dt = table
+        .get("dt")
+        .and_then(|v| v.as_float().or(v.as_integer().map(|i| i as f64)))
+        .ok_or_else(|| {
+            err(bad(
+                "dt",
+                "missing: the sample period the model is made for",
+            ))
+        })?;
     if !(dt > 0.0 && dt.is_finite()) {
         return Err(err(bad("dt", format!("{dt}: must be finite and > 0"))));
     }
-    let name = table.get("name").and_then(|v| v.as_str()).unwrap_or("linearized").to_string();
+    let name = table
+        .get("name")
+        .and_then(|v| v.as_str())
+        .unwrap_or("linearized")
+        .to_string();
     // It names the scenario file written: a name as a run's (letters, digits, '-', '_').
     check_name("name", &name, "it names the scenario file written").map_err(err)?;
-    let plant = table.get("plant").and_then(|v| v.as_table()).ok_or_else(|| err(bad("plant", "missing: [plant.fmu] names the FMU to linearise")))?;
-    let fmu: RawFmu = plant.get("fmu").ok_or_else(|| err(bad("plant.fmu", "missing: `launcher linearize` makes the model of an FMU plant")))?.clone().try_into().map_err(|e: toml::de::Error| err(bad("plant.fmu", e.message().lines().next().unwrap_or("").to_string())))?;
+    let plant = table
+        .get("plant")
+        .and_then(|v| v.as_table())
+        .ok_or_else(|| {
+            err(bad(
+                "plant",
+                "missing: [plant.fmu] names the FMU to linearise",
+            ))
+        })?;
+    let fmu: RawFmu = plant
+        .get("fmu")
+        .ok_or_else(|| {
+            err(bad(
+                "plant.fmu",
+                "missing: `launcher linearize` makes the model of an FMU plant",
+            ))
+        })?
+        .clone()
+        .try_into()
+        .map_err(|e: toml::de::Error| {
+            err(bad(
+                "plant.fmu",
+                e.message().lines().next().unwrap_or("").to_string(),
+            ))
+        })?;
     let op: Option<RawOperatingPoint> = match plant.get("operating_point") {
-        Some(v) => Some(v.clone().try_into().map_err(|e: toml::de::Error| err(bad("plant.operating_point", e.message().lines().next().unwrap_or("").to_string())))?),
+        Some(v) => Some(v.clone().try_into().map_err(|e: toml::de::Error| {
+            err(bad(
+                "plant.operating_point",
+                e.message().lines().next().unwrap_or("").to_string(),
+            ))
+        })?),
         None => None,
     };
     let x0: Option<Vec<f64>> = match plant.get("x0") {
-        Some(v) => Some(v.clone().try_into().map_err(|_| err(bad("plant.x0", "a list of numbers")))?),
+        Some(v) => Some(
+            v.clone()
+                .try_into()
+                .map_err(|_| err(bad("plant.x0", "a list of numbers")))?,
+        ),
         None => None,
     };
     let (n, p) = (fmu.states.len(), fmu.outputs.len());
-    let (l, q) = (fmu.inputs.as_ref().map_or(0, Vec::len), fmu.disturbances.as_ref().map_or(0, Vec::len));
-    let vector = |field: &str, v: Option<Vec<f64>>, len: usize, default: Option<Vec<f64>>| -> Result<Vec<f64>, Bad> {
+    let (l, q) = (
+        fmu.inputs.as_ref().map_or(0, Vec::len),
+        fmu.disturbances.as_ref().map_or(0, Vec::len),
+    );
+    let vector = |field: &str,
+                  v: Option<Vec<f64>>,
+                  len: usize,
+                  default: Option<Vec<f64>>|
+     -> Result<Vec<f64>, Bad> {
         let v = match v.or(default) {
             Some(v) => v,
-            None => return Err(bad(field, format!("missing: the operating point's {len} values (or [plant] x0)"))),
+            None => {
+                return Err(bad(
+                    field,
+                    format!("missing: the operating point's {len} values (or [plant] x0)"),
+                ));
+            }
         };
         if v.len() != len {
-            return Err(bad(field, format!("has {} entries; the FMU map has {len}", v.len())));
+            return Err(bad(
+                field,
+                format!("has {} entries; the FMU map has {len}", v.len()),
+            ));
         }
         for (i, &x) in v.iter().enumerate() {
             finite(&format!("{field}[{}]", i + 1), x)?;
@@ -81,9 +154,23 @@ pub fn request(path: &Path) -> Result<Request, ScenarioError> {
     let x = vector("plant.operating_point.x", ox, n, x0).map_err(err)?;
     let u = vector("plant.operating_point.u", ou, l, Some(vec![0.0; l])).map_err(err)?;
     let w = vector("plant.operating_point.w", ow, q, Some(vec![0.0; q])).map_err(err)?;
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let (fmu_path, spec) = super::fmu_plant::plant_fmu(&Some(fmu), Some(dir), &Sizes { n, p, l, q }, Some(&x)).map_err(err)?.expect("given");
-    Ok(Request { name, dt, params: spec.params, u, w, fmu: fmu_path, text })
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let (fmu_path, spec) =
+        super::fmu_plant::plant_fmu(&Some(fmu), Some(dir), &Sizes { n, p, l, q }, Some(&x))
+            .map_err(err)?
+            .expect("given");
+    Ok(Request {
+        name,
+        dt,
+        params: spec.params,
+        u,
+        w,
+        fmu: fmu_path,
+        text,
+    })
 }
 
 /// The model made, as `fmu_plant --linearize` answers.
@@ -103,14 +190,24 @@ pub struct Linearized<'a> {
 /// leaves no half-written file. Returns the scenario's path.
 pub fn write(req: &Request, m: &Linearized, out: &Path) -> Result<PathBuf, String> {
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
-    let mut table: toml::Table = req.text.parse().map_err(|e: toml::de::Error| e.to_string())?;
-    let plant = table.entry("plant").or_insert_with(|| toml::Value::Table(Default::default()));
+    let mut table: toml::Table = req
+        .text
+        .parse()
+        .map_err(|e: toml::de::Error| e.to_string())?;
+    let plant = table
+        .entry("plant")
+        .or_insert_with(|| toml::Value::Table(Default::default()));
     let plant = plant.as_table_mut().ok_or("plant: not a table")?;
     for key in ["A", "B", "E", "Phi", "Gamma_B", "Gamma_E", "C", "time"] {
         plant.remove(key);
     }
     let mut files = Vec::new();
-    for (key, rows) in [("Phi", m.phi), ("Gamma_B", m.gamma_b), ("Gamma_E", m.gamma_e), ("C", m.c)] {
+    for (key, rows) in [
+        ("Phi", m.phi),
+        ("Gamma_B", m.gamma_b),
+        ("Gamma_E", m.gamma_e),
+        ("C", m.c),
+    ] {
         let file = format!("{key}.npy");
         files.push((out.join(&file), super::matrix_file::npy_bytes(rows)?));
         plant.insert(key.into(), toml::Value::String(file));
@@ -137,7 +234,11 @@ pub fn write(req: &Request, m: &Linearized, out: &Path) -> Result<PathBuf, Strin
         "# Made by `launcher linearize` from the FMU {}: the sampled model at dt = {} in deviations\n# from [plant.operating_point] (Phi, Gamma_B, Gamma_E, C beside this file, as .npy).\n{}",
         req.fmu.display(),
         req.dt,
-        if at_rest { "# [plant] x0 is the operating point's x (the scenario gave none): the run starts at rest there.\n" } else { "" }
+        if at_rest {
+            "# [plant] x0 is the operating point's x (the scenario gave none): the run starts at rest there.\n"
+        } else {
+            ""
+        }
     );
     let text = header + &toml::to_string(&table).map_err(|e| e.to_string())?;
     let scenario = out.join(format!("{}.toml", req.name));

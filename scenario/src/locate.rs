@@ -62,10 +62,12 @@ pub fn offset(text: &str, path: &[Seg]) -> Option<usize> {
     let mut value: Option<&DeValue> = None;
     for seg in path {
         let next = match seg {
-            Seg::Key(k) => table.and_then(|t| t.iter().find(|(key, _)| key.get_ref() == k)).map(|(key, v)| {
-                best = Some(key.span().start);
-                v
-            }),
+            Seg::Key(k) => table
+                .and_then(|t| t.iter().find(|(key, _)| key.get_ref() == k))
+                .map(|(key, v)| {
+                    best = Some(key.span().start);
+                    v
+                }),
             Seg::Index(i) => value.and_then(|v| v.as_array()).and_then(|a| a.get(*i)),
         };
         let Some(v) = next else { break };
@@ -80,6 +82,9 @@ pub fn offset(text: &str, path: &[Seg]) -> Option<usize> {
 pub fn line_col(text: &str, offset: usize) -> (usize, usize) {
     let before = &text[..offset.min(text.len())];
     let line = before.matches('\n').count() + 1;
-    let col = before.rfind('\n').map_or(before.len(), |p| before.len() - p - 1) + 1;
+    let col = before
+        .rfind('\n')
+        .map_or(before.len(), |p| before.len() - p - 1)
+        + 1;
     (line, col)
 }

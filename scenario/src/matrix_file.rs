@@ -7,7 +7,7 @@ use std::path::Path;
 
 use super::raw::{RawScenario, Rows};
 use super::untrusted::{open_regular, quoted};
-use super::validate::{bad, Bad};
+use super::validate::{Bad, bad};
 
 /// Largest matrix file read, bytes (1 GiB: n ≈ 11 000 states).
 pub const MAX_MATRIX_FILE_BYTES: u64 = 1 << 30;
@@ -29,17 +29,30 @@ pub(crate) fn load_all(raw: &mut RawScenario, dir: &Path) -> Result<(), Bad> {
         fields.extend(m.as_mut().map(|m| (name.to_string(), m)));
     }
     if let Some(noise) = raw.noise.as_mut() {
-        for (name, m) in [("noise.process", &mut noise.process), ("noise.G", &mut noise.g), ("noise.process_discrete", &mut noise.process_discrete), ("noise.measurement", &mut noise.measurement)] {
+        for (name, m) in [
+            ("noise.process", &mut noise.process),
+            ("noise.G", &mut noise.g),
+            ("noise.process_discrete", &mut noise.process_discrete),
+            ("noise.measurement", &mut noise.measurement),
+        ] {
             fields.extend(m.as_mut().map(|m| (name.to_string(), m)));
         }
     }
     for (i, o) in raw.observer.iter_mut().enumerate() {
         for (name, m) in [("H", &mut o.h), ("Q", &mut o.q), ("R", &mut o.r)] {
-            fields.extend(m.as_mut().map(|m| (format!("observer[{}].{name}", i + 1), m)));
+            fields.extend(
+                m.as_mut()
+                    .map(|m| (format!("observer[{}].{name}", i + 1), m)),
+            );
         }
     }
     if let Some(c) = raw.controller.as_mut() {
-        for (name, m) in [("controller.gain", &mut c.gain), ("controller.track", &mut c.track), ("controller.Q", &mut c.q), ("controller.R", &mut c.r)] {
+        for (name, m) in [
+            ("controller.gain", &mut c.gain),
+            ("controller.track", &mut c.track),
+            ("controller.Q", &mut c.q),
+            ("controller.R", &mut c.r),
+        ] {
             fields.extend(m.as_mut().map(|m| (name.to_string(), m)));
         }
     }
@@ -60,38 +73,70 @@ pub fn read(dir: &Path, name: &str) -> Result<Vec<Vec<f64>>, String> {
     let path = dir.join(name);
     let (file, len) = open_regular(&path).map_err(|e| format!("{shown}: {e}"))?;
     if len > MAX_MATRIX_FILE_BYTES {
-        return Err(format!("{shown}: {len} bytes, larger than the 1 GiB a matrix file may hold"));
+        return Err(format!(
+            "{shown}: {len} bytes, larger than the 1 GiB a matrix file may hold"
+        ));
     }
     let mut file = std::io::BufReader::new(file);
-    let data_at = data_offset(&mut file, len).map_err(|e| format!("{shown}: not a .npy file ({e})"))?;
+    let data_at =
+        data_offset(&mut file, len).map_err(|e| format!("{shown}: not a .npy file ({e})"))?;
     let npy = npyz::NpyFile::new(file).map_err(|e| format!("{shown}: not a .npy file ({e})"))?;
     let descr = npy.dtype().descr();
     let dtype = descr.trim_matches('\'');
     if !matches!(dtype, "<f8" | ">f8") {
-        return Err(format!("{shown}: holds {dtype} values; save it as float64 (<f8)"));
+        return Err(format!(
+            "{shown}: holds {dtype} values; save it as float64 (<f8)"
+        ));
     }
     let (rows, cols) = match *npy.shape() {
         [r, c] => (r as usize, c as usize),
-        ref s => return Err(format!("{shown}: has shape {s:?}; a matrix is 2-D (save a vector as (k, 1) or (1, k))")),
+        ref s => {
+            return Err(format!(
+                "{shown}: has shape {s:?}; a matrix is 2-D (save a vector as (k, 1) or (1, k))"
+            ));
+        }
     };
     if rows == 0 || cols == 0 {
-        return Err(format!("{shown}: has shape ({rows}, {cols}); a matrix has at least one row and one column"));
+        return Err(format!(
+            "{shown}: has shape ({rows}, {cols}); a matrix has at least one row and one column"
+        ));
     }
     // The header's shape must be what the file holds (exactly, as numpy.save writes it) before
     // anything is allocated or read for it.
     let values = len - data_at;
     match rows.checked_mul(cols).and_then(|k| k.checked_mul(8)) {
         Some(b) if b as u64 == values => {}
-        Some(b) if (b as u64) < values => return Err(format!("{shown}: its header says {rows}×{cols} ({b} bytes of values), but {values} bytes follow the header")),
-        _ => return Err(format!("{shown}: its header says {rows}×{cols}, more values than its {len} bytes hold")),
+        Some(b) if (b as u64) < values => {
+            return Err(format!(
+                "{shown}: its header says {rows}×{cols} ({b} bytes of values), but {values} bytes follow the header"
+            ));
+        }
+        _ => {
+            return Err(format!(
+                "{shown}: its header says {rows}×{cols}, more values than its {len} bytes hold"
+            ));
+        }
     }
     let order = npy.order();
-    let data: Vec<f64> = npy.into_vec().map_err(|e| format!("{shown}: cannot read its values ({e})"))?;
+    let data: Vec<f64> = npy
+        .into_vec()
+        .map_err(|e| format!("{shown}: cannot read its values ({e})"))?;
     if data.len() != rows * cols {
-        return Err(format!("{shown}: holds {} values for a {rows}×{cols} shape", data.len()));
+        return Err(format!(
+            "{shown}: holds {} values for a {rows}×{cols} shape",
+            data.len()
+        ));
     }
-    let at = |i: usize, j: usize| if order == npyz::Order::Fortran { data[j * rows + i] } else { data[i * cols + j] };
-    Ok((0..rows).map(|i| (0..cols).map(|j| at(i, j)).collect()).collect())
+    let at = |i: usize, j: usize| {
+        if order == npyz::Order::Fortran {
+            data[j * rows + i]
+        } else {
+            data[i * cols + j]
+        }
+    };
+    Ok((0..rows)
+        .map(|i| (0..cols).map(|j| at(i, j)).collect())
+        .collect())
 }
 
 /// Longest `.npy` header text read: numpy's own reader refuses more than 10 000 bytes.
@@ -104,21 +149,31 @@ const MAX_HEADER_BYTES: u64 = 10_000;
 fn data_offset<R: std::io::Read + std::io::Seek>(file: &mut R, len: u64) -> Result<u64, String> {
     use std::io::Read as _;
     let mut pre = Vec::with_capacity(12);
-    file.by_ref().take(12).read_to_end(&mut pre).map_err(|e| e.to_string())?;
+    file.by_ref()
+        .take(12)
+        .read_to_end(&mut pre)
+        .map_err(|e| e.to_string())?;
     let got = pre.len();
     if got < 10 || &pre[..6] != b"\x93NUMPY" {
         return Err("no .npy magic".into());
     }
     let (size, at) = match pre[6] {
         1 => (u16::from_le_bytes([pre[8], pre[9]]) as u64, 10),
-        2 | 3 if got == 12 => (u32::from_le_bytes([pre[8], pre[9], pre[10], pre[11]]) as u64, 12),
+        2 | 3 if got == 12 => (
+            u32::from_le_bytes([pre[8], pre[9], pre[10], pre[11]]) as u64,
+            12,
+        ),
         v => return Err(format!("format version {v} is not 1, 2 or 3")),
     };
     if size > MAX_HEADER_BYTES || at + size > len {
-        return Err(format!("its header claims {size} bytes, in a file of {len}"));
+        return Err(format!(
+            "its header claims {size} bytes, in a file of {len}"
+        ));
     }
     let mut header = vec![0u8; size as usize];
-    file.seek(std::io::SeekFrom::Start(at)).and_then(|_| file.read_exact(&mut header)).map_err(|e| e.to_string())?;
+    file.seek(std::io::SeekFrom::Start(at))
+        .and_then(|_| file.read_exact(&mut header))
+        .map_err(|e| e.to_string())?;
     let mut depth = 0i32;
     for b in &header {
         depth += match b {
@@ -130,7 +185,8 @@ fn data_offset<R: std::io::Read + std::io::Seek>(file: &mut R, len: u64) -> Resu
             return Err("its header nests brackets deeper than a shape does".into());
         }
     }
-    file.seek(std::io::SeekFrom::Start(0)).map_err(|e| e.to_string())?;
+    file.seek(std::io::SeekFrom::Start(0))
+        .map_err(|e| e.to_string())?;
     Ok(at + size)
 }
 
@@ -150,7 +206,8 @@ pub fn npy_bytes(rows: &[Vec<f64>]) -> Result<Vec<u8>, String> {
             .writer(&mut bytes)
             .begin_nd()
             .map_err(|e| e.to_string())?;
-        w.extend(rows.iter().flatten().copied()).map_err(|e| e.to_string())?;
+        w.extend(rows.iter().flatten().copied())
+            .map_err(|e| e.to_string())?;
         w.finish().map_err(|e| e.to_string())?;
     }
     Ok(bytes)

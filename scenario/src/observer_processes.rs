@@ -20,20 +20,33 @@ pub struct ObserverProcess {
 
 /// The observer processes, in order: the scenario's own observers one by one, then each bank's
 /// members together.
-pub fn observer_processes(observers: &[ObserverEntry], remote: &BTreeMap<String, Remote>) -> Vec<ObserverProcess> {
+pub fn observer_processes(
+    observers: &[ObserverEntry],
+    remote: &BTreeMap<String, Remote>,
+) -> Vec<ObserverProcess> {
     let mut out: Vec<ObserverProcess> = Vec::new();
     let mut bank_of: BTreeMap<usize, usize> = BTreeMap::new();
-    let split: Vec<usize> = observers.iter().filter(|o| remote.contains_key(&o.name)).filter_map(|o| o.member.map(|(d, _)| d)).collect();
+    let split: Vec<usize> = observers
+        .iter()
+        .filter(|o| remote.contains_key(&o.name))
+        .filter_map(|o| o.member.map(|(d, _)| d))
+        .collect();
     for (i, o) in observers.iter().enumerate() {
         match o.member {
             Some((d, _)) if !split.contains(&d) => match bank_of.get(&d) {
                 Some(&p) => out[p].observers.push(i),
                 None => {
                     bank_of.insert(d, out.len());
-                    out.push(ObserverProcess { observers: vec![i], bank: Some(d) });
+                    out.push(ObserverProcess {
+                        observers: vec![i],
+                        bank: Some(d),
+                    });
                 }
             },
-            _ => out.push(ObserverProcess { observers: vec![i], bank: None }),
+            _ => out.push(ObserverProcess {
+                observers: vec![i],
+                bank: None,
+            }),
         }
     }
     out

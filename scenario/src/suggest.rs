@@ -4,7 +4,9 @@
 
 /// `" (did you mean \"poles\"?)"`, or "" when no known word is close.
 pub fn did_you_mean<'a>(word: &str, known: impl IntoIterator<Item = &'a str>) -> String {
-    closest(word, known).map_or(String::new(), |k| format!(" (did you mean {}?)", crate::untrusted::quoted(k)))
+    closest(word, known).map_or(String::new(), |k| {
+        format!(" (did you mean {}?)", crate::untrusted::quoted(k))
+    })
 }
 
 /// Words longer than this get no suggestion, and candidates longer than this are skipped: the
@@ -49,7 +51,9 @@ fn distance(a: &str, b: &str) -> usize {
     for i in 1..=a.len() {
         for j in 1..=b.len() {
             let cost = usize::from(a[i - 1] != b[j - 1]);
-            d[i][j] = (d[i - 1][j] + 1).min(d[i][j - 1] + 1).min(d[i - 1][j - 1] + cost);
+            d[i][j] = (d[i - 1][j] + 1)
+                .min(d[i][j - 1] + 1)
+                .min(d[i - 1][j - 1] + cost);
             if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
                 d[i][j] = d[i][j].min(d[i - 2][j - 2] + 1);
             }
@@ -65,8 +69,14 @@ mod tests {
     #[test]
     fn close_words_are_suggested_and_far_ones_not() {
         assert_eq!(closest("pole", ["poles", "gain"]), Some("poles"));
-        assert_eq!(closest("plaecment", ["placement", "poles"]), Some("placement"));
-        assert_eq!(closest("luenburger", ["luenberger", "kalman"]), Some("luenberger"));
+        assert_eq!(
+            closest("plaecment", ["placement", "poles"]),
+            Some("placement")
+        );
+        assert_eq!(
+            closest("luenburger", ["luenberger", "kalman"]),
+            Some("luenberger")
+        );
         assert_eq!(closest("Phi", ["A", "B", "Phi2"]), Some("Phi2"));
         assert_eq!(closest("zzz", ["poles", "gain"]), None);
         assert_eq!(did_you_mean("xyz", ["poles"]), "");

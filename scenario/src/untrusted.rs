@@ -83,7 +83,8 @@ fn escape_controls(text: &str, keep_lines: bool) -> String {
 /// Controls, bidirectional controls, and the line and paragraph separators (U+2028, U+2029:
 /// not controls, but line breaks to some terminals and to spreadsheets).
 fn needs_escape(c: char) -> bool {
-    c.is_control() || matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}' | '\u{2028}' | '\u{2029}')
+    c.is_control()
+        || matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}' | '\u{2028}' | '\u{2029}')
 }
 
 /// Opens `path` for reading if it is a regular file, without blocking on a FIFO; returns the
@@ -118,21 +119,33 @@ pub fn open_regular(path: &Path) -> Result<(File, u64), String> {
 /// Reads a regular file of at most `max` bytes as UTF-8 text.
 pub fn read_bounded(path: &Path, max: u64) -> Result<String, String> {
     let (file, len) = open_regular(path)?;
-    let limit = |n: u64| format!("{n} bytes, larger than the {} a scenario file may hold", human(max));
+    let limit = |n: u64| {
+        format!(
+            "{n} bytes, larger than the {} a scenario file may hold",
+            human(max)
+        )
+    };
     if len > max {
         return Err(limit(len));
     }
     // The file may grow after the check: never read more than the bound.
     let mut bytes = Vec::with_capacity(len as usize);
-    file.take(max + 1).read_to_end(&mut bytes).map_err(|e| format!("cannot read: {e}"))?;
+    file.take(max + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("cannot read: {e}"))?;
     if bytes.len() as u64 > max {
         return Err(limit(bytes.len() as u64));
     }
-    String::from_utf8(bytes).map_err(|e| format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()))
+    String::from_utf8(bytes)
+        .map_err(|e| format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()))
 }
 
 fn human(bytes: u64) -> String {
-    if bytes.is_multiple_of(1 << 20) { format!("{} MiB", bytes >> 20) } else { format!("{bytes} bytes") }
+    if bytes.is_multiple_of(1 << 20) {
+        format!("{} MiB", bytes >> 20)
+    } else {
+        format!("{bytes} bytes")
+    }
 }
 
 #[cfg(test)]
@@ -144,7 +157,10 @@ mod tests {
         assert_eq!(quoted("uio"), "'uio'");
         assert_eq!(quoted("a\nb\u{1b}[31m"), r"'a\nb\u{1b}[31m'");
         let long = quoted(&"n".repeat(250));
-        assert!(long.ends_with("… (250 characters)'") && long.len() < 110, "{long}");
+        assert!(
+            long.ends_with("… (250 characters)'") && long.len() < 110,
+            "{long}"
+        );
         assert_eq!(one_line("x\ny\u{9b}"), r"x\ny\u{9b}");
         assert_eq!(printable("a\tb\nc\u{7}"), "a\tb\nc\\u{7}");
         assert_eq!(one_line("a\\u{1b}"), "a\\u{1b}");
@@ -161,7 +177,11 @@ mod tests {
         assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
         assert!(read_bounded(&fifo, 10).unwrap_err().contains("FIFO"));
         assert!(read_bounded(&dir, 10).unwrap_err().contains("directory"));
-        assert!(read_bounded(Path::new("/dev/zero"), 10).unwrap_err().contains("device"));
+        assert!(
+            read_bounded(Path::new("/dev/zero"), 10)
+                .unwrap_err()
+                .contains("device")
+        );
         let big = dir.join("big");
         std::fs::write(&big, vec![b'#'; 11]).unwrap();
         assert!(read_bounded(&big, 10).unwrap_err().contains("11 bytes"));

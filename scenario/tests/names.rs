@@ -35,7 +35,10 @@ value = 0.0
 "#;
 
 fn with(lines: &str) -> Result<Scenario, String> {
-    let text = BASE.replace("x0 = [1.0, -1.0, 2.0]", &format!("x0 = [1.0, -1.0, 2.0]\n{lines}"));
+    let text = BASE.replace(
+        "x0 = [1.0, -1.0, 2.0]",
+        &format!("x0 = [1.0, -1.0, 2.0]\n{lines}"),
+    );
     Scenario::parse(Path::new("names.toml"), &text).map_err(|e| e.to_string())
 }
 
@@ -67,26 +70,72 @@ fn given_names_and_units_are_kept() {
     assert_eq!(names(&s.names.disturbance), ["gust [N]"]);
     assert_eq!(names(&s.names.measurement_disturbance), ["noise [m]"]);
     // Units alone keep the default names.
-    assert_eq!(names(&with("output_units = [\"m\", \"V\"]").unwrap().names.output), ["y1 [m]", "y2 [V]"]);
+    assert_eq!(
+        names(&with("output_units = [\"m\", \"V\"]").unwrap().names.output),
+        ["y1 [m]", "y2 [V]"]
+    );
 }
 
 #[test]
 fn a_wrong_length_or_an_empty_name_is_one_line_naming_file_and_field() {
     for (line, field, reason) in [
-        ("state_names = [\"a\", \"b\"]", "plant.state_names", "the plant has 3 states"),
-        ("state_units = [\"m\"]", "plant.state_units", "the plant has 3 states"),
-        ("output_names = [\"a\"]", "plant.output_names", "C has 2 rows"),
-        ("output_units = [\"m\", \"m\", \"m\"]", "plant.output_units", "C has 2 rows"),
-        ("input_names = [\"a\"]", "plant.input_names", "B has 2 columns"),
+        (
+            "state_names = [\"a\", \"b\"]",
+            "plant.state_names",
+            "the plant has 3 states",
+        ),
+        (
+            "state_units = [\"m\"]",
+            "plant.state_units",
+            "the plant has 3 states",
+        ),
+        (
+            "output_names = [\"a\"]",
+            "plant.output_names",
+            "C has 2 rows",
+        ),
+        (
+            "output_units = [\"m\", \"m\", \"m\"]",
+            "plant.output_units",
+            "C has 2 rows",
+        ),
+        (
+            "input_names = [\"a\"]",
+            "plant.input_names",
+            "B has 2 columns",
+        ),
         ("input_units = []", "plant.input_units", "B has 2 columns"),
-        ("disturbance_names = [\"a\", \"b\"]", "plant.disturbance_names", "E has 1 column (unknown inputs)"),
-        ("disturbance_units = []", "plant.disturbance_units", "E has 1 column (unknown inputs)"),
-        ("measurement_disturbance_names = [\"a\", \"b\"]", "plant.measurement_disturbance_names", "D has 1 column ("),
-        ("measurement_disturbance_units = [\"a\", \"b\"]", "plant.measurement_disturbance_units", "D has 1 column ("),
-        ("output_names = [\"a\", \" \"]", "plant.output_names[2]", "must not be empty"),
+        (
+            "disturbance_names = [\"a\", \"b\"]",
+            "plant.disturbance_names",
+            "E has 1 column (unknown inputs)",
+        ),
+        (
+            "disturbance_units = []",
+            "plant.disturbance_units",
+            "E has 1 column (unknown inputs)",
+        ),
+        (
+            "measurement_disturbance_names = [\"a\", \"b\"]",
+            "plant.measurement_disturbance_names",
+            "D has 1 column (",
+        ),
+        (
+            "measurement_disturbance_units = [\"a\", \"b\"]",
+            "plant.measurement_disturbance_units",
+            "D has 1 column (",
+        ),
+        (
+            "output_names = [\"a\", \" \"]",
+            "plant.output_names[2]",
+            "must not be empty",
+        ),
     ] {
         let e = with(line).unwrap_err();
-        assert!(e.starts_with("names.toml:") && e.contains(field) && e.contains(reason), "{line}: {e}");
+        assert!(
+            e.starts_with("names.toml:") && e.contains(field) && e.contains(reason),
+            "{line}: {e}"
+        );
         assert_eq!(e.lines().count(), 1, "{e}");
     }
 }

@@ -38,18 +38,34 @@ fn empty_poles(s: &Scenario) -> bool {
 
 #[test]
 fn an_empty_pole_list_and_a_missing_key_both_mean_no_free_poles() {
-    let with_empty = Scenario::parse(Path::new("empty.toml"), &format!("{BASE}poles = []\n")).unwrap();
+    let with_empty =
+        Scenario::parse(Path::new("empty.toml"), &format!("{BASE}poles = []\n")).unwrap();
     assert!(empty_poles(&with_empty));
     let without = Scenario::parse(Path::new("none.toml"), BASE).unwrap();
     assert!(empty_poles(&without));
     // And the design of either exists: its only mode is the fixed one, −1.
-    let d = observer::design(&without.model, without.observers[0].spec.as_ref().unwrap(), without.dt).unwrap();
-    assert!(d.report.poles.iter().all(|p| (p.re + 1.0).abs() < 1e-9 && p.im == 0.0), "{:?}", d.report.poles);
+    let d = observer::design(
+        &without.model,
+        without.observers[0].spec.as_ref().unwrap(),
+        without.dt,
+    )
+    .unwrap();
+    assert!(
+        d.report
+            .poles
+            .iter()
+            .all(|p| (p.re + 1.0).abs() < 1e-9 && p.im == 0.0),
+        "{:?}",
+        d.report.poles
+    );
 }
 
 #[test]
 fn an_empty_list_is_accepted_for_every_kind_and_the_design_says_what_it_needs() {
-    let text = BASE.replace("kind = \"das-ghosal-uio\"", "kind = \"luenberger\"\npoles = []");
+    let text = BASE.replace(
+        "kind = \"das-ghosal-uio\"",
+        "kind = \"luenberger\"\npoles = []",
+    );
     let s = Scenario::parse(Path::new("luenberger.toml"), &text).unwrap();
     let e = observer::design(&s.model, s.observers[0].spec.as_ref().unwrap(), s.dt).unwrap_err();
     assert!(e.detail.contains("give 3 pole(s)"), "{e}");

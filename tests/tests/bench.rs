@@ -6,7 +6,22 @@ use tests::*;
 #[test]
 fn bench_runs_its_floor_and_reports_ratios_to_it() {
     let s = Scratch::new("bench-floor");
-    let child = launcher(&s).args(["bench", "--steps", "3000", "--mode", "processes", "--recording", "off", "--repeat", "2", "--json"]).stdout(std::process::Stdio::piped()).spawn().unwrap();
+    let child = launcher(&s)
+        .args([
+            "bench",
+            "--steps",
+            "3000",
+            "--mode",
+            "processes",
+            "--recording",
+            "off",
+            "--repeat",
+            "2",
+            "--json",
+        ])
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
     let pid = child.id();
     let out = child.wait_with_output().unwrap();
     assert!(out.status.success(), "{:?}", text(&out));
@@ -33,17 +48,47 @@ fn bench_runs_its_floor_and_reports_ratios_to_it() {
 #[test]
 fn bench_states_measures_each_size() {
     let s = Scratch::new("bench-states");
-    let out = launcher(&s).args(["bench", "--states", "3,20", "--steps", "2000", "--mode", "in-process", "--json"]).output().unwrap();
+    let out = launcher(&s)
+        .args([
+            "bench",
+            "--states",
+            "3,20",
+            "--steps",
+            "2000",
+            "--mode",
+            "in-process",
+            "--json",
+        ])
+        .output()
+        .unwrap();
     assert!(out.status.success(), "{:?}", text(&out));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let runs = v["states"].as_array().unwrap();
     assert_eq!(runs.len(), 4, "{runs:?}");
-    let get = |n: u64, rec: bool| runs.iter().find(|r| r["n"] == n && r["recording"] == rec).unwrap();
+    let get = |n: u64, rec: bool| {
+        runs.iter()
+            .find(|r| r["n"] == n && r["recording"] == rec)
+            .unwrap()
+    };
     for n in [3, 20] {
         assert!(get(n, false)["bytes_per_step"].is_null());
         assert!(get(n, true)["bytes_per_step"].as_f64().unwrap() > 0.0);
     }
-    assert!(get(20, true)["bytes_per_step"].as_f64().unwrap() > get(3, true)["bytes_per_step"].as_f64().unwrap());
-    let bad = launcher(&s).args(["bench", "--states", "0", "--steps", "10", "--mode", "in-process"]).output().unwrap();
+    assert!(
+        get(20, true)["bytes_per_step"].as_f64().unwrap()
+            > get(3, true)["bytes_per_step"].as_f64().unwrap()
+    );
+    let bad = launcher(&s)
+        .args([
+            "bench",
+            "--states",
+            "0",
+            "--steps",
+            "10",
+            "--mode",
+            "in-process",
+        ])
+        .output()
+        .unwrap();
     assert_eq!(bad.status.code(), Some(2), "{:?}", text(&bad));
 }

@@ -1,7 +1,7 @@
 //! Issue 21, item 2: controllers do what was asked — the sampled loop's poles where the file puts
 //! them, integral action and disturbance cancellation that leave no steady-state error.
 
-use controller::design::{FeedbackSpec, Domain};
+use controller::design::{Domain, FeedbackSpec};
 use lti::C64;
 use tests::*;
 
@@ -17,31 +17,69 @@ fn shipped_closed_loops_have_the_sampled_poles_their_files_ask() {
         if path.extension().is_none_or(|e| e != "toml") {
             continue;
         }
-        let Ok(sc) = scenario::Scenario::load(&path) else { continue };
-        let Some(FeedbackSpec::Poles { poles, domain: Domain::Sampled, .. }) = sc.controller.as_ref().and_then(|c| c.spec.clone()) else { continue };
-        let out = launcher(&s).args(["design", "--json"]).arg(&path).output().unwrap();
-        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let Ok(sc) = scenario::Scenario::load(&path) else {
+            continue;
+        };
+        let Some(FeedbackSpec::Poles {
+            poles,
+            domain: Domain::Sampled,
+            ..
+        }) = sc.controller.as_ref().and_then(|c| c.spec.clone())
+        else {
+            continue;
+        };
+        let out = launcher(&s)
+            .args(["design", "--json"])
+            .arg(&path)
+            .output()
+            .unwrap();
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout)
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let got: Vec<C64> = complex_list(&v["controller"]["discrete_closed_loop_poles"]);
         let want = poles.to_discrete(sc.dt);
         let err = lti::eig::match_error(want.values(), &got);
-        assert!(err <= 1e-12, "{}: sampled poles {got:?} vs e^(p·dt) {:?}: {err:e}", path.display(), want.values());
+        assert!(
+            err <= 1e-12,
+            "{}: sampled poles {got:?} vs e^(p·dt) {:?}: {err:e}",
+            path.display(),
+            want.values()
+        );
         checked += 1;
     }
-    assert!(checked >= 4, "only {checked} shipped closed loops place poles");
+    assert!(
+        checked >= 4,
+        "only {checked} shipped closed loops place poles"
+    );
 }
 
 /// The last value of a recorded series.
 fn last(r: &recording::read::Recording, path: &str) -> f64 {
-    *r.series[path].values.last().unwrap_or_else(|| panic!("{path} is empty"))
+    *r.series[path]
+        .values
+        .last()
+        .unwrap_or_else(|| panic!("{path} is empty"))
 }
 
 /// Runs a scenario text in-process and reads the recording back.
 fn run_text(s: &Scratch, name: &str, text: &str) -> recording::read::Recording {
     let path = s.join(&format!("{name}.toml"));
     std::fs::write(&path, text).unwrap();
-    let out = launcher(s).args(["run", "--mode", "in-process", "--out"]).arg(s.join(name)).arg(&path).output().unwrap();
-    assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
-    let scen_name = text.lines().find_map(|l| l.strip_prefix("name = \"")).unwrap().trim_end_matches('"');
+    let out = launcher(s)
+        .args(["run", "--mode", "in-process", "--out"])
+        .arg(s.join(name))
+        .arg(&path)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{name}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let scen_name = text
+        .lines()
+        .find_map(|l| l.strip_prefix("name = \""))
+        .unwrap()
+        .trim_end_matches('"');
     recording::read::read(&s.join(&format!("{name}/{scen_name}.rrd"))).unwrap()
 }
 
@@ -54,7 +92,10 @@ fn integral_action_removes_the_offset_a_step_wind_leaves() {
     let text = std::fs::read_to_string(scenario("vehicle-lateral-integral")).unwrap();
     let r = run_text(&s, "with", &text);
     let e_y = last(&r, "/plant/x/1");
-    assert!((e_y - 0.5).abs() < 1e-9, "with integral action e_y ends at {e_y}");
+    assert!(
+        (e_y - 0.5).abs() < 1e-9,
+        "with integral action e_y ends at {e_y}"
+    );
     // The wind did act on the heading: a steady heading error balances it.
     assert!(last(&r, "/plant/x/3").abs() > 1e-3);
     let without: String = text
@@ -64,7 +105,10 @@ fn integral_action_removes_the_offset_a_step_wind_leaves() {
         .collect::<String>();
     let r = run_text(&s, "without", &without);
     let e_y = last(&r, "/plant/x/1");
-    assert!((e_y - 0.5).abs() > 1e-2, "without integral action e_y ends at {e_y}");
+    assert!(
+        (e_y - 0.5).abs() > 1e-2,
+        "without integral action e_y ends at {e_y}"
+    );
 }
 
 /// Seed 003 (Charlie) with an elevator-like step disturbance (E = B) and its Das–Ghosal observer,
@@ -77,14 +121,25 @@ fn integral_action_on_seed003_under_a_step_unknown_input() {
     let text = text.split("[expect]").next().unwrap().to_string();
     let disturbed = text.replacen("C = [[", "E = [[0.0], [-0.04], [0.0], [-12.5]]\nC = [[", 1)
         + "\n[[disturbance]]\nkind = \"step\"\ntime = 4.0\nbefore = 0.0\nafter = 0.02\n";
-    let integral = disturbed.replace("poles = [-4.0, -5.0, -6.0, -7.0]", "integral = true\npoles = [-4.0, -5.0, -6.0, -7.0, -8.0]").replace("duration = 10.0", "duration = 16.0");
+    let integral = disturbed
+        .replace(
+            "poles = [-4.0, -5.0, -6.0, -7.0]",
+            "integral = true\npoles = [-4.0, -5.0, -6.0, -7.0, -8.0]",
+        )
+        .replace("duration = 10.0", "duration = 16.0");
     assert_ne!(integral, disturbed);
     let r = run_text(&s, "integral", &integral);
     let alpha = last(&r, "/plant/x/2");
-    assert!((alpha - 0.1).abs() < 1e-9, "α ends at {alpha} with integral action");
+    assert!(
+        (alpha - 0.1).abs() < 1e-9,
+        "α ends at {alpha} with integral action"
+    );
     let r = run_text(&s, "prefilter", &disturbed);
     let alpha = last(&r, "/plant/x/2");
-    assert!((alpha - 0.1).abs() > 1e-3, "α ends at {alpha} with the prefilter alone");
+    assert!(
+        (alpha - 0.1).abs() > 1e-3,
+        "α ends at {alpha} with the prefilter alone"
+    );
 }
 
 /// A wind acting at the front axle enters through the steering column (Γ_E = Γ_B M): with
@@ -103,24 +158,51 @@ fn feedforward_cancels_a_matched_unknown_input_and_refuses_an_unmatched_one() {
         .collect::<String>();
     let r = run_text(&s, "ff", &matched);
     let e_y = last(&r, "/plant/x/1");
-    assert!((e_y - 0.5).abs() < 1e-9, "with the wind cancelled e_y ends at {e_y}");
-    let without: String = matched.lines().filter(|l| !l.starts_with("feedforward")).map(|l| format!("{l}\n")).collect();
+    assert!(
+        (e_y - 0.5).abs() < 1e-9,
+        "with the wind cancelled e_y ends at {e_y}"
+    );
+    let without: String = matched
+        .lines()
+        .filter(|l| !l.starts_with("feedforward"))
+        .map(|l| format!("{l}\n"))
+        .collect();
     assert_ne!(without, matched);
     let r = run_text(&s, "noff", &without);
     let e_y = last(&r, "/plant/x/1");
-    assert!((e_y - 0.5).abs() > 1e-3, "without feedforward e_y ends at {e_y}");
+    assert!(
+        (e_y - 0.5).abs() > 1e-3,
+        "without feedforward e_y ends at {e_y}"
+    );
     // The shipped wind acts 0.3 m ahead of the centre of gravity: not through the steering.
     let path = s.join("unmatched.toml");
-    std::fs::write(&path, matched.replace("E = [[0.0], [0.0006666666666666666], [0.0], [0.00048]]", "E = [[0.0], [0.0006666667], [0.0], [0.00012]]")).unwrap();
+    std::fs::write(
+        &path,
+        matched.replace(
+            "E = [[0.0], [0.0006666666666666666], [0.0], [0.00048]]",
+            "E = [[0.0], [0.0006666667], [0.0], [0.00012]]",
+        ),
+    )
+    .unwrap();
     let out = launcher(&s).arg("design").arg(&path).output().unwrap();
-    let err = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+    let err =
+        String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains("controller.feedforward") && err.contains("w1 does not enter through the inputs"), "{err}");
+    assert!(
+        err.contains("controller.feedforward")
+            && err.contains("w1 does not enter through the inputs"),
+        "{err}"
+    );
     // An observer without ŵ is refused too.
     let path = s.join("luenberger.toml");
-    std::fs::write(&path, matched.replace("observer = \"uio\"", "observer = \"luenberger\"")).unwrap();
+    std::fs::write(
+        &path,
+        matched.replace("observer = \"uio\"", "observer = \"luenberger\""),
+    )
+    .unwrap();
     let out = launcher(&s).arg("design").arg(&path).output().unwrap();
-    let err = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+    let err =
+        String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("'luenberger' gives no estimate ŵ"), "{err}");
 }
@@ -136,9 +218,18 @@ fn a_controller_reading_the_plant_counts_against_the_subscriber_limit() {
     let text = text.replacen("[controller]", &format!("{extra}[controller]"), 1);
     let path = s.join("many.toml");
     std::fs::write(&path, text.split("[expect]").next().unwrap()).unwrap();
-    let out = launcher(&s).arg("run").arg(&path).arg("--out").arg(s.join("out")).output().unwrap();
+    let out = launcher(&s)
+        .arg("run")
+        .arg(&path)
+        .arg("--out")
+        .arg(s.join("out"))
+        .output()
+        .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains("controller.integral") && err.contains("at most 6 observers here"), "{err}");
+    assert!(
+        err.contains("controller.integral") && err.contains("at most 6 observers here"),
+        "{err}"
+    );
     assert!(!s.join("out").exists() || std::fs::read_dir(s.join("out")).unwrap().next().is_none());
 }

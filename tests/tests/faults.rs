@@ -9,7 +9,9 @@ use tests::*;
 
 /// seed002-sine stretched to `seconds` of simulated time (1000 steps per second).
 fn long_scenario(s: &Scratch, seconds: u32) -> PathBuf {
-    let text = std::fs::read_to_string(scenario("seed002-sine")).unwrap().replace("duration = 20.0", &format!("duration = {seconds}.0"));
+    let text = std::fs::read_to_string(scenario("seed002-sine"))
+        .unwrap()
+        .replace("duration = 20.0", &format!("duration = {seconds}.0"));
     let text = text.split("\n[expect]").next().unwrap().to_string();
     let p = s.join("long.toml");
     std::fs::write(&p, text).unwrap();
@@ -17,12 +19,24 @@ fn long_scenario(s: &Scratch, seconds: u32) -> PathBuf {
 }
 
 fn start(s: &Scratch, scenario: &PathBuf, extra: &[&str]) -> Child {
-    launcher(s).arg("run").arg(scenario).arg("--out").arg(s.join("out")).args(extra).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap()
+    launcher(s)
+        .arg("run")
+        .arg(scenario)
+        .arg("--out")
+        .arg(s.join("out"))
+        .args(extra)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
 }
 
 /// A reproducible pseudo-random delay (ms) in [lo, hi).
 fn delay(seed: u64, lo: u64, hi: u64) -> Duration {
-    let x = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407) >> 33;
+    let x = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407)
+        >> 33;
     Duration::from_millis(lo + x % (hi - lo))
 }
 
@@ -49,20 +63,34 @@ fn a_killed_component_stops_the_run_cleanly() {
             let killed = Instant::now();
             let (out, took) = finish(child, killed);
             let (_, err) = text(&out);
-            assert!(took < Duration::from_secs(2), "{victim}: the launcher took {took:?}");
+            assert!(
+                took < Duration::from_secs(2),
+                "{victim}: the launcher took {took:?}"
+            );
             assert_eq!(out.status.code(), Some(3), "{victim}: {err}");
             let label = match *victim {
                 "uio" | "luenberger" => format!("observer '{victim}'"),
                 other => other.to_string(),
             };
-            assert!(err.contains(&label) && err.contains("SIGKILL") && err.contains("last completed step"), "{victim}: {err}");
+            assert!(
+                err.contains(&label)
+                    && err.contains("SIGKILL")
+                    && err.contains("last completed step"),
+                "{victim}: {err}"
+            );
             assert_clean(&s, lpid);
             let r = read(&s.join("out/seed002-sine.rrd")).unwrap();
             assert!(r.complete, "{victim}: recording not finalised");
             let steps = r.series["/plant/x/1"].values.len();
-            assert!(steps > 0 && steps < 600_000, "{victim}: {steps} steps recorded");
+            assert!(
+                steps > 0 && steps < 600_000,
+                "{victim}: {steps} steps recorded"
+            );
             let sum = summary(&s, "seed002-sine");
-            assert!(sum["stopped"].as_str().unwrap().contains("SIGKILL"), "{sum}");
+            assert!(
+                sum["stopped"].as_str().unwrap().contains("SIGKILL"),
+                "{sum}"
+            );
         }
     }
 }
@@ -71,7 +99,12 @@ fn a_killed_component_stops_the_run_cleanly() {
 /// its components to die with it; returns the dead launcher's pid.
 fn kill_mid_run(s: &Scratch, path: &PathBuf, shared: bool) -> u32 {
     let mut cmd = launcher(s);
-    cmd.arg("run").arg(path).arg("--out").arg(s.join("out")).stdout(Stdio::piped()).stderr(Stdio::piped());
+    cmd.arg("run")
+        .arg(path)
+        .arg("--out")
+        .arg(s.join("out"))
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
     if shared {
         cmd.env(lockstep::private_shm::SHARED_ENV, "1");
     }
@@ -83,7 +116,11 @@ fn kill_mid_run(s: &Scratch, path: &PathBuf, shared: bool) -> u32 {
     // The components die with their launcher.
     let deadline = Instant::now() + Duration::from_secs(2);
     while !processes_of(dead).is_empty() {
-        assert!(Instant::now() < deadline, "components outlived their launcher: {:?}", processes_of(dead));
+        assert!(
+            Instant::now() < deadline,
+            "components outlived their launcher: {:?}",
+            processes_of(dead)
+        );
         std::thread::sleep(Duration::from_millis(10));
     }
     dead
@@ -94,13 +131,19 @@ fn a_run_killed_with_sigkill_leaves_no_shared_memory_on_the_machine() {
     // As root the run's /dev/shm is a tmpfs of its own mount namespace: it goes with the last
     // process in it. Elsewhere the run uses the machine's and the next test's cleanup applies.
     if unsafe { libc::geteuid() } != 0 {
-        eprintln!("SKIPPED a_run_killed_with_sigkill_leaves_no_shared_memory_on_the_machine: needs root (a private /dev/shm)");
+        eprintln!(
+            "SKIPPED a_run_killed_with_sigkill_leaves_no_shared_memory_on_the_machine: needs root (a private /dev/shm)"
+        );
         return;
     }
     let s = Scratch::new("killed");
     let path = long_scenario(&s, 100);
     let dead = kill_mid_run(&s, &path, false);
-    assert!(shm_of(dead).is_empty(), "shared memory left on the machine: {:?}", shm_of(dead));
+    assert!(
+        shm_of(dead).is_empty(),
+        "shared memory left on the machine: {:?}",
+        shm_of(dead)
+    );
     assert!(s.join("out/seed002-sine.rrd.partial").exists());
 }
 
@@ -110,14 +153,21 @@ fn a_run_after_a_dead_one_cleans_up_and_succeeds() {
     let path = long_scenario(&s, 100);
     // With the machine's /dev/shm, what a killed run leaves stays until the next run.
     let dead = kill_mid_run(&s, &path, true);
-    assert!(!shm_of(dead).is_empty(), "the killed run should have left shared memory to clean");
+    assert!(
+        !shm_of(dead).is_empty(),
+        "the killed run should have left shared memory to clean"
+    );
     assert!(s.join("out/seed002-sine.rrd.partial").exists());
     // Same scenario, same output directory.
     let next = start(&s, &path, &[]);
     let npid = next.id();
     let out = next.wait_with_output().unwrap();
     assert!(out.status.success(), "{:?}", text(&out));
-    assert!(shm_of(dead).is_empty(), "stale shared memory left: {:?}", shm_of(dead));
+    assert!(
+        shm_of(dead).is_empty(),
+        "stale shared memory left: {:?}",
+        shm_of(dead)
+    );
     assert_clean(&s, npid);
     assert!(read(&s.join("out/seed002-sine.rrd")).unwrap().complete);
     // And the killed run's partial recording is still readable, marked incomplete.
@@ -125,7 +175,12 @@ fn a_run_after_a_dead_one_cleans_up_and_succeeds() {
 
 #[test]
 fn four_parallel_runs_give_what_each_gives_alone() {
-    let names = ["seed002-sine", "seed003-charlie-open-loop", "seed004-projection-uio-piecewise", "seed001-missile-full-order"];
+    let names = [
+        "seed002-sine",
+        "seed003-charlie-open-loop",
+        "seed004-projection-uio-piecewise",
+        "seed001-missile-full-order",
+    ];
     let runs: Vec<(Scratch, Child)> = names
         .iter()
         .map(|n| {
@@ -146,11 +201,21 @@ fn four_parallel_runs_give_what_each_gives_alone() {
         let alone = Scratch::new(&format!("alone-{n}"));
         let out = run(&alone, &scenario(n), &["--mode", "in-process"]);
         assert!(out.status.success());
-        let (a, b) = (read(&s.join(&format!("out/{n}.rrd"))).unwrap(), read(&alone.join(&format!("out/{n}.rrd"))).unwrap());
+        let (a, b) = (
+            read(&s.join(&format!("out/{n}.rrd"))).unwrap(),
+            read(&alone.join(&format!("out/{n}.rrd"))).unwrap(),
+        );
         let (ta, tb) = (trajectories(&a), trajectories(&b));
         assert_eq!(ta.len(), tb.len());
         for ((ka, sa), (_, sb)) in ta.iter().zip(&tb) {
-            assert!(sa.values.iter().zip(&sb.values).all(|(x, y)| x.to_bits() == y.to_bits()) && sa.values.len() == sb.values.len(), "{n}: {ka} differs");
+            assert!(
+                sa.values
+                    .iter()
+                    .zip(&sb.values)
+                    .all(|(x, y)| x.to_bits() == y.to_bits())
+                    && sa.values.len() == sb.values.len(),
+                "{n}: {ka} differs"
+            );
         }
     }
 }
@@ -160,11 +225,18 @@ fn components_started_by_hand_say_how_to_start_them() {
     for bin in ["plant", "observer", "controller"] {
         for args in [&[][..], &["--run", "nosuchrun1", "--name", "x"][..]] {
             let started = Instant::now();
-            let out = Command::new(bin_dir().join(bin)).args(args).stdin(Stdio::null()).output().unwrap();
+            let out = Command::new(bin_dir().join(bin))
+                .args(args)
+                .stdin(Stdio::null())
+                .output()
+                .unwrap();
             let err = String::from_utf8_lossy(&out.stderr);
             assert!(started.elapsed() < Duration::from_secs(1));
             assert_eq!(out.status.code(), Some(2), "{bin} {args:?}: {err}");
-            assert!(err.contains("started by the launcher"), "{bin} {args:?}: {err}");
+            assert!(
+                err.contains("started by the launcher"),
+                "{bin} {args:?}: {err}"
+            );
             if !args.is_empty() {
                 assert!(err.contains("no run 'nosuchrun1'"), "{err}");
             }
@@ -188,12 +260,18 @@ fn a_signal_stops_the_run_cleanly(sig: i32, name: &str, code: i32) {
         let sent = Instant::now();
         let (out, took) = finish(child, sent);
         let (_, err) = text(&out);
-        assert!(took < Duration::from_secs(2), "{name} {mode}: took {took:?}");
+        assert!(
+            took < Duration::from_secs(2),
+            "{name} {mode}: took {took:?}"
+        );
         assert_eq!(out.status.code(), Some(code), "{name} {mode}: {err}");
         assert!(err.contains(name), "{name} {mode}: {err}");
         assert_clean(&s, lpid);
         let r = read(&s.join("out/seed002-sine.rrd")).unwrap();
-        assert!(r.complete && !r.series["/plant/x/1"].values.is_empty(), "{name} {mode}");
+        assert!(
+            r.complete && !r.series["/plant/x/1"].values.is_empty(),
+            "{name} {mode}"
+        );
         let sum = summary(&s, "seed002-sine");
         assert!(sum["stopped"].as_str().unwrap().contains(name), "{sum}");
     }
@@ -216,11 +294,20 @@ fn sighup_and_sigquit_stop_the_run_cleanly() {
 /// Mounts a tmpfs of `size` at `dir`; the error says why it could not.
 fn mount_tmpfs(dir: &std::path::Path, size: &str) -> Result<(), String> {
     std::fs::create_dir_all(dir).unwrap();
-    let out = Command::new("mount").args(["-t", "tmpfs", "-o", &format!("size={size}"), "tmpfs"]).arg(dir).output().map_err(|e| format!("cannot run mount: {e}"))?;
+    let out = Command::new("mount")
+        .args(["-t", "tmpfs", "-o", &format!("size={size}"), "tmpfs"])
+        .arg(dir)
+        .output()
+        .map_err(|e| format!("cannot run mount: {e}"))?;
     if out.status.success() {
         Ok(())
     } else {
-        Err(format!("mount -t tmpfs at {} failed ({}): {}", dir.display(), out.status, String::from_utf8_lossy(&out.stderr).trim()))
+        Err(format!(
+            "mount -t tmpfs at {} failed ({}): {}",
+            dir.display(),
+            out.status,
+            String::from_utf8_lossy(&out.stderr).trim()
+        ))
     }
 }
 
@@ -234,7 +321,12 @@ fn fill(dir: &std::path::Path, leave: u64) {
     let f = std::fs::File::create(dir.join("filler")).unwrap();
     use std::os::fd::AsRawFd;
     // SAFETY: allocates blocks for our own open file.
-    assert_eq!(unsafe { libc::posix_fallocate(f.as_raw_fd(), 0, free.saturating_sub(leave) as libc::off_t) }, 0);
+    assert_eq!(
+        unsafe {
+            libc::posix_fallocate(f.as_raw_fd(), 0, free.saturating_sub(leave) as libc::off_t)
+        },
+        0
+    );
 }
 
 /// Issue 10, item 21: a full disk stops the run cleanly, naming the file and saying what of
@@ -250,7 +342,12 @@ fn a_full_disk_stops_the_run_and_says_what_was_kept() {
     // cannot, exit 2), so the disk fills while it runs: a 128 MB tmpfs, a paced run, and after
     // 0.7 s — before its first batch of 4096 steps reaches the file — a filler leaves 200 kB
     // (no whole step: the partial file is removed) or 3 MB (a few thousand steps: kept).
-    for (mode, leave) in [("processes", 200u64 << 10), ("in-process", 200 << 10), ("processes", 3 << 20), ("in-process", 3 << 20)] {
+    for (mode, leave) in [
+        ("processes", 200u64 << 10),
+        ("in-process", 200 << 10),
+        ("processes", 3 << 20),
+        ("in-process", 3 << 20),
+    ] {
         let size = if leave < 1 << 20 { "200k" } else { "3m" };
         let s = Scratch::new(&format!("disk-full-{mode}-{size}"));
         let full = s.join("full");
@@ -258,28 +355,52 @@ fn a_full_disk_stops_the_run_and_says_what_was_kept() {
             panic!("{mode}, {size}: {why}");
         }
         let path = long_scenario(&s, 60);
-        let child = launcher(&s).arg("run").arg(&path).args(["--mode", mode, "--realtime", "--speed", "2", "--out"]).arg(&full).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+        let child = launcher(&s)
+            .arg("run")
+            .arg(&path)
+            .args(["--mode", mode, "--realtime", "--speed", "2", "--out"])
+            .arg(&full)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
         let lpid = child.id();
         std::thread::sleep(Duration::from_millis(700));
         fill(&full, leave);
         let out = child.wait_with_output().unwrap();
         let (_, err) = text(&out);
-        let listing: Vec<String> = std::fs::read_dir(&full).unwrap().flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect();
+        let listing: Vec<String> = std::fs::read_dir(&full)
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .collect();
         let partial = full.join("seed002-sine.rrd.partial");
         let kept = partial.exists().then(|| read(&partial));
         let _ = Command::new("umount").arg(&full).status();
         assert_eq!(out.status.code(), Some(3), "{mode}: {err}");
         assert_eq!(err.trim_end().lines().count(), 1, "{mode}: {err}");
-        assert!(err.contains("seed002-sine.rrd.partial") && err.contains("No space left on device"), "{mode}: {err}");
+        assert!(
+            err.contains("seed002-sine.rrd.partial") && err.contains("No space left on device"),
+            "{mode}: {err}"
+        );
         assert_clean(&s, lpid);
-        assert!(!listing.contains(&"seed002-sine.rrd".to_string()), "{mode}: {listing:?}");
+        assert!(
+            !listing.contains(&"seed002-sine.rrd".to_string()),
+            "{mode}: {listing:?}"
+        );
         match kept {
             Some(r) => {
                 assert!(err.contains("was kept") && size == "3m", "{mode}: {err}");
                 let r = r.expect("the kept partial recording is readable");
-                assert!(!r.complete && r.series.values().any(|s| !s.values.is_empty()), "{mode}");
+                assert!(
+                    !r.complete && r.series.values().any(|s| !s.values.is_empty()),
+                    "{mode}"
+                );
             }
-            None => assert!(err.contains("was removed") && size == "200k", "{mode}: {err}"),
+            None => assert!(
+                err.contains("was removed") && size == "200k",
+                "{mode}: {err}"
+            ),
         }
     }
 }

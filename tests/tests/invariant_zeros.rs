@@ -8,7 +8,9 @@ use tests::*;
 mod zero_plants;
 
 fn toml_matrix(m: &lti::Mat) -> String {
-    let rows: Vec<Vec<f64>> = (0..m.nrows()).map(|i| m.row(i).iter().copied().collect()).collect();
+    let rows: Vec<Vec<f64>> = (0..m.nrows())
+        .map(|i| m.row(i).iter().copied().collect())
+        .collect();
     format!("{rows:?}")
 }
 
@@ -64,21 +66,42 @@ poles = {feedback:?}
 }
 
 fn tail(sum: &serde_json::Value, name: &str) -> f64 {
-    sum["observers"].as_array().unwrap().iter().find(|o| o["name"] == name).unwrap()["tail_max_abs_error"].as_f64().unwrap()
+    sum["observers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|o| o["name"] == name)
+        .unwrap()["tail_max_abs_error"]
+        .as_f64()
+        .unwrap()
 }
 
 /// Runs `path` in both modes; asserts bit-identical trajectories; returns the summary.
 fn both_modes(path: &std::path::Path, name: &str) -> serde_json::Value {
-    let (a, b) = (Scratch::new(&format!("{name}-p")), Scratch::new(&format!("{name}-i")));
+    let (a, b) = (
+        Scratch::new(&format!("{name}-p")),
+        Scratch::new(&format!("{name}-i")),
+    );
     for (s, mode) in [(&a, "processes"), (&b, "in-process")] {
         let out = run(s, path, &["--mode", mode]);
         assert!(out.status.success(), "{name} {mode}: {:?}", text(&out));
     }
-    let (ra, rb) = (read(&a.join(&format!("out/{name}.rrd"))).unwrap(), read(&b.join(&format!("out/{name}.rrd"))).unwrap());
+    let (ra, rb) = (
+        read(&a.join(&format!("out/{name}.rrd"))).unwrap(),
+        read(&b.join(&format!("out/{name}.rrd"))).unwrap(),
+    );
     let (ta, tb) = (trajectories(&ra), trajectories(&rb));
     assert_eq!(ta.len(), tb.len());
     for ((k, sa), (_, sb)) in ta.iter().zip(&tb) {
-        assert!(sa.values.len() == sb.values.len() && sa.values.iter().zip(&sb.values).all(|(x, y)| x.to_bits() == y.to_bits()), "{name}: {k} differs between modes");
+        assert!(
+            sa.values.len() == sb.values.len()
+                && sa
+                    .values
+                    .iter()
+                    .zip(&sb.values)
+                    .all(|(x, y)| x.to_bits() == y.to_bits()),
+            "{name}: {k} differs between modes"
+        );
     }
     summary(&a, name)
 }
@@ -86,11 +109,18 @@ fn both_modes(path: &std::path::Path, name: &str) -> serde_json::Value {
 #[test]
 fn dc_motor_runs_in_both_modes_and_the_uios_converge() {
     let sum = both_modes(&scenario("dc-motor-load-torque"), "dc-motor-load-torque");
-    let (uio, hz, lu) = (tail(&sum, "uio"), tail(&sum, "hui-zak"), tail(&sum, "luenberger"));
+    let (uio, hz, lu) = (
+        tail(&sum, "uio"),
+        tail(&sum, "hui-zak"),
+        tail(&sum, "luenberger"),
+    );
     eprintln!("dc motor tail max|e|: uio {uio:e}, hui-zak {hz:e}, luenberger {lu:e}");
     // The error decays like e^{−2t} (the fixed mode) from ~1 at t = 0: by the tail (7.5 s) ≲ 1e-6.
     assert!(uio < 1e-5 && hz < 1e-5, "uio {uio}, hui-zak {hz}");
-    assert!(lu > 1e3 * uio, "luenberger {lu} should follow the load torque");
+    assert!(
+        lu > 1e3 * uio,
+        "luenberger {lu} should follow the load torque"
+    );
 }
 
 #[test]

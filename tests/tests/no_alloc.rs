@@ -5,16 +5,16 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use controller::shell::ControllerComponent;
 use controller::Controller;
+use controller::shell::ControllerComponent;
 use launcher::plan::plan;
 use launcher::run::configs;
-use scenario::Scenario;
 use lockstep::component::{Component, Runner};
 use lockstep::{Bus, RunSpace, Wait};
 use observer::shell::ObserverComponent;
-use plant::shell::PlantComponent;
 use plant::Plant;
+use plant::shell::PlantComponent;
+use scenario::Scenario;
 use tests::*;
 
 struct Counting;
@@ -61,19 +61,31 @@ fn counting_allocator_counts() {
 }
 
 fn shipped() -> Vec<Scenario> {
-    let mut v: Vec<_> = std::fs::read_dir(repo().join("scenarios")).unwrap().flatten().map(|e| e.path()).collect();
+    let mut v: Vec<_> = std::fs::read_dir(repo().join("scenarios"))
+        .unwrap()
+        .flatten()
+        .map(|e| e.path())
+        .collect();
     v.sort();
     // Our own step functions: scenarios whose components are all built in.
     v.iter()
         .filter(|p| p.extension().is_some_and(|x| x == "toml"))
         .map(|p| Scenario::load(p).unwrap())
-        .filter(|s| s.plant_process.is_none() && s.observers.iter().all(|o| o.process.is_none()) && s.controller.as_ref().is_none_or(|c| c.process.is_none()))
+        .filter(|s| {
+            s.plant_process.is_none()
+                && s.observers.iter().all(|o| o.process.is_none())
+                && s.controller.as_ref().is_none_or(|c| c.process.is_none())
+        })
         .collect()
 }
 
 /// The benchmark's random plant with 120 states, 120 outputs, a UIO and a Luenberger observer.
 fn large() -> Scenario {
-    Scenario::parse(std::path::Path::new("states-120.toml"), &launcher::bench::states::scenario_text(120, 400)).unwrap()
+    Scenario::parse(
+        std::path::Path::new("states-120.toml"),
+        &launcher::bench::states::scenario_text(120, 400),
+    )
+    .unwrap()
 }
 
 #[test]
@@ -81,19 +93,36 @@ fn step_functions_do_not_allocate() {
     let mut scenarios = shipped();
     // A disturbance switching between samples makes the plant take its split-step path.
     let mut split = Scenario::load(&scenario("seed002-piecewise")).unwrap();
-    split.disturbances[0] = lti::signal::Signal::Piecewise { times: vec![0.0, 0.00105, 0.0023], values: vec![1.0, -1.0, 2.0] };
+    split.disturbances[0] = lti::signal::Signal::Piecewise {
+        times: vec![0.0, 0.00105, 0.0023],
+        values: vec![1.0, -1.0, 2.0],
+    };
     scenarios.push(split);
     // A large model: samples of hundreds of values, the double-precision exponential.
     scenarios.push(large());
     for s in scenarios {
-        let Ok(p) = plan(&s) else { panic!("{} does not design", s.name) };
+        let Ok(p) = plan(&s) else {
+            panic!("{} does not design", s.name)
+        };
         let cfg = configs(&s, &p);
         let mut plant = Plant::new(&cfg.plant).unwrap();
-        let mut observers: Vec<_> = cfg.observers.iter().map(|(_, o)| o.as_ref().unwrap().instantiate()).collect();
+        let mut observers: Vec<_> = cfg
+            .observers
+            .iter()
+            .map(|(_, o)| o.as_ref().unwrap().instantiate())
+            .collect();
         let mut controller = cfg.controller.as_ref().map(|c| Controller::new(c).unwrap());
-        let c_obs = cfg.controller.as_ref().and_then(|c| cfg.observers.iter().position(|(n, _)| *n == c.observer)).unwrap_or(0);
+        let c_obs = cfg
+            .controller
+            .as_ref()
+            .and_then(|c| cfg.observers.iter().position(|(n, _)| *n == c.observer))
+            .unwrap_or(0);
         let lay = cfg.layout;
-        let (mut row, mut xhat, mut u) = (vec![0.0; lay.len()], vec![vec![0.0; lay.n]; observers.len()], vec![0.0; lay.l]);
+        let (mut row, mut xhat, mut u) = (
+            vec![0.0; lay.len()],
+            vec![vec![0.0; lay.n]; observers.len()],
+            vec![0.0; lay.l],
+        );
         let steps = s.steps.min(5000);
         // A diverging run (the printed gain) stops at its first error, whose message allocates.
         let mut stopped = false;
@@ -142,17 +171,33 @@ fn process_loop(s: &Scenario) {
     let space = &space.0;
     {
         let components = launcher::run::envelopes(s, &cfg, space, Wait::Yield);
-        let bus = |c: &launcher::run::Launchable| Bus::join(space, &c.config.name, Wait::Yield).unwrap();
+        let bus =
+            |c: &launcher::run::Launchable| Bus::join(space, &c.config.name, Wait::Yield).unwrap();
         let (plant_bus, ctrl_bus) = (bus(&components[0]), bus(components.last().unwrap()));
-        let obs_buses: Vec<Bus> = components[1..components.len() - 1].iter().map(bus).collect();
-        let mut plant = Runner::new(&components[0].config, &plant_bus, PlantComponent::new(&components[0].config).unwrap()).unwrap();
+        let obs_buses: Vec<Bus> = components[1..components.len() - 1]
+            .iter()
+            .map(bus)
+            .collect();
+        let mut plant = Runner::new(
+            &components[0].config,
+            &plant_bus,
+            PlantComponent::new(&components[0].config).unwrap(),
+        )
+        .unwrap();
         let mut observers: Vec<Runner<ObserverComponent>> = components[1..components.len() - 1]
             .iter()
             .zip(&obs_buses)
-            .map(|(c, b)| Runner::new(&c.config, b, ObserverComponent::new(&c.config).unwrap()).unwrap())
+            .map(|(c, b)| {
+                Runner::new(&c.config, b, ObserverComponent::new(&c.config).unwrap()).unwrap()
+            })
             .collect();
         let c = components.last().unwrap();
-        let mut controller = Runner::new(&c.config, &ctrl_bus, ControllerComponent::new(&c.config).unwrap()).unwrap();
+        let mut controller = Runner::new(
+            &c.config,
+            &ctrl_bus,
+            ControllerComponent::new(&c.config).unwrap(),
+        )
+        .unwrap();
         // Every component steps in lockstep order; each wait finds its sample already there.
         let mut step = |k: u64| {
             plant.step(k).unwrap();
@@ -166,7 +211,13 @@ fn process_loop(s: &Scenario) {
         }
         let end = s.steps.min(5000);
         let n = allocations(|| (100..end).for_each(&mut step));
-        assert_eq!(n, 0, "{}: {n} allocations in {} steps of the process loops", s.name, end - 100);
+        assert_eq!(
+            n,
+            0,
+            "{}: {n} allocations in {} steps of the process loops",
+            s.name,
+            end - 100
+        );
     }
 }
 
@@ -174,13 +225,29 @@ fn process_loop(s: &Scenario) {
 /// row and its values go into buffers sized for a whole batch (`FLUSH_STEPS` rows).
 #[test]
 fn the_recording_writer_allocates_nothing_between_sends() {
-    use recording::write::{blueprint, RrdSink, FLUSH_STEPS};
+    use recording::write::{FLUSH_STEPS, RrdSink, blueprint};
     let s = Scenario::load(&scenario("seed002-sine")).unwrap();
     let dir = Scratch::new("noalloc-writer");
     let shown = s.clone();
-    let mut sink = RrdSink::create(&dir.join("r.rrd"), "r", move |l| blueprint(&shown, l), &s.source, Default::default()).unwrap();
+    let mut sink = RrdSink::create(
+        &dir.join("r.rrd"),
+        "r",
+        move |l| blueprint(&shown, l),
+        &s.source,
+        Default::default(),
+    )
+    .unwrap();
     let (g, late) = (sink.group("signals"), sink.group("late"));
-    let ids: Vec<_> = ["/plant/x/1", "/plant/y/1", "/observer/a/xhat/1", "/observer/a/error/1", "/controller/u/1"].iter().map(|p| sink.series(g, p, p, [0, 0, 0], 1.0)).collect();
+    let ids: Vec<_> = [
+        "/plant/x/1",
+        "/plant/y/1",
+        "/observer/a/xhat/1",
+        "/observer/a/error/1",
+        "/controller/u/1",
+    ]
+    .iter()
+    .map(|p| sink.series(g, p, p, [0, 0, 0], 1.0))
+    .collect();
     let step = sink.series(late, "/latency/step", "step", [0, 0, 0], 1.0);
     let mut k = 0u64;
     let mut one = |sink: &mut RrdSink| {

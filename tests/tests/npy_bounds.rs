@@ -38,17 +38,37 @@ fn a_sparse_matrix_file_claiming_a_huge_shape_is_refused_from_its_header() {
     for shape in ["(11585, 11585)", "(300000, 300000)"] {
         let path = s.join("model/A.npy");
         std::fs::write(&path, npy_header(shape)).unwrap();
-        std::fs::OpenOptions::new().write(true).open(&path).unwrap().set_len(1 << 30).unwrap();
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open(&path)
+            .unwrap()
+            .set_len(1 << 30)
+            .unwrap();
         let started = Instant::now();
         let out = launcher(&s).arg("design").arg(&scenario).output().unwrap();
         let took = started.elapsed();
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{shape}: {err}");
-        assert!(err.contains("plant.A") && err.contains("'model/A.npy'") && err.contains("its header says"), "{shape}: {err}");
+        assert!(
+            err.contains("plant.A")
+                && err.contains("'model/A.npy'")
+                && err.contains("its header says"),
+            "{shape}: {err}"
+        );
         assert_eq!(err.trim_end().lines().count(), 1, "{err}");
-        assert!(took < Duration::from_secs(2), "{shape}: refused after {took:?}");
+        assert!(
+            took < Duration::from_secs(2),
+            "{shape}: refused after {took:?}"
+        );
         let peak = children_peak_rss();
-        assert!(peak < 200 << 20, "{shape}: the launcher's memory peaked at {} MB", peak >> 20);
-        eprintln!("{shape}: refused in {took:?}, peak memory {} MB", peak >> 20);
+        assert!(
+            peak < 200 << 20,
+            "{shape}: the launcher's memory peaked at {} MB",
+            peak >> 20
+        );
+        eprintln!(
+            "{shape}: refused in {took:?}, peak memory {} MB",
+            peak >> 20
+        );
     }
 }

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use recording::plot::{figures, PlotSelection, Scale};
+use recording::plot::{PlotSelection, Scale, figures};
 use tests::*;
 
 /// The plot rectangle of a PNG (left, top, right, bottom): the y axis is the longest vertical
@@ -64,12 +64,48 @@ fn spiky_recording(path: &Path) {
     let n = 300_000;
     let steps: Vec<i64> = (0..n).collect();
     let noise = |k: i64| ((k * 7919) % 101) as f64 / 101.0;
-    let latency: Vec<f64> = steps.iter().map(|&k| if k == 150_000 { 4e9 } else { 15_000.0 + 20_000.0 * noise(k) }).collect();
-    let estimate: Vec<f64> = steps.iter().map(|&k| if k == 200_000 { 1e6 } else { (k as f64 * 1e-3).sin() + 0.01 * noise(k) }).collect();
+    let latency: Vec<f64> = steps
+        .iter()
+        .map(|&k| {
+            if k == 150_000 {
+                4e9
+            } else {
+                15_000.0 + 20_000.0 * noise(k)
+            }
+        })
+        .collect();
+    let estimate: Vec<f64> = steps
+        .iter()
+        .map(|&k| {
+            if k == 200_000 {
+                1e6
+            } else {
+                (k as f64 * 1e-3).sin() + 0.01 * noise(k)
+            }
+        })
+        .collect();
     let mut r = Recording::default();
-    r.series.insert("/latency/step".into(), Series { steps: steps.clone(), values: latency });
-    r.series.insert("/observer/a/xhat/1".into(), Series { steps: steps.clone(), values: estimate.clone() });
-    r.series.insert("/plant/x/1".into(), Series { steps, values: estimate });
+    r.series.insert(
+        "/latency/step".into(),
+        Series {
+            steps: steps.clone(),
+            values: latency,
+        },
+    );
+    r.series.insert(
+        "/observer/a/xhat/1".into(),
+        Series {
+            steps: steps.clone(),
+            values: estimate.clone(),
+        },
+    );
+    r.series.insert(
+        "/plant/x/1".into(),
+        Series {
+            steps,
+            values: estimate,
+        },
+    );
     recording::read::write(path, &r).unwrap();
 }
 
@@ -78,12 +114,24 @@ fn plots_stay_inside_their_axes() {
     let s = Scratch::new("plot-spike");
     let rrd = s.join("spike.rrd");
     spiky_recording(&rrd);
-    let out = launcher(&s).arg("plot").arg(&rrd).arg("--out").arg(s.join("png")).output().unwrap();
+    let out = launcher(&s)
+        .arg("plot")
+        .arg(&rrd)
+        .arg("--out")
+        .arg(s.join("png"))
+        .output()
+        .unwrap();
     assert!(out.status.success(), "{:?}", text(&out));
     let mut checked = 0;
     for f in std::fs::read_dir(s.join("png")).unwrap().flatten() {
         let outside = coloured_outside(&f.path());
-        assert!(outside.is_empty(), "{}: {} pixels of a series colour outside the axes, e.g. {:?}", f.path().display(), outside.len(), &outside[..outside.len().min(5)]);
+        assert!(
+            outside.is_empty(),
+            "{}: {} pixels of a series colour outside the axes, e.g. {:?}",
+            f.path().display(),
+            outside.len(),
+            &outside[..outside.len().min(5)]
+        );
         checked += 1;
     }
     assert!(checked >= 2, "{checked} files");
@@ -92,13 +140,39 @@ fn plots_stay_inside_their_axes() {
 #[test]
 fn one_colour_per_observer_a_log_error_view_and_one_based_names() {
     let s = Scratch::new("plot-views");
-    assert!(run(&s, &scenario("seed002-sine"), &["--mode", "in-process"]).status.success());
+    assert!(
+        run(&s, &scenario("seed002-sine"), &["--mode", "in-process"])
+            .status
+            .success()
+    );
     let r = read(&s.join("out/seed002-sine.rrd")).unwrap();
-    assert!(r.series.contains_key("/plant/x/1") && r.series.contains_key("/plant/x/3") && !r.series.contains_key("/plant/x/0"));
-    assert!(r.series.contains_key("/observer/uio/error/3") && r.series.contains_key("/input/2") && r.series.contains_key("/disturbance/1"));
+    assert!(
+        r.series.contains_key("/plant/x/1")
+            && r.series.contains_key("/plant/x/3")
+            && !r.series.contains_key("/plant/x/0")
+    );
+    assert!(
+        r.series.contains_key("/observer/uio/error/3")
+            && r.series.contains_key("/input/2")
+            && r.series.contains_key("/disturbance/1")
+    );
     let figs = figures(&r, &PlotSelection::default()).unwrap();
-    let fig = |file: &str| &figs.iter().find(|(f, _)| f == file).unwrap_or_else(|| panic!("no {file}")).1;
-    let colour_of = |file: &str, label_part: &str| fig(file).curves.iter().find(|c| c.label.contains(label_part)).unwrap_or_else(|| panic!("{file}: {label_part}")).line.color;
+    let fig = |file: &str| {
+        &figs
+            .iter()
+            .find(|(f, _)| f == file)
+            .unwrap_or_else(|| panic!("no {file}"))
+            .1
+    };
+    let colour_of = |file: &str, label_part: &str| {
+        fig(file)
+            .curves
+            .iter()
+            .find(|c| c.label.contains(label_part))
+            .unwrap_or_else(|| panic!("{file}: {label_part}"))
+            .line
+            .color
+    };
     // The same colour for an observer in every view; the true state apart and wider.
     let uio = colour_of("state_1_x1.png", "(uio)");
     let luenberger = colour_of("state_1_x1.png", "(luenberger)");
@@ -107,38 +181,112 @@ fn one_colour_per_observer_a_log_error_view_and_one_based_names() {
     assert_eq!(colour_of("errors_log.png", "uio"), uio);
     assert_eq!(colour_of("error_uio.png", "e1"), uio);
     let truth = &fig("state_2_x2.png").curves[0];
-    assert!(truth.label.contains("true") && truth.line.width > fig("state_2_x2.png").curves[1].line.width);
+    assert!(
+        truth.label.contains("true")
+            && truth.line.width > fig("state_2_x2.png").curves[1].line.width
+    );
     assert!(![uio, luenberger].contains(&truth.line.color));
     // The log view separates the UIO (converging like e^{−t}) from the Luenberger observer
     // (driven by the disturbance) by orders of magnitude at the end of the run.
     let log = fig("errors_log.png");
     assert_eq!(log.scale, Scale::Log);
-    let last = |part: &str| log.curves.iter().find(|c| c.label.contains(part)).unwrap().points.iter().filter(|p| p.0 > 15.0).map(|p| p.1).fold(f64::MIN, f64::max);
-    assert!(last("luenberger") - last("uio") > 4.0, "log10 gap {}", last("luenberger") - last("uio"));
+    let last = |part: &str| {
+        log.curves
+            .iter()
+            .find(|c| c.label.contains(part))
+            .unwrap()
+            .points
+            .iter()
+            .filter(|p| p.0 > 15.0)
+            .map(|p| p.1)
+            .fold(f64::MIN, f64::max)
+    };
+    assert!(
+        last("luenberger") - last("uio") > 4.0,
+        "log10 gap {}",
+        last("luenberger") - last("uio")
+    );
 }
 
 #[test]
 fn signals_and_a_time_window_choose_what_is_drawn() {
     let s = Scratch::new("plot-select");
-    assert!(run(&s, &scenario("seed002-sine"), &["--mode", "in-process"]).status.success());
+    assert!(
+        run(&s, &scenario("seed002-sine"), &["--mode", "in-process"])
+            .status
+            .success()
+    );
     let rrd = s.join("out/seed002-sine.rrd");
-    let out = launcher(&s).arg("plot").arg(&rrd).args(["--out", "png", "--signals", "/observer/uio/**", "--from", "5", "--to", "7.5"]).output().unwrap();
+    let out = launcher(&s)
+        .arg("plot")
+        .arg(&rrd)
+        .args([
+            "--out",
+            "png",
+            "--signals",
+            "/observer/uio/**",
+            "--from",
+            "5",
+            "--to",
+            "7.5",
+        ])
+        .output()
+        .unwrap();
     assert!(out.status.success(), "{:?}", text(&out));
-    let mut files: Vec<String> = std::fs::read_dir(s.join("png")).unwrap().flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect();
+    let mut files: Vec<String> = std::fs::read_dir(s.join("png"))
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
     files.sort();
-    assert_eq!(files, ["error_uio.png", "errors_log.png", "input_estimate_uio.png", "residual_uio.png", "state_1_x1.png", "state_2_x2.png", "state_3_x3.png"]);
+    assert_eq!(
+        files,
+        [
+            "error_uio.png",
+            "errors_log.png",
+            "input_estimate_uio.png",
+            "residual_uio.png",
+            "state_1_x1.png",
+            "state_2_x2.png",
+            "state_3_x3.png"
+        ]
+    );
     let r = read(&rrd).unwrap();
-    let sel = PlotSelection { signals: vec!["/observer/uio/**".into()], from: Some(5.0), to: Some(7.5) };
+    let sel = PlotSelection {
+        signals: vec!["/observer/uio/**".into()],
+        from: Some(5.0),
+        to: Some(7.5),
+    };
     for (file, fig) in figures(&r, &sel).unwrap() {
         for c in &fig.curves {
-            assert!(c.label.contains("uio") || file.contains("uio"), "{file}: {}", c.label);
-            let (lo, hi) = c.points.iter().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
-            assert!(lo >= 5.0 && hi <= 7.5 && hi - lo > 2.4, "{file}: {lo}..{hi}");
+            assert!(
+                c.label.contains("uio") || file.contains("uio"),
+                "{file}: {}",
+                c.label
+            );
+            let (lo, hi) = c
+                .points
+                .iter()
+                .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
+            assert!(
+                lo >= 5.0 && hi <= 7.5 && hi - lo > 2.4,
+                "{file}: {lo}..{hi}"
+            );
         }
     }
     // A bad window or glob: exit 2, one line naming the option, nothing drawn.
-    for (args, what) in [(vec!["--from", "3", "--to", "1"], "--from"), (vec!["--to", "nan"], "--to"), (vec!["--signals", "/plant/[x"], "--signals")] {
-        let out = launcher(&s).arg("plot").arg(&rrd).args(["--out", "bad"]).args(&args).output().unwrap();
+    for (args, what) in [
+        (vec!["--from", "3", "--to", "1"], "--from"),
+        (vec!["--to", "nan"], "--to"),
+        (vec!["--signals", "/plant/[x"], "--signals"),
+    ] {
+        let out = launcher(&s)
+            .arg("plot")
+            .arg(&rrd)
+            .args(["--out", "bad"])
+            .args(&args)
+            .output()
+            .unwrap();
         let (_, err) = text(&out);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
         assert_eq!(err.trim().lines().count(), 1, "{err}");
@@ -146,7 +294,12 @@ fn signals_and_a_time_window_choose_what_is_drawn() {
         assert!(!s.join("bad").exists());
     }
     // A window with no data.
-    let out = launcher(&s).arg("plot").arg(&rrd).args(["--out", "late", "--from", "100", "--to", "200"]).output().unwrap();
+    let out = launcher(&s)
+        .arg("plot")
+        .arg(&rrd)
+        .args(["--out", "late", "--from", "100", "--to", "200"])
+        .output()
+        .unwrap();
     assert_eq!(out.status.code(), Some(2), "{:?}", text(&out));
 }
 
@@ -163,20 +316,55 @@ fn names_and_units_label_plots_and_csv_headers() {
     std::fs::write(&path, named).unwrap();
     assert!(run(&s, &path, &["--mode", "in-process"]).status.success());
     let rrd = s.join("out/seed002-sine.rrd");
-    let out = launcher(&s).arg("export").arg(&rrd).arg("--csv").arg(s.join("csv")).output().unwrap();
+    let out = launcher(&s)
+        .arg("export")
+        .arg(&rrd)
+        .arg("--csv")
+        .arg(s.join("csv"))
+        .output()
+        .unwrap();
     assert!(out.status.success(), "{:?}", text(&out));
-    let header = |file: &str| std::fs::read_to_string(s.join("csv").join(file)).unwrap().lines().next().unwrap().to_string();
-    assert_eq!(header("plant_x.csv"), "step,sim_time,pos [m],vel [m/s],volt [V]");
-    assert_eq!(header("plant_y.csv"), "step,sim_time,pos_meas [m],volt_meas [V]");
-    assert_eq!(header("observer_uio_xhat.csv"), "step,sim_time,pos [m],vel [m/s],volt [V]");
-    assert_eq!(header("observer_uio_error.csv"), "step,sim_time,e1 [m],e2 [m/s],e3 [V]");
-    assert_eq!(header("observer_luenberger_residual.csv"), "step,sim_time,r1 [m],r2 [V]");
+    let header = |file: &str| {
+        std::fs::read_to_string(s.join("csv").join(file))
+            .unwrap()
+            .lines()
+            .next()
+            .unwrap()
+            .to_string()
+    };
+    assert_eq!(
+        header("plant_x.csv"),
+        "step,sim_time,pos [m],vel [m/s],volt [V]"
+    );
+    assert_eq!(
+        header("plant_y.csv"),
+        "step,sim_time,pos_meas [m],volt_meas [V]"
+    );
+    assert_eq!(
+        header("observer_uio_xhat.csv"),
+        "step,sim_time,pos [m],vel [m/s],volt [V]"
+    );
+    assert_eq!(
+        header("observer_uio_error.csv"),
+        "step,sim_time,e1 [m],e2 [m/s],e3 [V]"
+    );
+    assert_eq!(
+        header("observer_luenberger_residual.csv"),
+        "step,sim_time,r1 [m],r2 [V]"
+    );
     assert_eq!(header("input.csv"), "step,sim_time,force [N],supply [V]");
-    assert_eq!(header("controller_u.csv"), "step,sim_time,force (u) [N],supply (u) [V]");
+    assert_eq!(
+        header("controller_u.csv"),
+        "step,sim_time,force (u) [N],supply (u) [V]"
+    );
     assert_eq!(header("disturbance.csv"), "step,sim_time,gust [N]");
     let latency = header("latency.csv");
     let cols: Vec<&str> = latency.split(',').collect();
-    assert_eq!(cols.iter().filter(|c| **c == "step").count(), 1, "{latency}");
+    assert_eq!(
+        cols.iter().filter(|c| **c == "step").count(),
+        1,
+        "{latency}"
+    );
     assert!(cols.contains(&"step_latency [ns]"), "{latency}");
     // Plots: titles, axis labels and legends carry the names and units.
     let r = read(&rrd).unwrap();
@@ -189,12 +377,20 @@ fn names_and_units_label_plots_and_csv_headers() {
     let labels: Vec<&str> = outputs.curves.iter().map(|c| c.label.as_str()).collect();
     assert_eq!(labels, ["pos_meas [m]", "volt_meas [V]"]);
     // A names list of the wrong length is bad input, named by file and field.
-    let bad = std::fs::read_to_string(&path).unwrap().replace("output_names = [\"pos_meas\", \"volt_meas\"]", "output_names = [\"pos_meas\"]");
+    let bad = std::fs::read_to_string(&path).unwrap().replace(
+        "output_names = [\"pos_meas\", \"volt_meas\"]",
+        "output_names = [\"pos_meas\"]",
+    );
     std::fs::write(&path, bad).unwrap();
     let out = run(&s, &path, &["--mode", "in-process", "--force"]);
     let (_, err) = text(&out);
     assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains("named.toml") && err.contains("plant.output_names") && err.contains("has 1 entry, C has 2 rows"), "{err}");
+    assert!(
+        err.contains("named.toml")
+            && err.contains("plant.output_names")
+            && err.contains("has 1 entry, C has 2 rows"),
+        "{err}"
+    );
 }
 
 /// Issue 21: the diagnosis view draws J on a log axis (its values log10, 0 at the floor), and
@@ -202,15 +398,30 @@ fn names_and_units_label_plots_and_csv_headers() {
 #[test]
 fn the_diagnosis_view_has_j_on_a_log_axis_and_dashed_thresholds_in_their_colours() {
     let s = Scratch::new("plot-diagnosis");
-    let out = run(&s, &scenario("seed002-actuator-faults"), &["--mode", "in-process"]);
+    let out = run(
+        &s,
+        &scenario("seed002-actuator-faults"),
+        &["--mode", "in-process"],
+    );
     assert!(out.status.success(), "{:?}", text(&out));
     let r = recording::read::read(&s.join("out/seed002-actuator-faults.rrd")).unwrap();
     let figs = figures(&r, &PlotSelection::default()).unwrap();
-    let (_, fig) = figs.iter().find(|(f, _)| f == "diagnosis_gos.png").expect("a diagnosis view");
+    let (_, fig) = figs
+        .iter()
+        .find(|(f, _)| f == "diagnosis_gos.png")
+        .expect("a diagnosis view");
     assert_eq!(fig.scale, Scale::Log);
     for i in 1..=2 {
-        let j = fig.curves.iter().find(|c| c.label.starts_with(&format!("J{i}"))).unwrap();
-        let t = fig.curves.iter().find(|c| c.label.starts_with(&format!("threshold {i}"))).unwrap();
+        let j = fig
+            .curves
+            .iter()
+            .find(|c| c.label.starts_with(&format!("J{i}")))
+            .unwrap();
+        let t = fig
+            .curves
+            .iter()
+            .find(|c| c.label.starts_with(&format!("threshold {i}")))
+            .unwrap();
         assert!(t.dashed && !j.dashed);
         assert_eq!(t.line.color, j.line.color, "threshold {i}");
         let raw = r.series[&format!("/diagnosis/gos/threshold/{i}")].values[0];
@@ -227,13 +438,35 @@ fn a_state_name_of_250_characters_is_plotted_under_a_file_name_that_fits() {
     let long = "x".repeat(250);
     let text_ = std::fs::read_to_string(scenario("seed002-sine")).unwrap();
     let path = s.join("long.toml");
-    std::fs::write(&path, text_.replacen("[plant]", &format!("[plant]\nstate_names = [\"{long}\", \"vel\", \"volt\"]"), 1)).unwrap();
+    std::fs::write(
+        &path,
+        text_.replacen(
+            "[plant]",
+            &format!("[plant]\nstate_names = [\"{long}\", \"vel\", \"volt\"]"),
+            1,
+        ),
+    )
+    .unwrap();
     assert!(run(&s, &path, &["--mode", "in-process"]).status.success());
-    let out = launcher(&s).arg("plot").arg(s.join("out/seed002-sine.rrd")).arg("--out").arg(s.join("png")).output().unwrap();
+    let out = launcher(&s)
+        .arg("plot")
+        .arg(s.join("out/seed002-sine.rrd"))
+        .arg("--out")
+        .arg(s.join("png"))
+        .output()
+        .unwrap();
     assert!(out.status.success(), "{:?}", text(&out));
     let file = format!("state_1_{}.png", "x".repeat(64));
     assert!(s.join("png").join(&file).is_file(), "{file} missing");
-    let figs = figures(&read(&s.join("out/seed002-sine.rrd")).unwrap(), &PlotSelection::default()).unwrap();
+    let figs = figures(
+        &read(&s.join("out/seed002-sine.rrd")).unwrap(),
+        &PlotSelection::default(),
+    )
+    .unwrap();
     let fig = &figs.iter().find(|(f, _)| *f == file).unwrap().1;
-    assert!(fig.title.contains(&long) && fig.y_label.contains(&long), "{}", fig.title);
+    assert!(
+        fig.title.contains(&long) && fig.y_label.contains(&long),
+        "{}",
+        fig.title
+    );
 }

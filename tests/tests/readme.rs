@@ -26,7 +26,10 @@ fn toml_blocks(text: &str) -> Vec<(usize, String)> {
 /// A line's commented-out setting, uncommented: "# key = value   # note" → "key = value".
 fn uncomment(line: &str) -> Option<String> {
     let rest = line.trim_start().strip_prefix('#')?.trim_start();
-    let looks_like_toml = rest.starts_with('[') || rest.split_once('=').is_some_and(|(k, _)| !k.trim().is_empty() && !k.contains(' '));
+    let looks_like_toml = rest.starts_with('[')
+        || rest
+            .split_once('=')
+            .is_some_and(|(k, _)| !k.trim().is_empty() && !k.contains(' '));
     looks_like_toml.then(|| rest.to_string())
 }
 
@@ -38,7 +41,8 @@ fn every_toml_example_parses_and_scenarios_validate() {
     for (line, body) in &blocks {
         toml::from_str::<toml::Table>(body).unwrap_or_else(|e| panic!("README.md:{line}: {e}"));
         if body.contains("[plant]") {
-            scenario::Scenario::parse(Path::new("README.md"), body).unwrap_or_else(|e| panic!("README.md:{line}: {e}"));
+            scenario::Scenario::parse(Path::new("README.md"), body)
+                .unwrap_or_else(|e| panic!("README.md:{line}: {e}"));
         }
         // Each commented setting, uncommented on its own, is valid TOML too.
         for (j, l) in body.lines().enumerate() {
@@ -46,7 +50,12 @@ fn every_toml_example_parses_and_scenarios_validate() {
                 if setting.starts_with('[') {
                     continue;
                 }
-                toml::from_str::<toml::Table>(&setting).unwrap_or_else(|e| panic!("README.md:{}: commented example `{setting}` is not TOML: {e}", line + j));
+                toml::from_str::<toml::Table>(&setting).unwrap_or_else(|e| {
+                    panic!(
+                        "README.md:{}: commented example `{setting}` is not TOML: {e}",
+                        line + j
+                    )
+                });
             }
         }
     }

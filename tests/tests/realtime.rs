@@ -11,7 +11,10 @@ fn cpu_ticks(pid: i32) -> Option<(u64, u64)> {
     let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
     let rest = stat.rsplit_once(')')?.1;
     let f: Vec<&str> = rest.split_whitespace().collect();
-    Some((f.get(11)?.parse::<u64>().ok()?, f.get(12)?.parse::<u64>().ok()?))
+    Some((
+        f.get(11)?.parse::<u64>().ok()?,
+        f.get(12)?.parse::<u64>().ok()?,
+    ))
 }
 
 /// How long `n` sleeps of `period` take here, now: the machine's own floor for a paced step
@@ -67,7 +70,10 @@ fn a_paced_run_keeps_wall_time_and_its_processes_idle() {
     // core for the plant on 2026-11-28, all of it in recvfrom/sendto, user time ~0).
     for ((name, b), a) in names.iter().zip(&before).zip(&after) {
         let a = a.expect("still running");
-        let (user, total) = ((a.0 - b.0) as f64 / hz / secs, ((a.0 + a.1) - (b.0 + b.1)) as f64 / hz / secs);
+        let (user, total) = (
+            (a.0 - b.0) as f64 / hz / secs,
+            ((a.0 + a.1) - (b.0 + b.1)) as f64 / hz / secs,
+        );
         assert!(
             user < 0.10 && total < 0.5,
             "{name} used {:.0} % of a core ({:.0} % in user space) in a paced run",

@@ -21,7 +21,9 @@ fn root_or_skip(test: &str) -> bool {
     // SAFETY: geteuid cannot fail.
     let root = unsafe { libc::geteuid() } == 0;
     if !root {
-        eprintln!("skipped {test}: needs root (it plants files owned by another user and runs the launcher as root)");
+        eprintln!(
+            "skipped {test}: needs root (it plants files owned by another user and runs the launcher as root)"
+        );
     }
     root
 }
@@ -53,7 +55,12 @@ fn dead_pid() -> u32 {
 fn mkfifo(path: &Path) {
     let c = CString::new(path.as_os_str().as_bytes()).unwrap();
     // SAFETY: a valid NUL-terminated path.
-    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo {}", path.display());
+    assert_eq!(
+        unsafe { libc::mkfifo(c.as_ptr(), 0o600) },
+        0,
+        "mkfifo {}",
+        path.display()
+    );
 }
 
 fn private_dir(path: &Path) {
@@ -70,14 +77,23 @@ fn victim(path: &Path) {
 
 fn assert_victim_intact(path: &Path) {
     for d in ["a", "a/b", "c"] {
-        assert!(path.join(d).is_dir(), "{} was removed", path.join(d).display());
+        assert!(
+            path.join(d).is_dir(),
+            "{} was removed",
+            path.join(d).display()
+        );
     }
     assert_eq!(fs::read_to_string(path.join("file")).unwrap(), "precious");
 }
 
 /// Runs `launcher run <scenario>` with `runs` as UIO_RUNS_DIR (None: unset, with `env` added),
 /// killing it if it is not done by [`DEADLINE`].
-fn run_launcher(s: &Scratch, scenario: &Path, runs: Option<&Path>, env: &[(&str, &Path)]) -> (Output, u32) {
+fn run_launcher(
+    s: &Scratch,
+    scenario: &Path,
+    runs: Option<&Path>,
+    env: &[(&str, &Path)],
+) -> (Output, u32) {
     let mut cmd = launcher(s);
     match runs {
         Some(r) => cmd.env(lockstep_runs_env(), r),
@@ -106,11 +122,21 @@ fn run_launcher(s: &Scratch, scenario: &Path, runs: Option<&Path>, env: &[(&str,
         if start.elapsed() > DEADLINE {
             signal(pid as i32, libc::SIGKILL);
             let _ = child.wait();
-            panic!("the launcher hung: not done after {DEADLINE:?}; stderr: {}", fs::read_to_string(&err).unwrap_or_default());
+            panic!(
+                "the launcher hung: not done after {DEADLINE:?}; stderr: {}",
+                fs::read_to_string(&err).unwrap_or_default()
+            );
         }
         std::thread::sleep(Duration::from_millis(20));
     };
-    (Output { status, stdout: fs::read(&out).unwrap(), stderr: fs::read(&err).unwrap() }, pid)
+    (
+        Output {
+            status,
+            stdout: fs::read(&out).unwrap(),
+            stderr: fs::read(&err).unwrap(),
+        },
+        pid,
+    )
 }
 
 fn scenario_of(s: &Scratch) -> PathBuf {
@@ -121,15 +147,30 @@ fn scenario_of(s: &Scratch) -> PathBuf {
 /// any output existed.
 fn assert_refused(s: &Scratch, o: &Output, path: &Path, why: &str) {
     let (_, err) = text(o);
-    assert_eq!(o.status.code(), Some(2), "expected a refusal (exit 2): {err}");
-    let line = err.lines().find(|l| l.starts_with("error:")).unwrap_or_else(|| panic!("no error line: {err}"));
-    assert!(line.contains(&path.display().to_string()) && line.contains(why), "{line}");
-    assert!(!s.join("out/seed002-sine.rrd.partial").exists() && !s.join("out/seed002-sine.rrd").exists(), "output written");
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "expected a refusal (exit 2): {err}"
+    );
+    let line = err
+        .lines()
+        .find(|l| l.starts_with("error:"))
+        .unwrap_or_else(|| panic!("no error line: {err}"));
+    assert!(
+        line.contains(&path.display().to_string()) && line.contains(why),
+        "{line}"
+    );
+    assert!(
+        !s.join("out/seed002-sine.rrd.partial").exists()
+            && !s.join("out/seed002-sine.rrd").exists(),
+        "output written"
+    );
 }
 
 #[test]
 fn a_symlink_planted_as_the_runs_directory_is_refused_and_its_target_untouched() {
-    if !root_or_skip("a_symlink_planted_as_the_runs_directory_is_refused_and_its_target_untouched") {
+    if !root_or_skip("a_symlink_planted_as_the_runs_directory_is_refused_and_its_target_untouched")
+    {
         return;
     }
     let s = Scratch::new("rd-link");
@@ -145,7 +186,13 @@ fn a_symlink_planted_as_the_runs_directory_is_refused_and_its_target_untouched()
     let (o, _) = run_launcher(&s, &scenario_of(&s), Some(&runs), &[]);
     assert_victim_intact(&target);
     assert_refused(&s, &o, &runs, "is a symbolic link");
-    assert!(fs::symlink_metadata(&runs).unwrap().file_type().is_symlink(), "the planted link is not ours to remove");
+    assert!(
+        fs::symlink_metadata(&runs)
+            .unwrap()
+            .file_type()
+            .is_symlink(),
+        "the planted link is not ours to remove"
+    );
 }
 
 #[test]
@@ -167,7 +214,11 @@ fn another_users_or_an_open_runs_directory_is_refused() {
     fs::set_permissions(&open, fs::Permissions::from_mode(0o755)).unwrap();
     let (o, _) = run_launcher(&s, &scenario_of(&s), Some(&open), &[]);
     assert_refused(&s, &o, &open, "accessible to group or others");
-    assert_eq!(fs::metadata(&open).unwrap().mode() & 0o777, 0o755, "a refused directory is left as it was");
+    assert_eq!(
+        fs::metadata(&open).unwrap().mode() & 0o777,
+        0o755,
+        "a refused directory is left as it was"
+    );
 }
 
 #[test]
@@ -191,12 +242,21 @@ fn a_fifo_as_a_dead_runs_owner_pid_neither_hangs_nor_is_removed() {
     let start = Instant::now();
     let (o, pid) = run_launcher(&s, &scenario_of(&s), Some(&runs), &[]);
     assert!(o.status.success(), "{:?}", text(&o));
-    assert!(start.elapsed() < Duration::from_secs(30), "took {:?}", start.elapsed());
+    assert!(
+        start.elapsed() < Duration::from_secs(30),
+        "took {:?}",
+        start.elapsed()
+    );
     for d in [&ours, &theirs] {
-        let m = fs::symlink_metadata(d.join("owner.pid")).unwrap_or_else(|e| panic!("{}: {e}", d.display()));
+        let m = fs::symlink_metadata(d.join("owner.pid"))
+            .unwrap_or_else(|e| panic!("{}: {e}", d.display()));
         assert!(m.file_type().is_fifo(), "{} replaced", d.display());
     }
-    assert!(shm_of(pid).is_empty(), "shared memory left: {:?}", shm_of(pid));
+    assert!(
+        shm_of(pid).is_empty(),
+        "shared memory left: {:?}",
+        shm_of(pid)
+    );
 }
 
 #[test]
@@ -220,7 +280,13 @@ fn only_our_own_dead_runs_are_cleaned() {
     let (ours, ours_shm) = plant_run(3);
     // A dead run of nobody's, with shared memory of nobody's named like one of ours: left.
     let (theirs, theirs_shm) = plant_run(4);
-    for p in [theirs.join("iox2/sub"), theirs.join("iox2"), theirs.join("owner.pid"), theirs.clone(), theirs_shm.clone()] {
+    for p in [
+        theirs.join("iox2/sub"),
+        theirs.join("iox2"),
+        theirs.join("owner.pid"),
+        theirs.clone(),
+        theirs_shm.clone(),
+    ] {
         give_to_nobody(&p);
     }
     let (o, _) = run_launcher(&s, &scenario_of(&s), Some(&runs), &[]);
@@ -229,8 +295,14 @@ fn only_our_own_dead_runs_are_cleaned() {
     let _ = fs::remove_file(&ours_shm);
     assert!(o.status.success(), "{:?}", text(&o));
     assert!(!ours.exists(), "our dead run was not cleaned");
-    assert!(!ours_shm.exists(), "our dead run's shared memory was not cleaned");
-    assert!(theirs.join("iox2/sub").is_dir() && theirs.join("owner.pid").is_file(), "nobody's run was removed");
+    assert!(
+        !ours_shm.exists(),
+        "our dead run's shared memory was not cleaned"
+    );
+    assert!(
+        theirs.join("iox2/sub").is_dir() && theirs.join("owner.pid").is_file(),
+        "nobody's run was removed"
+    );
     assert!(theirs_shm_left, "nobody's shared memory was removed");
 }
 
@@ -248,7 +320,10 @@ fn a_symlink_planted_as_a_run_is_neither_followed_nor_removed() {
     victim(&target);
     fs::create_dir(target.join("iox2")).unwrap();
     fs::write(target.join("owner.pid"), format!("{dead}\n")).unwrap();
-    let links = [runs.join(format!("{dead}x0x5")), runs.join(format!(".new-{dead}x0x6"))];
+    let links = [
+        runs.join(format!("{dead}x0x5")),
+        runs.join(format!(".new-{dead}x0x6")),
+    ];
     for l in &links {
         std::os::unix::fs::symlink(&target, l).unwrap();
         give_to_nobody(l);
@@ -258,7 +333,11 @@ fn a_symlink_planted_as_a_run_is_neither_followed_nor_removed() {
     assert_victim_intact(&target);
     assert!(target.join("iox2").is_dir() && target.join("owner.pid").is_file());
     for l in &links {
-        assert!(fs::symlink_metadata(l).is_ok_and(|m| m.file_type().is_symlink()), "{}: not ours, yet removed", l.display());
+        assert!(
+            fs::symlink_metadata(l).is_ok_and(|m| m.file_type().is_symlink()),
+            "{}: not ours, yet removed",
+            l.display()
+        );
     }
 }
 
@@ -274,13 +353,32 @@ fn the_default_runs_directory_is_a_private_one_in_xdg_runtime_dir() {
     let (o, pid) = run_launcher(&s, &scenario_of(&s), None, &[("XDG_RUNTIME_DIR", &xdg)]);
     assert!(o.status.success(), "{:?}", text(&o));
     let runs = xdg.join("uio-observers");
-    let m = fs::symlink_metadata(&runs).unwrap_or_else(|e| panic!("{} was not used: {e}", runs.display()));
-    assert!(m.is_dir() && m.uid() == 0 && m.mode() & 0o777 == 0o700, "mode {:o}, uid {}", m.mode(), m.uid());
-    let left: Vec<_> = fs::read_dir(&runs).unwrap().flatten().map(|e| e.path()).collect();
+    let m = fs::symlink_metadata(&runs)
+        .unwrap_or_else(|e| panic!("{} was not used: {e}", runs.display()));
+    assert!(
+        m.is_dir() && m.uid() == 0 && m.mode() & 0o777 == 0o700,
+        "mode {:o}, uid {}",
+        m.mode(),
+        m.uid()
+    );
+    let left: Vec<_> = fs::read_dir(&runs)
+        .unwrap()
+        .flatten()
+        .map(|e| e.path())
+        .collect();
     assert!(left.is_empty(), "run directories left: {left:?}");
     let short: Vec<_> = fs::read_dir("/tmp/uio-iox2-0")
-        .map(|d| d.flatten().map(|e| e.file_name()).filter(|n| n.to_string_lossy().starts_with(&format!("{pid}x"))).collect())
+        .map(|d| {
+            d.flatten()
+                .map(|e| e.file_name())
+                .filter(|n| n.to_string_lossy().starts_with(&format!("{pid}x")))
+                .collect()
+        })
         .unwrap_or_default();
     assert!(short.is_empty(), "short iceoryx2 roots left: {short:?}");
-    assert!(shm_of(pid).is_empty(), "shared memory left: {:?}", shm_of(pid));
+    assert!(
+        shm_of(pid).is_empty(),
+        "shared memory left: {:?}",
+        shm_of(pid)
+    );
 }

@@ -18,8 +18,14 @@ fn with_busy_observer(s: &Scratch, busy_s: f64, extra: &str) -> std::path::PathB
     )
     .unwrap();
     let text = std::fs::read_to_string(scenario("seed002-sine")).unwrap();
-    let text = text.split("\n[controller]").next().unwrap().replace("duration = 20.0", "duration = 0.5");
-    let text = format!("{extra}{text}\n[[observer]]\nname = \"slow\"\nkind = \"process\"\ncommand = [\"python3\", \"busy.py\"]\n");
+    let text = text
+        .split("\n[controller]")
+        .next()
+        .unwrap()
+        .replace("duration = 20.0", "duration = 0.5");
+    let text = format!(
+        "{extra}{text}\n[[observer]]\nname = \"slow\"\nkind = \"process\"\ncommand = [\"python3\", \"busy.py\"]\n"
+    );
     let p = s.join("slow.toml");
     std::fs::write(&p, text).unwrap();
     p
@@ -40,7 +46,11 @@ fn a_component_that_runs_long_is_waited_for() {
 /// scenario — is named with the limit that was hit; the command line wins over the file.
 #[test]
 fn a_component_past_the_stall_limit_is_named_with_the_limit() {
-    for (extra, args) in [("", &["--stall-timeout", "5"][..]), ("stall_timeout = 5.0\n", &[][..]), ("stall_timeout = 5.0\n", &["--stall-timeout", "30"][..])] {
+    for (extra, args) in [
+        ("", &["--stall-timeout", "5"][..]),
+        ("stall_timeout = 5.0\n", &[][..]),
+        ("stall_timeout = 5.0\n", &["--stall-timeout", "30"][..]),
+    ] {
         let s = Scratch::new("busy-limit");
         let path = with_busy_observer(&s, 12.0, extra);
         let (code, err, took) = run_checked(&s, &path, args);
@@ -57,7 +67,10 @@ fn a_component_past_the_stall_limit_is_named_with_the_limit() {
     let path = with_busy_observer(&s, 0.0, "");
     let (code, err, _) = run_checked(&s, &path, &["--stall-timeout", "1"]);
     assert_eq!(code, Some(2), "{err}");
-    assert!(err.contains("--stall-timeout: 1 s must be between 5 s"), "{err}");
+    assert!(
+        err.contains("--stall-timeout: 1 s must be between 5 s"),
+        "{err}"
+    );
 }
 
 /// Busy loops of our own, one per core, starve the ring: the seed-002 runs (cut to 3 s of
@@ -66,23 +79,56 @@ fn a_component_past_the_stall_limit_is_named_with_the_limit() {
 #[test]
 fn seed002_runs_finish_under_a_cpu_hog_on_both_cores() {
     let cores = std::thread::available_parallelism().map_or(2, |n| n.get());
-    let mut hogs: Vec<std::process::Child> = (0..cores).map(|_| std::process::Command::new("sh").args(["-c", "while :; do :; done"]).spawn().unwrap()).collect();
+    let mut hogs: Vec<std::process::Child> = (0..cores)
+        .map(|_| {
+            std::process::Command::new("sh")
+                .args(["-c", "while :; do :; done"])
+                .spawn()
+                .unwrap()
+        })
+        .collect();
     let result = std::panic::catch_unwind(|| {
-        for (name, seconds) in [("seed002-sine", 3.0), ("seed002-actuator-faults", 3.0), ("cartpole-python-plant", 1.0)] {
+        for (name, seconds) in [
+            ("seed002-sine", 3.0),
+            ("seed002-actuator-faults", 3.0),
+            ("cartpole-python-plant", 1.0),
+        ] {
             let s = Scratch::new(&format!("hog-{name}"));
             let path = variant(&s, name, seconds, false);
             // The variant lives in the scratch directory: its components by absolute path.
-            let text = std::fs::read_to_string(&path).unwrap().replace("\"../components/", &format!("\"{}/components/", repo().display()));
+            let text = std::fs::read_to_string(&path).unwrap().replace(
+                "\"../components/",
+                &format!("\"{}/components/", repo().display()),
+            );
             std::fs::write(&path, text).unwrap();
             let (code, err, _) = run_checked(&s, &path, &[]);
             assert_eq!(code, Some(0), "{name} under load: {err}");
             if name.starts_with("cartpole") {
                 continue;
             }
-            let ip = launcher(&s).arg("run").arg(&path).args(["--mode", "in-process", "--out"]).arg(s.join("ip")).output().unwrap();
-            assert!(ip.status.success(), "{name}: {}", String::from_utf8_lossy(&ip.stderr));
-            let cmp = launcher(&s).arg("compare").arg(s.join(&format!("out/{name}.rrd"))).arg(s.join(&format!("ip/{name}.rrd"))).output().unwrap();
-            assert!(String::from_utf8_lossy(&cmp.stdout).contains("bit for bit"), "{name}: {}", String::from_utf8_lossy(&cmp.stdout));
+            let ip = launcher(&s)
+                .arg("run")
+                .arg(&path)
+                .args(["--mode", "in-process", "--out"])
+                .arg(s.join("ip"))
+                .output()
+                .unwrap();
+            assert!(
+                ip.status.success(),
+                "{name}: {}",
+                String::from_utf8_lossy(&ip.stderr)
+            );
+            let cmp = launcher(&s)
+                .arg("compare")
+                .arg(s.join(&format!("out/{name}.rrd")))
+                .arg(s.join(&format!("ip/{name}.rrd")))
+                .output()
+                .unwrap();
+            assert!(
+                String::from_utf8_lossy(&cmp.stdout).contains("bit for bit"),
+                "{name}: {}",
+                String::from_utf8_lossy(&cmp.stdout)
+            );
         }
     });
     for h in &mut hogs {

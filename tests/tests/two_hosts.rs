@@ -26,10 +26,16 @@ use tests::*;
 fn attempt(name: &str) -> Result<String, String> {
     let out = Command::new(repo().join("scripts/two-hosts.sh"))
         .arg(name)
-        .env("CARGO_TARGET_DIR", bin_dir().parent().expect("release/'s parent"))
+        .env(
+            "CARGO_TARGET_DIR",
+            bin_dir().parent().expect("release/'s parent"),
+        )
         .output()
         .expect("runs scripts/two-hosts.sh");
-    let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
     if out.status.code() == Some(77) {
         return Ok(format!("{name}: {stdout}"));
     }
@@ -60,7 +66,17 @@ fn case(name: &str) {
 // two cores with the runs.
 #[test]
 fn two_hosts() {
-    for c in ["run", "kill-component", "kill-agent", "cut-link", "kill-local", "refused", "attacks", "concurrent", "insecure"] {
+    for c in [
+        "run",
+        "kill-component",
+        "kill-agent",
+        "cut-link",
+        "kill-local",
+        "refused",
+        "attacks",
+        "concurrent",
+        "insecure",
+    ] {
         case(c);
     }
 }

@@ -20,7 +20,9 @@ pub const MATCHED: f64 = 1e-8;
 pub fn matched_gain(dm: &Discrete) -> Result<Mat, String> {
     let q = dm.e.ncols();
     if q == 0 {
-        return Err("the plant has no unknown input (E has no columns): there is no ŵ to cancel".into());
+        return Err(
+            "the plant has no unknown input (E has no columns): there is no ŵ to cancel".into(),
+        );
     }
     let m = pinv(&dm.b) * &dm.e;
     let outside = &dm.e - &dm.b * &m;

@@ -23,8 +23,8 @@ pub mod measured;
 
 use lti::dare::solve_dare;
 use lti::eig::{continuous_image, eigenvalues, format_list};
-use lti::place::{place, place_sampled, Method};
-use lti::{Discrete, Mat, Model, Poles, C64};
+use lti::place::{Method, place, place_sampled};
+use lti::{C64, Discrete, Mat, Model, Poles};
 
 /// Where the poles asked for are placed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -124,7 +124,10 @@ impl FeedbackDesign {
                 r_op[keep[i]] = *z;
             }
         }
-        (col(&op.u) - &self.n * r_op + &self.g * x).iter().copied().collect()
+        (col(&op.u) - &self.n * r_op + &self.g * x)
+            .iter()
+            .copied()
+            .collect()
     }
 
     /// Whether the continuous and the sampled loops are both asymptotically stable.
@@ -140,10 +143,21 @@ impl FeedbackDesign {
     /// "unstable closed loop: eig(A − BG) has +122.271" style description, if unstable.
     pub fn instability(&self) -> Option<String> {
         if !self.unstable.is_empty() {
-            Some(format!("unstable closed loop: eig(A − BG) has {}", format_list(&self.unstable)))
+            Some(format!(
+                "unstable closed loop: eig(A − BG) has {}",
+                format_list(&self.unstable)
+            ))
         } else if !self.stable() {
-            let bad: Vec<C64> = self.discrete_closed_loop.iter().copied().filter(|z| z.norm() >= 1.0).collect();
-            Some(format!("unstable sampled closed loop: eig(Φ − Γ_BG) has {} (|z| ≥ 1): dt too coarse", format_list(&bad)))
+            let bad: Vec<C64> = self
+                .discrete_closed_loop
+                .iter()
+                .copied()
+                .filter(|z| z.norm() >= 1.0)
+                .collect();
+            Some(format!(
+                "unstable sampled closed loop: eig(Φ − Γ_BG) has {} (|z| ≥ 1): dt too coarse",
+                format_list(&bad)
+            ))
         } else {
             None
         }
@@ -155,13 +169,21 @@ impl FeedbackDesign {
 ///
 /// With measured disturbances ([`Options::measured`]) G is designed on the commanded inputs'
 /// columns and embedded in l rows ([`measured`]).
-pub fn design(model: Option<&Model>, dm: &Discrete, spec: &FeedbackSpec, opts: &Options) -> Result<FeedbackDesign, String> {
+pub fn design(
+    model: Option<&Model>,
+    dm: &Discrete,
+    spec: &FeedbackSpec,
+    opts: &Options,
+) -> Result<FeedbackDesign, String> {
     let l_all = dm.b.ncols();
     if opts.measured.is_empty() {
         return design_commanded(model, dm, spec, opts);
     }
     if let Some(&j) = opts.measured.iter().find(|&&j| j >= l_all) {
-        return Err(format!("measured disturbance {} is not an input (the plant has {l_all})", j + 1));
+        return Err(format!(
+            "measured disturbance {} is not an input (the plant has {l_all})",
+            j + 1
+        ));
     }
     let keep = measured::commanded(l_all, opts.measured);
     if keep.is_empty() {
@@ -179,18 +201,35 @@ pub fn design(model: Option<&Model>, dm: &Discrete, spec: &FeedbackSpec, opts: &
 }
 
 /// [`design`] on every column of Γ_B.
-fn design_commanded(model: Option<&Model>, dm: &Discrete, spec: &FeedbackSpec, opts: &Options) -> Result<FeedbackDesign, String> {
+fn design_commanded(
+    model: Option<&Model>,
+    dm: &Discrete,
+    spec: &FeedbackSpec,
+    opts: &Options,
+) -> Result<FeedbackDesign, String> {
     let (n, l) = (dm.a.nrows(), dm.b.ncols());
-    let per = if opts.measured.is_empty() { "input" } else { "commanded input" };
+    let per = if opts.measured.is_empty() {
+        "input"
+    } else {
+        "commanded input"
+    };
     if let Some(ct) = opts.track
         && ct.shape() != (l, n)
     {
-        return Err(format!("track is {}×{}, must be {l}×{n} (one tracked output per {per})", ct.nrows(), ct.ncols()));
+        return Err(format!(
+            "track is {}×{}, must be {l}×{n} (one tracked output per {per})",
+            ct.nrows(),
+            ct.ncols()
+        ));
     }
     // The pair G is designed on: the plant's, or the plant with the integrators (integral.rs).
     let ct = match (opts.integral, opts.track) {
         (true, Some(ct)) => Some(ct.clone()),
-        (true, None) => return Err("integral action needs track = [[…]]: the outputs the integrators hold at r".into()),
+        (true, None) => {
+            return Err(
+                "integral action needs track = [[…]]: the outputs the integrators hold at r".into(),
+            );
+        }
         (false, _) => None,
     };
     let (phi, gamma) = match &ct {
@@ -202,22 +241,38 @@ fn design_commanded(model: Option<&Model>, dm: &Discrete, spec: &FeedbackSpec, o
         None => (m.a.clone(), m.b.clone()),
     });
     let size = phi.nrows();
-    let states = if ct.is_some() { format!("n + l = {size} (the plant's {n} states and one integrator per tracked output)") } else { format!("{size}") };
+    let states = if ct.is_some() {
+        format!("n + l = {size} (the plant's {n} states and one integrator per tracked output)")
+    } else {
+        format!("{size}")
+    };
     let (g_all, how) = match spec {
-        FeedbackSpec::Poles { poles, placement, domain } => {
+        FeedbackSpec::Poles {
+            poles,
+            placement,
+            domain,
+        } => {
             if poles.len() != size {
-                return Err(format!("{} poles given, the loop has {states}", poles.len()));
+                return Err(format!(
+                    "{} poles given, the loop has {states}",
+                    poles.len()
+                ));
             }
             match domain {
                 // Ackermann's formula works on the characteristic polynomial, whose coefficients
                 // in z cancel when the poles crowd at 1 (seed 003 at dt = 1 ms): it is placed in
                 // the δ-domain, δ = (z − 1)/dt, where they spread as in s (`lti::place::delta`).
                 Domain::Sampled if *placement == Method::Ackermann => (
-                    place_sampled(&phi, &gamma, poles, dm.dt, *placement).map_err(|e| e.to_string())?.gain,
-                    "placed for the sampled loop in the δ-domain: eig(Φ − Γ_BG) = e^{p·dt}".to_string(),
+                    place_sampled(&phi, &gamma, poles, dm.dt, *placement)
+                        .map_err(|e| e.to_string())?
+                        .gain,
+                    "placed for the sampled loop in the δ-domain: eig(Φ − Γ_BG) = e^{p·dt}"
+                        .to_string(),
                 ),
                 Domain::Sampled => (
-                    place(&phi, &gamma, &poles.to_discrete(dm.dt), *placement).map_err(|e| e.to_string())?.gain,
+                    place(&phi, &gamma, &poles.to_discrete(dm.dt), *placement)
+                        .map_err(|e| e.to_string())?
+                        .gain,
                     "placed for the sampled loop: eig(Φ − Γ_BG) = e^{p·dt}".to_string(),
                 ),
                 Domain::Continuous => {
@@ -230,17 +285,35 @@ fn design_commanded(model: Option<&Model>, dm: &Discrete, spec: &FeedbackSpec, o
             let q = q.clone().unwrap_or_else(|| Mat::identity(size, size));
             let r = r.clone().unwrap_or_else(|| Mat::identity(l, l));
             if q.shape() != (size, size) {
-                return Err(format!("Q is {}×{}, must be {size}×{size} ({states})", q.nrows(), q.ncols()));
+                return Err(format!(
+                    "Q is {}×{}, must be {size}×{size} ({states})",
+                    q.nrows(),
+                    q.ncols()
+                ));
             }
             if r.shape() != (l, l) {
-                return Err(format!("R is {}×{}, must be {l}×{l} (one row per {per})", r.nrows(), r.ncols()));
+                return Err(format!(
+                    "R is {}×{}, must be {l}×{l} (one row per {per})",
+                    r.nrows(),
+                    r.ncols()
+                ));
             }
             let dare = solve_dare(&phi, &gamma, &q, &r).map_err(|e| format!("LQR: {e}"))?;
-            (dare.k, format!("LQR: X = DARE(Φ, Γ_B, Q, R), relative residual {:.1e}; G = (R + Γ_BᵀXΓ_B)⁻¹Γ_BᵀXΦ", dare.residual))
+            (
+                dare.k,
+                format!(
+                    "LQR: X = DARE(Φ, Γ_B, Q, R), relative residual {:.1e}; G = (R + Γ_BᵀXΓ_B)⁻¹Γ_BᵀXΦ",
+                    dare.residual
+                ),
+            )
         }
         FeedbackSpec::Gain(g) => {
             if g.shape() != (l, size) {
-                return Err(format!("gain is {}×{}, must be {l}×{size} ({states})", g.nrows(), g.ncols()));
+                return Err(format!(
+                    "gain is {}×{}, must be {l}×{size} ({states})",
+                    g.nrows(),
+                    g.ncols()
+                ));
             }
             (g.clone(), "given".to_string())
         }
@@ -248,13 +321,31 @@ fn design_commanded(model: Option<&Model>, dm: &Discrete, spec: &FeedbackSpec, o
     let acl = &phi - &gamma * &g_all;
     let discrete_closed_loop = eigenvalues(&acl).map_err(|e| e.to_string())?;
     let closed_loop = match (spec, &continuous) {
-        (FeedbackSpec::Poles { domain: Domain::Continuous, .. } | FeedbackSpec::Gain(_), Some((a, b))) => eigenvalues(&(a - b * &g_all)).map_err(|e| e.to_string())?,
+        (
+            FeedbackSpec::Poles {
+                domain: Domain::Continuous,
+                ..
+            }
+            | FeedbackSpec::Gain(_),
+            Some((a, b)),
+        ) => eigenvalues(&(a - b * &g_all)).map_err(|e| e.to_string())?,
         _ => continuous_image(&discrete_closed_loop, dm.dt).0,
     };
-    let unstable: Vec<C64> = closed_loop.iter().copied().filter(|z| z.re >= 0.0).collect();
+    let unstable: Vec<C64> = closed_loop
+        .iter()
+        .copied()
+        .filter(|z| z.re >= 0.0)
+        .collect();
     let g = g_all.columns(0, n).into_owned();
     let (prefilter, integral) = match (&ct, opts.track) {
-        (Some(ct), _) => (Mat::zeros(l, l), Some((g_all.columns(n, l).into_owned(), ct.clone(), integral::measured(ct, &dm.c)))),
+        (Some(ct), _) => (
+            Mat::zeros(l, l),
+            Some((
+                g_all.columns(n, l).into_owned(),
+                ct.clone(),
+                integral::measured(ct, &dm.c),
+            )),
+        ),
         (None, None) => (Mat::identity(l, l), None),
         (None, Some(ct)) => match prefilter(&acl, &gamma, ct) {
             Ok(p) => (p, None),
@@ -264,7 +355,17 @@ fn design_commanded(model: Option<&Model>, dm: &Discrete, spec: &FeedbackSpec, o
             Err(e) => return Err(e),
         },
     };
-    Ok(FeedbackDesign { g, integral, n: prefilter, measured: Vec::new(), closed_loop, discrete_closed_loop, unstable, how, feedforward: None })
+    Ok(FeedbackDesign {
+        g,
+        integral,
+        n: prefilter,
+        measured: Vec::new(),
+        closed_loop,
+        discrete_closed_loop,
+        unstable,
+        how,
+        feedforward: None,
+    })
 }
 
 /// N = (C_t (I − Φ + Γ_BG)⁻¹ Γ_B)⁻¹ (see the module documentation).

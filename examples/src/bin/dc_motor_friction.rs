@@ -15,10 +15,10 @@
 //! `params`: `coulomb` (τ_c, in the units of w, default 0.02), `stribeck_speed` (ω_s, rad/s,
 //! default 0.05), `substeps` (default 10).
 
-use plant::PlantConfig;
-use lockstep::component::{self, Component, ComponentConfig, Inputs, StepError};
 use lockstep::PlantLayout;
+use lockstep::component::{self, Component, ComponentConfig, Inputs, StepError};
 use lti::Mat;
+use plant::PlantConfig;
 use serde::Deserialize;
 
 #[derive(Deserialize)]
@@ -31,7 +31,11 @@ struct Params {
 
 impl Default for Params {
     fn default() -> Self {
-        Params { coulomb: 0.02, stribeck_speed: 0.05, substeps: 10 }
+        Params {
+            coulomb: 0.02,
+            stribeck_speed: 0.05,
+            substeps: 10,
+        }
     }
 }
 
@@ -65,7 +69,16 @@ impl FrictionMotor {
     /// ẋ at (t, x) with u held: A x + B u + E (w(t) + τ_f(ω)) — ω is x[1]; `held` is the
     /// piecewise-constant part of each w over this step.
     #[allow(clippy::too_many_arguments)]
-    fn f(m: &Mats, s: &PlantConfig, p: &Params, t: f64, x: &[f64], u: &[f64], held: &[f64], out: &mut [f64]) {
+    fn f(
+        m: &Mats,
+        s: &PlantConfig,
+        p: &Params,
+        t: f64,
+        x: &[f64],
+        u: &[f64],
+        held: &[f64],
+        out: &mut [f64],
+    ) {
         let friction = p.coulomb * (x[1] / p.stribeck_speed).tanh();
         for (i, o) in out.iter_mut().enumerate() {
             let mut v = 0.0;
@@ -114,18 +127,46 @@ fn mul(m: &Mat, x: &[f64], i: usize) -> f64 {
 impl Component for FrictionMotor {
     fn new(cfg: &ComponentConfig) -> Result<Self, String> {
         let s = PlantConfig::from_protocol(cfg)?;
-        let m = Mats { a: (&s.a).into(), b: (&s.b).into(), c: (&s.c).into(), d: (&s.d).into(), e: (&s.e).into() };
+        let m = Mats {
+            a: (&s.a).into(),
+            b: (&s.b).into(),
+            c: (&s.c).into(),
+            d: (&s.d).into(),
+            e: (&s.e).into(),
+        };
         let p: Params = cfg.params()?;
-        let lay = PlantLayout { n: m.a.nrows(), p: m.c.nrows(), q: m.e.ncols(), r: m.d.ncols(), l: m.b.ncols(), f: 0 };
+        let lay = PlantLayout {
+            n: m.a.nrows(),
+            p: m.c.nrows(),
+            q: m.e.ncols(),
+            r: m.d.ncols(),
+            l: m.b.ncols(),
+            f: 0,
+        };
         if lay.n != 3 || lay.q < 1 {
-            return Err(format!("this plant is x = [i, ω, θ] with the load torque as the first unknown input; the scenario has n = {}, q = {}", lay.n, lay.q));
+            return Err(format!(
+                "this plant is x = [i, ω, θ] with the load torque as the first unknown input; the scenario has n = {}, q = {}",
+                lay.n, lay.q
+            ));
         }
         if !(p.stribeck_speed > 0.0 && p.substeps > 0 && p.coulomb.is_finite()) {
             return Err("params: stribeck_speed must be > 0, substeps ≥ 1, coulomb finite".into());
         }
         let x = s.x0.clone();
         let held = vec![0.0; lay.q];
-        Ok(FrictionMotor { held, lay, dt: cfg.dt, controller: cfg.read_index("controller"), u: vec![0.0; lay.l], k: std::array::from_fn(|_| vec![0.0; 3]), tmp: vec![0.0; 3], x, m, s, p })
+        Ok(FrictionMotor {
+            held,
+            lay,
+            dt: cfg.dt,
+            controller: cfg.read_index("controller"),
+            u: vec![0.0; lay.l],
+            k: std::array::from_fn(|_| vec![0.0; 3]),
+            tmp: vec![0.0; 3],
+            x,
+            m,
+            s,
+            p,
+        })
     }
 
     fn step(&mut self, k: u64, inputs: &Inputs, out: &mut [f64]) -> Result<(), StepError> {
@@ -139,27 +180,45 @@ impl Component for FrictionMotor {
                 }
             }
             for (c, w) in self.held.iter_mut().zip(&self.s.disturbances) {
-                let sine = w.sine().map_or(0.0, |(a, om, ph)| a * (om * (k - 1) as f64 * self.dt + ph).sin());
+                let sine = w.sine().map_or(0.0, |(a, om, ph)| {
+                    a * (om * (k - 1) as f64 * self.dt + ph).sin()
+                });
                 *c = w.sample_step(k - 1, self.dt) - sine;
             }
             let h = self.dt / self.p.substeps as f64;
             for j in 0..self.p.substeps {
                 self.rk4((k - 1) as f64 * self.dt + j as f64 * h, h);
             }
-            if let Some(i) = self.x.iter().position(|v| !v.is_finite() || v.abs() > self.s.state_bound) {
-                return Err(StepError { code: plant::shell::EXIT_DIVERGED, message: format!("diverged: x{} = {} at step {k}", i + 1, self.x[i]) });
+            if let Some(i) = self
+                .x
+                .iter()
+                .position(|v| !v.is_finite() || v.abs() > self.s.state_bound)
+            {
+                return Err(StepError {
+                    code: plant::shell::EXIT_DIVERGED,
+                    message: format!("diverged: x{} = {} at step {k}", i + 1, self.x[i]),
+                });
             }
         }
         let (lay, dt) = (self.lay, self.dt);
         out[lay.x()].copy_from_slice(&self.x);
         for (j, y) in out[lay.y()].iter_mut().enumerate() {
-            let noise: f64 = self.s.measurement_disturbances.iter().enumerate().map(|(c, s)| self.m.d[(j, c)] * s.sample_step(k, dt)).sum();
+            let noise: f64 = self
+                .s
+                .measurement_disturbances
+                .iter()
+                .enumerate()
+                .map(|(c, s)| self.m.d[(j, c)] * s.sample_step(k, dt))
+                .sum();
             *y = mul(&self.m.c, &self.x, j) + noise;
         }
         for (o, s) in out[lay.w()].iter_mut().zip(&self.s.disturbances) {
             *o = s.sample_step(k, dt);
         }
-        for (o, s) in out[lay.v()].iter_mut().zip(&self.s.measurement_disturbances) {
+        for (o, s) in out[lay.v()]
+            .iter_mut()
+            .zip(&self.s.measurement_disturbances)
+        {
             *o = s.sample_step(k, dt);
         }
         for (o, s) in out[lay.r()].iter_mut().zip(&self.s.inputs) {

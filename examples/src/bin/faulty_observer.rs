@@ -18,7 +18,7 @@
 use std::process::ExitCode;
 
 use lockstep::component::read_config;
-use lockstep::{parse_launch, ready_then_wait_for_go, Bus, WireHeader, PROTOCOL_VERSION};
+use lockstep::{Bus, PROTOCOL_VERSION, WireHeader, parse_launch, ready_then_wait_for_go};
 use serde::Deserialize;
 
 #[derive(Deserialize)]
@@ -55,7 +55,9 @@ fn main() -> ExitCode {
         Err(e) => return fail(e),
     };
     if p.fault == "refuse_version" {
-        eprintln!("faulty_observer: the run speaks protocol version {PROTOCOL_VERSION}, this component 2");
+        eprintln!(
+            "faulty_observer: the run speaks protocol version {PROTOCOL_VERSION}, this component 2"
+        );
         return ExitCode::from(2);
     }
     if p.fault == "close_stdout" {
@@ -76,7 +78,10 @@ fn main() -> ExitCode {
         Err(e) => return fail(e.to_string()),
     };
     let out_len = if p.fault == "wrong_len" { n + 1 } else { n };
-    let (outlet, inlet) = match (bus.outlet(&cfg.publishes.service, out_len), bus.inlet(&cfg.reads[0].service)) {
+    let (outlet, inlet) = match (
+        bus.outlet(&cfg.publishes.service, out_len),
+        bus.inlet(&cfg.reads[0].service),
+    ) {
         (Ok(o), Ok(i)) => (o, i),
         (Err(e), _) | (_, Err(e)) => return fail(e.to_string()),
     };
@@ -90,7 +95,14 @@ fn main() -> ExitCode {
     if p.fault == "no_read" {
         let out = vec![0.0; out_len];
         for k in 0..cfg.steps {
-            let header = WireHeader { step: k, sim_time: k as f64 * cfg.dt, sent_ns: 0, taken_ns: lockstep::now_ns(), protocol: PROTOCOL_VERSION, reserved: 0 };
+            let header = WireHeader {
+                step: k,
+                sim_time: k as f64 * cfg.dt,
+                sent_ns: 0,
+                taken_ns: lockstep::now_ns(),
+                protocol: PROTOCOL_VERSION,
+                reserved: 0,
+            };
             if let Err(e) = outlet.send_header(header, &out) {
                 return fail(e.to_string());
             }
@@ -105,9 +117,20 @@ fn main() -> ExitCode {
             Err(e) => return fail(e.to_string()),
         };
         for (i, o) in out.iter_mut().enumerate() {
-            *o = if i < n { sample.get(y0 + i).copied().unwrap_or(0.0) } else { 0.0 };
+            *o = if i < n {
+                sample.get(y0 + i).copied().unwrap_or(0.0)
+            } else {
+                0.0
+            };
         }
-        let mut header = WireHeader { step: k, sim_time: h.sim_time, sent_ns: 0, taken_ns: h.received_ns, protocol: PROTOCOL_VERSION, reserved: 0 };
+        let mut header = WireHeader {
+            step: k,
+            sim_time: h.sim_time,
+            sent_ns: 0,
+            taken_ns: h.received_ns,
+            protocol: PROTOCOL_VERSION,
+            reserved: 0,
+        };
         if k >= p.at {
             match p.fault.as_str() {
                 "nan" => out[0] = f64::NAN,

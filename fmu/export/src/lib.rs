@@ -20,17 +20,39 @@ pub use model_description::{Description, Fmi, Signal};
 pub use resource::{ObserverResource, OperatingPoint};
 
 /// Writes the FMU of `res` to `path` (atomically), with the library read from `library`.
-pub fn export(res: &ObserverResource, d: &Description, fmi: Fmi, library: &Path, path: &Path) -> Result<(), String> {
+pub fn export(
+    res: &ObserverResource,
+    d: &Description,
+    fmi: Fmi,
+    library: &Path,
+    path: &Path,
+) -> Result<(), String> {
     let xml = model_description::model_description(res, d, fmi)?;
-    let lib = std::fs::read(library).map_err(|e| format!("{}: cannot read: {e}", library.display()))?;
-    let contents = package::Contents { model_description: &xml, resource_json: &res.to_json(), library: &lib, model_identifier: &d.model_identifier, fmi };
+    let lib =
+        std::fs::read(library).map_err(|e| format!("{}: cannot read: {e}", library.display()))?;
+    let contents = package::Contents {
+        model_description: &xml,
+        resource_json: &res.to_json(),
+        library: &lib,
+        model_identifier: &d.model_identifier,
+        fmi,
+    };
     package::write(path, &contents)
 }
 
 /// A C identifier from an observer's name (letters, digits, `_`; `-` and the rest become `_`),
 /// for the modelIdentifier.
 pub fn identifier(name: &str) -> String {
-    let mut id: String = name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '_' }).collect();
+    let mut id: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
     if !id.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_') {
         id.insert(0, '_');
     }

@@ -9,7 +9,7 @@
 use std::fmt::Write;
 
 use crate::resource::ObserverResource;
-use crate::variables::{dependencies, Layout, Role};
+use crate::variables::{Layout, Role, dependencies};
 
 /// The FMI version of an export.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -41,7 +41,11 @@ pub struct Signal {
 
 impl Signal {
     fn label(&self) -> String {
-        if self.unit.is_empty() { self.name.clone() } else { format!("{} [{}]", self.name, self.unit) }
+        if self.unit.is_empty() {
+            self.name.clone()
+        } else {
+            format!("{} [{}]", self.name, self.unit)
+        }
     }
 }
 
@@ -65,15 +69,38 @@ pub struct Description {
 }
 
 /// The modelDescription.xml text.
-pub fn model_description(res: &ObserverResource, d: &Description, fmi: Fmi) -> Result<String, String> {
+pub fn model_description(
+    res: &ObserverResource,
+    d: &Description,
+    fmi: Fmi,
+) -> Result<String, String> {
     let dims = res.dims()?;
     let lay = Layout { dims };
     let mut x = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<fmiModelDescription");
-    attr(&mut x, "fmiVersion", if fmi == Fmi::V2 { "2.0" } else { "3.0" });
+    attr(
+        &mut x,
+        "fmiVersion",
+        if fmi == Fmi::V2 { "2.0" } else { "3.0" },
+    );
     attr(&mut x, "modelName", &d.model_name);
-    attr(&mut x, if fmi == Fmi::V2 { "guid" } else { "instantiationToken" }, &res.token);
+    attr(
+        &mut x,
+        if fmi == Fmi::V2 {
+            "guid"
+        } else {
+            "instantiationToken"
+        },
+        &res.token,
+    );
     attr(&mut x, "description", &d.description);
-    attr(&mut x, "generationTool", concat!("uio-observers launcher export-fmu ", env!("CARGO_PKG_VERSION")));
+    attr(
+        &mut x,
+        "generationTool",
+        concat!(
+            "uio-observers launcher export-fmu ",
+            env!("CARGO_PKG_VERSION")
+        ),
+    );
     attr(&mut x, "variableNamingConvention", "flat");
     if fmi == Fmi::V2 {
         attr(&mut x, "numberOfEventIndicators", "0");
@@ -107,10 +134,21 @@ pub fn model_description(res: &ObserverResource, d: &Description, fmi: Fmi) -> R
             (Role::Y(j), Some(op)) => op.y[j],
             _ => 0.0,
         };
-        variable(&mut x, &lay, role, describe(d, role), unit(d, role), start, fmi);
+        variable(
+            &mut x,
+            &lay,
+            role,
+            describe(d, role),
+            unit(d, role),
+            start,
+            fmi,
+        );
     }
     x += "  </ModelVariables>\n  <ModelStructure>\n";
-    let outputs: Vec<Role> = lay.roles().filter(|r| matches!(r, Role::Xhat(_) | Role::R(_))).collect();
+    let outputs: Vec<Role> = lay
+        .roles()
+        .filter(|r| matches!(r, Role::Xhat(_) | Role::R(_)))
+        .collect();
     // Both lists hold every output: each is calculated from the inputs in initialization too.
     for (v2, v3) in [("Outputs", "Output"), ("InitialUnknowns", "InitialUnknown")] {
         if fmi == Fmi::V2 {
@@ -120,7 +158,10 @@ pub fn model_description(res: &ObserverResource, d: &Description, fmi: Fmi) -> R
             let deps = dependencies(role, &res.q, &res.c, res.xhat0.is_some());
             // FMI 2 names inputs by index (value reference + 1), FMI 3 by value reference.
             let base = if fmi == Fmi::V2 { 1 } else { 0 };
-            let list: Vec<String> = deps.iter().map(|&m| (lay.vr(Role::Y(m)) + base).to_string()).collect();
+            let list: Vec<String> = deps
+                .iter()
+                .map(|&m| (lay.vr(Role::Y(m)) + base).to_string())
+                .collect();
             match fmi {
                 Fmi::V2 => x += &format!("      <Unknown index=\"{}\"", lay.vr(role) + 1),
                 Fmi::V3 => x += &format!("    <{v3} valueReference=\"{}\"", lay.vr(role)),
@@ -159,13 +200,25 @@ fn unit(d: &Description, role: Role) -> &str {
     list.get(i).map_or("", |s| s.unit.as_str())
 }
 
-fn variable(x: &mut String, lay: &Layout, role: Role, description: String, unit: &str, start: f64, fmi: Fmi) {
+fn variable(
+    x: &mut String,
+    lay: &Layout,
+    role: Role,
+    description: String,
+    unit: &str,
+    start: f64,
+    fmi: Fmi,
+) {
     let (causality, extra) = match role {
         Role::Time => ("independent", ""),
         Role::U(_) | Role::Y(_) => ("input", ""),
         Role::Xhat(_) | Role::R(_) => ("output", "calculated"),
     };
-    *x += if fmi == Fmi::V2 { "    <ScalarVariable" } else { "    <Float64" };
+    *x += if fmi == Fmi::V2 {
+        "    <ScalarVariable"
+    } else {
+        "    <Float64"
+    };
     attr(x, "name", &lay.name(role));
     attr(x, "valueReference", &lay.vr(role).to_string());
     if !description.is_empty() {
@@ -186,7 +239,11 @@ fn variable(x: &mut String, lay: &Layout, role: Role, description: String, unit:
     if input {
         attr(x, "start", &num(start));
     }
-    *x += if fmi == Fmi::V2 { "/></ScalarVariable>\n" } else { "/>\n" };
+    *x += if fmi == Fmi::V2 {
+        "/></ScalarVariable>\n"
+    } else {
+        "/>\n"
+    };
 }
 
 /// A variable's description, with the scenario's names and units.
@@ -194,8 +251,14 @@ fn describe(d: &Description, role: Role) -> String {
     let label = |v: &[Signal], i: usize| v.get(i).map_or(String::new(), Signal::label);
     match role {
         Role::Time => String::new(),
-        Role::U(i) => format!("the plant's known input {} as applied over [t_k, t_k + dt): in closed loop the controller's output u, not its reference", label(&d.inputs, i)),
-        Role::Y(j) => format!("the plant's measured output {} at t_k", label(&d.outputs, j)),
+        Role::U(i) => format!(
+            "the plant's known input {} as applied over [t_k, t_k + dt): in closed loop the controller's output u, not its reference",
+            label(&d.inputs, i)
+        ),
+        Role::Y(j) => format!(
+            "the plant's measured output {} at t_k",
+            label(&d.outputs, j)
+        ),
         Role::Xhat(i) => format!("estimate of {}", label(&d.states, i)),
         Role::R(j) => format!("residual y - C xhat of {}", label(&d.outputs, j)),
     }
@@ -231,7 +294,11 @@ mod tests {
     use lti::MatData;
 
     fn resource(xhat0: bool) -> ObserverResource {
-        let m = |rows: usize, cols: usize, data: &[f64]| MatData { rows, cols, data: data.to_vec() };
+        let m = |rows: usize, cols: usize, data: &[f64]| MatData {
+            rows,
+            cols,
+            data: data.to_vec(),
+        };
         // n = 3, r = 2, l = 1, p = 2; Q has one non-zero, in row 3 column 2.
         ObserverResource::new(
             "uio",
@@ -248,7 +315,10 @@ mod tests {
     }
 
     fn description() -> Description {
-        let s = |n: &str, u: &str| Signal { name: n.into(), unit: u.into() };
+        let s = |n: &str, u: &str| Signal {
+            name: n.into(),
+            unit: u.into(),
+        };
         Description {
             model_identifier: "uio".into(),
             model_name: "seed & <test>".into(),
@@ -273,7 +343,9 @@ mod tests {
         assert_eq!(count(&x, "causality=\"output\""), 5);
         assert!(x.contains("name=\"u_1\" valueReference=\"1\""));
         assert!(x.contains("name=\"y_2\" valueReference=\"3\""));
-        assert!(x.contains("name=\"xhat_3\" valueReference=\"6\" description=\"estimate of eta [rad]\""));
+        assert!(x.contains(
+            "name=\"xhat_3\" valueReference=\"6\" description=\"estimate of eta [rad]\""
+        ));
         assert!(x.contains("name=\"r_2\" valueReference=\"8\""));
         // x̂_3 = … + y_2 (vr 3); x̂_1 depends on no input; r_2 on y_2 (C picks x̂_3).
         assert!(x.contains("<Output valueReference=\"6\" dependencies=\"3\"/>"));
@@ -282,7 +354,9 @@ mod tests {
         assert!(x.contains("<Output valueReference=\"8\" dependencies=\"3\"/>"));
         assert_eq!(count(&x, "<InitialUnknown "), 5);
         assert!(x.contains("fixedInternalStepSize=\"0.001\"") && x.contains("stepSize=\"0.001\""));
-        assert!(x.contains("modelName=\"seed &amp; &lt;test&gt;\"") && x.contains("&quot;quoted&quot;"));
+        assert!(
+            x.contains("modelName=\"seed &amp; &lt;test&gt;\"") && x.contains("&quot;quoted&quot;")
+        );
     }
 
     #[test]
@@ -293,7 +367,10 @@ mod tests {
         assert_eq!(count(&x, " start=\"0.0\"/>"), 3);
         // Units from the scenario's: declared once each, on u, y, x̂ and r alike.
         assert!(x.contains("<UnitDefinitions>\n    <Unit name=\"N\"/>\n    <Unit name=\"rad\"/>\n    <Unit name=\"m\"/>\n  </UnitDefinitions>"));
-        assert!(x.contains("<Real unit=\"N\" start=\"0.0\"/>") && x.contains("<Real unit=\"rad\" start=\"0.0\"/>"));
+        assert!(
+            x.contains("<Real unit=\"N\" start=\"0.0\"/>")
+                && x.contains("<Real unit=\"rad\" start=\"0.0\"/>")
+        );
         assert_eq!(count(&x, "<Real unit=\"rad\"/>"), 2); // x̂_3 (eta) and r_2 (eta)
         assert!(x.contains("canHandleVariableCommunicationStepSize=\"false\""));
         // With x̂₀ every output depends on both y (indices 3 and 4).

@@ -104,9 +104,35 @@ impl ObserverResource {
     /// The resource of an observer; P⁺ is formed here when x̂₀ is given, and the token from the
     /// rest of the content.
     #[allow(clippy::too_many_arguments)] // the observer form's five matrices, C, dt and x̂₀
-    pub fn new(observer: &str, dt: f64, f: MatData, g: MatData, k: MatData, p: MatData, q: MatData, c: MatData, xhat0: Option<Vec<f64>>) -> Result<Self, String> {
-        let p_pinv = xhat0.as_ref().map(|_| MatData::from(&lti::pinv::pinv(&(&p).into())));
-        let mut res = ObserverResource { format: FORMAT, token: String::new(), observer: observer.into(), dt, f, g, k, p, q, c, xhat0, p_pinv, operating_point: None };
+    pub fn new(
+        observer: &str,
+        dt: f64,
+        f: MatData,
+        g: MatData,
+        k: MatData,
+        p: MatData,
+        q: MatData,
+        c: MatData,
+        xhat0: Option<Vec<f64>>,
+    ) -> Result<Self, String> {
+        let p_pinv = xhat0
+            .as_ref()
+            .map(|_| MatData::from(&lti::pinv::pinv(&(&p).into())));
+        let mut res = ObserverResource {
+            format: FORMAT,
+            token: String::new(),
+            observer: observer.into(),
+            dt,
+            f,
+            g,
+            k,
+            p,
+            q,
+            c,
+            xhat0,
+            p_pinv,
+            operating_point: None,
+        };
         res.dims()?;
         res.token = token(&res.to_json());
         Ok(res)
@@ -124,17 +150,37 @@ impl ObserverResource {
     /// Checks that the matrices conform and every number is finite; the dimensions.
     pub fn dims(&self) -> Result<Dims, String> {
         if self.format != FORMAT {
-            return Err(format!("format {} (this library reads format {FORMAT})", self.format));
+            return Err(format!(
+                "format {} (this library reads format {FORMAT})",
+                self.format
+            ));
         }
         if !(self.dt.is_finite() && self.dt > 0.0) {
             return Err(format!("dt = {} is not a positive finite number", self.dt));
         }
-        let d = Dims { n: self.p.rows, r: self.f.rows, l: self.g.cols, p: self.k.cols };
-        let shapes = [("F", &self.f, d.r, d.r), ("G", &self.g, d.r, d.l), ("K", &self.k, d.r, d.p), ("P", &self.p, d.n, d.r), ("Q", &self.q, d.n, d.p), ("C", &self.c, d.p, d.n)];
+        let d = Dims {
+            n: self.p.rows,
+            r: self.f.rows,
+            l: self.g.cols,
+            p: self.k.cols,
+        };
+        let shapes = [
+            ("F", &self.f, d.r, d.r),
+            ("G", &self.g, d.r, d.l),
+            ("K", &self.k, d.r, d.p),
+            ("P", &self.p, d.n, d.r),
+            ("Q", &self.q, d.n, d.p),
+            ("C", &self.c, d.p, d.n),
+        ];
         let pinv = self.p_pinv.as_ref().map(|m| ("P⁺", m, d.r, d.n));
         for (name, m, rows, cols) in shapes.into_iter().chain(pinv) {
             if m.rows != rows || m.cols != cols || m.data.len() != rows * cols {
-                return Err(format!("{name} is {}×{} with {} entries; {rows}×{cols} expected", m.rows, m.cols, m.data.len()));
+                return Err(format!(
+                    "{name} is {}×{} with {} entries; {rows}×{cols} expected",
+                    m.rows,
+                    m.cols,
+                    m.data.len()
+                ));
             }
             if m.data.iter().any(|v| !v.is_finite()) {
                 return Err(format!("{name} has an entry that is not finite"));
@@ -142,14 +188,24 @@ impl ObserverResource {
         }
         if let Some(op) = &self.operating_point {
             let c_r_len = if op.c_r.is_empty() { 0 } else { d.p };
-            for (name, v, len) in [("u", &op.u, d.l), ("y", &op.y, d.p), ("c_z", &op.c_z, d.r), ("c_x", &op.c_x, d.n), ("c_r", &op.c_r, c_r_len)] {
+            for (name, v, len) in [
+                ("u", &op.u, d.l),
+                ("y", &op.y, d.p),
+                ("c_z", &op.c_z, d.r),
+                ("c_x", &op.c_x, d.n),
+                ("c_r", &op.c_r, c_r_len),
+            ] {
                 if v.len() != len || v.iter().any(|x| !x.is_finite()) {
-                    return Err(format!("operating_point.{name} must hold {len} finite values"));
+                    return Err(format!(
+                        "operating_point.{name} must hold {len} finite values"
+                    ));
                 }
             }
         }
         match (&self.xhat0, &self.p_pinv) {
-            (Some(x), Some(_)) if x.len() != d.n || x.iter().any(|v| !v.is_finite()) => Err(format!("xhat0 must hold {} finite values", d.n)),
+            (Some(x), Some(_)) if x.len() != d.n || x.iter().any(|v| !v.is_finite()) => {
+                Err(format!("xhat0 must hold {} finite values", d.n))
+            }
             (Some(_), None) | (None, Some(_)) => Err("xhat0 and p_pinv come together".into()),
             _ => Ok(d),
         }
@@ -162,7 +218,8 @@ impl ObserverResource {
 
     /// Reads and checks a resource's text.
     pub fn from_json(text: &str) -> Result<(Self, Dims), String> {
-        let res: ObserverResource = serde_json::from_str(text).map_err(|e| format!("not an observer resource: {e}"))?;
+        let res: ObserverResource =
+            serde_json::from_str(text).map_err(|e| format!("not an observer resource: {e}"))?;
         let dims = res.dims()?;
         Ok((res, dims))
     }
@@ -171,9 +228,19 @@ impl ObserverResource {
 /// A GUID-shaped digest (two 64-bit FNV-1a hashes) of the resource's text: not secret, only
 /// different for different content.
 fn token(text: &str) -> String {
-    let fnv = |seed: u64| text.bytes().fold(seed, |h, b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3));
+    let fnv = |seed: u64| {
+        text.bytes()
+            .fold(seed, |h, b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3))
+    };
     let (a, b) = (fnv(0xcbf2_9ce4_8422_2325), fnv(0x6c62_272e_07bb_0142));
-    format!("{{{:08x}-{:04x}-{:04x}-{:04x}-{:012x}}}", a >> 32, (a >> 16) & 0xffff, a & 0xffff, b >> 48, b & 0xffff_ffff_ffff)
+    format!(
+        "{{{:08x}-{:04x}-{:04x}-{:04x}-{:012x}}}",
+        a >> 32,
+        (a >> 16) & 0xffff,
+        a & 0xffff,
+        b >> 48,
+        b & 0xffff_ffff_ffff
+    )
 }
 
 #[cfg(test)]
@@ -181,17 +248,40 @@ mod tests {
     use super::*;
 
     fn m(rows: usize, cols: usize, data: &[f64]) -> MatData {
-        MatData { rows, cols, data: data.to_vec() }
+        MatData {
+            rows,
+            cols,
+            data: data.to_vec(),
+        }
     }
 
     #[test]
     fn round_trips_every_bit_and_checks_shapes() {
         let third = 1.0 / 3.0;
-        let res = ObserverResource::new("o", 1e-3, m(1, 1, &[third]), m(1, 1, &[0.1]), m(1, 2, &[0.2, 0.7]), m(2, 1, &[1.0, 2.0]), m(2, 2, &[0.0, 0.3, 0.0, 0.0]), m(2, 2, &[1.0, 0.0, 0.0, 1.0]), Some(vec![1.0, -2.0])).unwrap();
+        let res = ObserverResource::new(
+            "o",
+            1e-3,
+            m(1, 1, &[third]),
+            m(1, 1, &[0.1]),
+            m(1, 2, &[0.2, 0.7]),
+            m(2, 1, &[1.0, 2.0]),
+            m(2, 2, &[0.0, 0.3, 0.0, 0.0]),
+            m(2, 2, &[1.0, 0.0, 0.0, 1.0]),
+            Some(vec![1.0, -2.0]),
+        )
+        .unwrap();
         let (back, dims) = ObserverResource::from_json(&res.to_json()).unwrap();
         assert_eq!(back, res);
         assert_eq!(back.f.data[0].to_bits(), third.to_bits());
-        assert_eq!(dims, Dims { n: 2, r: 1, l: 1, p: 2 });
+        assert_eq!(
+            dims,
+            Dims {
+                n: 2,
+                r: 1,
+                l: 1,
+                p: 2
+            }
+        );
         // P⁺ of [1; 2] is [1/5, 2/5].
         let pinv = back.p_pinv.unwrap();
         assert!((pinv.data[0] - 0.2).abs() < 1e-15 && (pinv.data[1] - 0.4).abs() < 1e-15);
@@ -207,9 +297,42 @@ mod tests {
     #[test]
     fn the_token_follows_the_content() {
         let one = |v: f64| m(1, 1, &[v]);
-        let a = ObserverResource::new("o", 0.1, one(0.5), one(1.0), one(1.0), one(1.0), one(0.0), one(1.0), None).unwrap();
-        let b = ObserverResource::new("o", 0.1, one(0.5), one(1.0), one(1.0), one(1.0), one(0.0), one(1.0), None).unwrap();
-        let c = ObserverResource::new("o", 0.1, one(0.25), one(1.0), one(1.0), one(1.0), one(0.0), one(1.0), None).unwrap();
+        let a = ObserverResource::new(
+            "o",
+            0.1,
+            one(0.5),
+            one(1.0),
+            one(1.0),
+            one(1.0),
+            one(0.0),
+            one(1.0),
+            None,
+        )
+        .unwrap();
+        let b = ObserverResource::new(
+            "o",
+            0.1,
+            one(0.5),
+            one(1.0),
+            one(1.0),
+            one(1.0),
+            one(0.0),
+            one(1.0),
+            None,
+        )
+        .unwrap();
+        let c = ObserverResource::new(
+            "o",
+            0.1,
+            one(0.25),
+            one(1.0),
+            one(1.0),
+            one(1.0),
+            one(0.0),
+            one(1.0),
+            None,
+        )
+        .unwrap();
         assert_eq!(a.token, b.token);
         assert_ne!(a.token, c.token);
         assert_eq!(a.token.len(), 38);

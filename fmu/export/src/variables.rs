@@ -94,13 +94,20 @@ impl Layout {
 /// Q and C: x̂_i = (P z)_i + Σ_m Q_im y_m, r_j = y_j − Σ_i C_ji x̂_i. With an initial estimate,
 /// x̂_0 = P P⁺(x̂₀ − Q y_0) + Q y_0 may involve every y: then every output depends on every y.
 /// u never acts on an output directly (only on z⁺).
-pub fn dependencies(role: Role, q: &lti::MatData, c: &lti::MatData, with_xhat0: bool) -> Vec<usize> {
+pub fn dependencies(
+    role: Role,
+    q: &lti::MatData,
+    c: &lti::MatData,
+    with_xhat0: bool,
+) -> Vec<usize> {
     let p = q.cols;
     let q_at = |i: usize, m: usize| q.data[i * q.cols + m] != 0.0;
     match role {
         Role::Xhat(_) | Role::R(_) if with_xhat0 => (0..p).collect(),
         Role::Xhat(i) => (0..p).filter(|&m| q_at(i, m)).collect(),
-        Role::R(j) => (0..p).filter(|&m| m == j || (0..c.cols).any(|i| c.data[j * c.cols + i] != 0.0 && q_at(i, m))).collect(),
+        Role::R(j) => (0..p)
+            .filter(|&m| m == j || (0..c.cols).any(|i| c.data[j * c.cols + i] != 0.0 && q_at(i, m)))
+            .collect(),
         _ => Vec::new(),
     }
 }
@@ -112,7 +119,14 @@ mod tests {
 
     #[test]
     fn value_references_number_every_variable_once() {
-        let lay = Layout { dims: Dims { n: 3, r: 2, l: 2, p: 2 } };
+        let lay = Layout {
+            dims: Dims {
+                n: 3,
+                r: 2,
+                l: 2,
+                p: 2,
+            },
+        };
         assert_eq!(lay.len(), 10);
         for (vr, role) in lay.roles().enumerate() {
             assert_eq!(lay.vr(role), vr as u32);
@@ -127,8 +141,16 @@ mod tests {
     #[test]
     fn dependencies_follow_q_and_c() {
         // Q = [[0, 1], [0, 0]], C = [[1, 0], [0, 1]]: x̂_1 on y_2, x̂_2 on none; r_1 on y_1, y_2.
-        let q = MatData { rows: 2, cols: 2, data: vec![0.0, 1.0, 0.0, 0.0] };
-        let c = MatData { rows: 2, cols: 2, data: vec![1.0, 0.0, 0.0, 1.0] };
+        let q = MatData {
+            rows: 2,
+            cols: 2,
+            data: vec![0.0, 1.0, 0.0, 0.0],
+        };
+        let c = MatData {
+            rows: 2,
+            cols: 2,
+            data: vec![1.0, 0.0, 0.0, 1.0],
+        };
         assert_eq!(dependencies(Role::Xhat(0), &q, &c, false), [1]);
         assert!(dependencies(Role::Xhat(1), &q, &c, false).is_empty());
         assert_eq!(dependencies(Role::R(0), &q, &c, false), [0, 1]);

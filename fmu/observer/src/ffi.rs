@@ -1,8 +1,8 @@
 //! What both FMI versions need at the C boundary: no panic crosses it, pointers and arrays
 //! from the importer are checked before use, and resource locations become paths.
 
-use std::ffi::{c_char, CStr};
-use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::ffi::{CStr, c_char};
+use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::PathBuf;
 
 use crate::instance::Instance;
@@ -67,10 +67,15 @@ pub unsafe fn text(s: *const c_char) -> String {
 /// The folder an FMI 2 `fmuResourceLocation` names: a `file:` URI (`file:///p`,
 /// `file://localhost/p` or `file:/p`), percent-decoded.
 pub fn uri_path(uri: &str) -> Result<PathBuf, String> {
-    let rest = uri.strip_prefix("file:").ok_or_else(|| format!("the resource location {uri:?} is not a file: URI"))?;
+    let rest = uri
+        .strip_prefix("file:")
+        .ok_or_else(|| format!("the resource location {uri:?} is not a file: URI"))?;
     let path = match rest.strip_prefix("//") {
         Some(authority) if authority.starts_with('/') => authority,
-        Some(authority) => authority.strip_prefix("localhost").filter(|p| p.starts_with('/')).ok_or_else(|| format!("the resource location {uri:?} is on another host"))?,
+        Some(authority) => authority
+            .strip_prefix("localhost")
+            .filter(|p| p.starts_with('/'))
+            .ok_or_else(|| format!("the resource location {uri:?} is on another host"))?,
         None => rest,
     };
     let bytes = path.as_bytes();
@@ -78,8 +83,13 @@ pub fn uri_path(uri: &str) -> Result<PathBuf, String> {
     let mut i = 0;
     while i < bytes.len() {
         if bytes[i] == b'%' {
-            let hex = bytes.get(i + 1..i + 3).and_then(|h| std::str::from_utf8(h).ok()).and_then(|h| u8::from_str_radix(h, 16).ok());
-            out.push(hex.ok_or_else(|| format!("the resource location {uri:?} has a bad %-escape"))?);
+            let hex = bytes
+                .get(i + 1..i + 3)
+                .and_then(|h| std::str::from_utf8(h).ok())
+                .and_then(|h| u8::from_str_radix(h, 16).ok());
+            out.push(
+                hex.ok_or_else(|| format!("the resource location {uri:?} has a bad %-escape"))?,
+            );
             i += 3;
         } else {
             out.push(bytes[i]);
@@ -96,8 +106,14 @@ mod tests {
 
     #[test]
     fn file_uris_become_paths() {
-        assert_eq!(uri_path("file:///tmp/a%20b/resources").unwrap(), PathBuf::from("/tmp/a b/resources"));
-        assert_eq!(uri_path("file://localhost/tmp/r/").unwrap(), PathBuf::from("/tmp/r/"));
+        assert_eq!(
+            uri_path("file:///tmp/a%20b/resources").unwrap(),
+            PathBuf::from("/tmp/a b/resources")
+        );
+        assert_eq!(
+            uri_path("file://localhost/tmp/r/").unwrap(),
+            PathBuf::from("/tmp/r/")
+        );
         assert_eq!(uri_path("file:/tmp/r").unwrap(), PathBuf::from("/tmp/r"));
         assert!(uri_path("http://x/r").is_err());
         assert!(uri_path("file://host/r").is_err());

@@ -3,7 +3,7 @@
 //! directional derivatives, input derivatives and asynchronous steps are not supported
 //! (fmi2Error). Every entry point checks its instance pointer and catches panics.
 
-use std::ffi::{c_char, c_int, c_void, CString};
+use std::ffi::{CString, c_char, c_int, c_void};
 
 use crate::ffi::{guard, instance, slice, slice_mut, text, uri_path};
 use crate::instance::Instance;
@@ -13,7 +13,16 @@ const ERROR: c_int = 3;
 const CO_SIMULATION: c_int = 1;
 const LAST_SUCCESSFUL_TIME: c_int = 2;
 
-type Logger = Option<unsafe extern "C" fn(env: *mut c_void, name: *const c_char, status: c_int, category: *const c_char, message: *const c_char, ...)>;
+type Logger = Option<
+    unsafe extern "C" fn(
+        env: *mut c_void,
+        name: *const c_char,
+        status: c_int,
+        category: *const c_char,
+        message: *const c_char,
+        ...
+    ),
+>;
 
 /// fmi2CallbackFunctions.
 #[repr(C)]
@@ -31,7 +40,16 @@ fn log_to(log: Logger, env: *mut c_void, name: &CString, message: &str) {
     if let Some(log) = log {
         let message = CString::new(message.replace('\0', " ")).expect("no NUL");
         // SAFETY: the importer's callback, called as fmi2FunctionTypes.h declares it.
-        unsafe { log(env, name.as_ptr(), ERROR, c"logStatusError".as_ptr(), c"%s".as_ptr(), message.as_ptr()) };
+        unsafe {
+            log(
+                env,
+                name.as_ptr(),
+                ERROR,
+                c"logStatusError".as_ptr(),
+                c"%s".as_ptr(),
+                message.as_ptr(),
+            )
+        };
     }
 }
 
@@ -70,7 +88,12 @@ pub unsafe extern "C" fn fmi2GetVersion() -> *const c_char {
 /// # Safety
 /// Called by an FMI importer.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetDebugLogging(c: *mut c_void, _on: c_int, _n: usize, _categories: *const *const c_char) -> c_int {
+pub unsafe extern "C" fn fmi2SetDebugLogging(
+    c: *mut c_void,
+    _on: c_int,
+    _n: usize,
+    _categories: *const *const c_char,
+) -> c_int {
     with(c, |_| Ok(())) // errors are always logged; there is nothing else to log
 }
 
@@ -88,8 +111,17 @@ pub unsafe extern "C" fn fmi2Instantiate(
 ) -> *mut c_void {
     guard(std::ptr::null_mut(), || {
         // SAFETY: the importer passes NUL-terminated strings (or null) and valid callbacks.
-        let (name, guid, location, functions) = unsafe { (text(name), text(guid), text(resource_location), functions.as_ref()) };
-        let Some(functions) = functions else { return std::ptr::null_mut() };
+        let (name, guid, location, functions) = unsafe {
+            (
+                text(name),
+                text(guid),
+                text(resource_location),
+                functions.as_ref(),
+            )
+        };
+        let Some(functions) = functions else {
+            return std::ptr::null_mut();
+        };
         let (log, env) = (functions.logger, functions.component_environment);
         let name = CString::new(name.replace('\0', " ")).expect("no NUL");
         let made = if fmu_type != CO_SIMULATION {
@@ -97,7 +129,11 @@ pub unsafe extern "C" fn fmi2Instantiate(
         } else {
             uri_path(&location).and_then(|dir| {
                 let own = name.clone();
-                Instance::new(&dir, &guid, Box::new(move |m: &str| log_to(log, env, &own, m)))
+                Instance::new(
+                    &dir,
+                    &guid,
+                    Box::new(move |m: &str| log_to(log, env, &own, m)),
+                )
             })
         };
         match made {
@@ -123,7 +159,14 @@ pub unsafe extern "C" fn fmi2FreeInstance(c: *mut c_void) {
 /// # Safety
 /// Called by an FMI importer.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetupExperiment(c: *mut c_void, _tolerance_defined: c_int, _tolerance: f64, start_time: f64, _stop_time_defined: c_int, _stop_time: f64) -> c_int {
+pub unsafe extern "C" fn fmi2SetupExperiment(
+    c: *mut c_void,
+    _tolerance_defined: c_int,
+    _tolerance: f64,
+    start_time: f64,
+    _stop_time_defined: c_int,
+    _stop_time: f64,
+) -> c_int {
     with(c, |inst| {
         if inst.mode != crate::instance::Mode::Instantiated {
             return Err("fmi2SetupExperiment: only after instantiation or reset".into());
@@ -167,7 +210,12 @@ pub unsafe extern "C" fn fmi2Reset(c: *mut c_void) -> c_int {
 /// # Safety
 /// `vr` and `values` hold `nvr` elements.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetReal(c: *mut c_void, vr: *const u32, nvr: usize, values: *mut f64) -> c_int {
+pub unsafe extern "C" fn fmi2GetReal(
+    c: *mut c_void,
+    vr: *const u32,
+    nvr: usize,
+    values: *mut f64,
+) -> c_int {
     with(c, |inst| {
         // SAFETY: the importer passes arrays of nvr elements.
         match unsafe { (slice(vr, nvr), slice_mut(values, nvr)) } {
@@ -180,7 +228,12 @@ pub unsafe extern "C" fn fmi2GetReal(c: *mut c_void, vr: *const u32, nvr: usize,
 /// # Safety
 /// `vr` and `values` hold `nvr` elements.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetReal(c: *mut c_void, vr: *const u32, nvr: usize, values: *const f64) -> c_int {
+pub unsafe extern "C" fn fmi2SetReal(
+    c: *mut c_void,
+    vr: *const u32,
+    nvr: usize,
+    values: *const f64,
+) -> c_int {
     with(c, |inst| {
         // SAFETY: the importer passes arrays of nvr elements.
         match unsafe { (slice(vr, nvr), slice(values, nvr)) } {
@@ -218,7 +271,12 @@ no_variables! {
 /// # Safety
 /// Called by an FMI importer.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2DoStep(c: *mut c_void, t: f64, h: f64, _no_set_state_prior: c_int) -> c_int {
+pub unsafe extern "C" fn fmi2DoStep(
+    c: *mut c_void,
+    t: f64,
+    h: f64,
+    _no_set_state_prior: c_int,
+) -> c_int {
     with(c, |inst| inst.do_step(t, h))
 }
 

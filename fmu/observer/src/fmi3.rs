@@ -5,7 +5,7 @@
 //! one; importers such as FMPy load them all) and return fmi3Error. Every entry point checks
 //! its instance pointer and catches panics.
 
-use std::ffi::{c_char, c_int, c_void, CString};
+use std::ffi::{CString, c_char, c_int, c_void};
 use std::path::PathBuf;
 
 use crate::ffi::{guard, instance, slice, slice_mut, text};
@@ -14,7 +14,14 @@ use crate::instance::{Instance, Mode};
 const OK: c_int = 0;
 const ERROR: c_int = 3;
 
-type LogMessage = Option<unsafe extern "C" fn(env: *mut c_void, status: c_int, category: *const c_char, message: *const c_char)>;
+type LogMessage = Option<
+    unsafe extern "C" fn(
+        env: *mut c_void,
+        status: c_int,
+        category: *const c_char,
+        message: *const c_char,
+    ),
+>;
 
 /// One line to the importer's logger, status Error.
 fn log_to(log: LogMessage, env: *mut c_void, message: &str) {
@@ -53,7 +60,12 @@ pub unsafe extern "C" fn fmi3GetVersion() -> *const c_char {
 /// # Safety
 /// Called by an FMI importer.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3SetDebugLogging(i: *mut c_void, _on: bool, _n: usize, _categories: *const *const c_char) -> c_int {
+pub unsafe extern "C" fn fmi3SetDebugLogging(
+    i: *mut c_void,
+    _on: bool,
+    _n: usize,
+    _categories: *const *const c_char,
+) -> c_int {
     with(i, |_| Ok(())) // errors are always logged; there is nothing else to log
 }
 
@@ -99,9 +111,21 @@ pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
 /// # Safety
 /// Called by an FMI importer.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3InstantiateModelExchange(_name: *const c_char, _token: *const c_char, _resource_path: *const c_char, _visible: bool, _logging_on: bool, env: *mut c_void, log: LogMessage) -> *mut c_void {
+pub unsafe extern "C" fn fmi3InstantiateModelExchange(
+    _name: *const c_char,
+    _token: *const c_char,
+    _resource_path: *const c_char,
+    _visible: bool,
+    _logging_on: bool,
+    env: *mut c_void,
+    log: LogMessage,
+) -> *mut c_void {
     guard(std::ptr::null_mut(), || {
-        log_to(log, env, "model exchange is not supported: this FMU is for co-simulation");
+        log_to(
+            log,
+            env,
+            "model exchange is not supported: this FMU is for co-simulation",
+        );
         std::ptr::null_mut()
     })
 }
@@ -123,7 +147,11 @@ pub unsafe extern "C" fn fmi3InstantiateScheduledExecution(
     _unlock: *const c_void,
 ) -> *mut c_void {
     guard(std::ptr::null_mut(), || {
-        log_to(log, env, "scheduled execution is not supported: this FMU is for co-simulation");
+        log_to(
+            log,
+            env,
+            "scheduled execution is not supported: this FMU is for co-simulation",
+        );
         std::ptr::null_mut()
     })
 }
@@ -141,7 +169,14 @@ pub unsafe extern "C" fn fmi3FreeInstance(i: *mut c_void) {
 /// # Safety
 /// Called by an FMI importer.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3EnterInitializationMode(i: *mut c_void, _tolerance_defined: bool, _tolerance: f64, start_time: f64, _stop_time_defined: bool, _stop_time: f64) -> c_int {
+pub unsafe extern "C" fn fmi3EnterInitializationMode(
+    i: *mut c_void,
+    _tolerance_defined: bool,
+    _tolerance: f64,
+    start_time: f64,
+    _stop_time_defined: bool,
+    _stop_time: f64,
+) -> c_int {
     with(i, |inst| inst.enter_initialization(start_time))
 }
 
@@ -172,7 +207,13 @@ pub unsafe extern "C" fn fmi3Reset(i: *mut c_void) -> c_int {
 /// # Safety
 /// `vr` and `values` hold `nvr` elements.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3GetFloat64(i: *mut c_void, vr: *const u32, nvr: usize, values: *mut f64, n_values: usize) -> c_int {
+pub unsafe extern "C" fn fmi3GetFloat64(
+    i: *mut c_void,
+    vr: *const u32,
+    nvr: usize,
+    values: *mut f64,
+    n_values: usize,
+) -> c_int {
     with(i, |inst| {
         // SAFETY: the importer passes arrays of the lengths it gives.
         let (vr, values) = unsafe { (slice(vr, nvr), slice_mut(values, n_values)) };
@@ -186,7 +227,13 @@ pub unsafe extern "C" fn fmi3GetFloat64(i: *mut c_void, vr: *const u32, nvr: usi
 /// # Safety
 /// `vr` and `values` hold `nvr` elements.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3SetFloat64(i: *mut c_void, vr: *const u32, nvr: usize, values: *const f64, n_values: usize) -> c_int {
+pub unsafe extern "C" fn fmi3SetFloat64(
+    i: *mut c_void,
+    vr: *const u32,
+    nvr: usize,
+    values: *const f64,
+    n_values: usize,
+) -> c_int {
     with(i, |inst| {
         // SAFETY: the importer passes arrays of the lengths it gives.
         let (vr, values) = unsafe { (slice(vr, nvr), slice(values, n_values)) };
@@ -231,29 +278,69 @@ no_variables! {
 /// # Safety
 /// Called by an FMI importer.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3GetBinary(i: *mut c_void, _vr: *const u32, nvr: usize, _sizes: *mut usize, _values: *mut *const u8, _n: usize) -> c_int {
-    if nvr == 0 { with(i, |_| Ok(())) } else { unsupported(i, "fmi3GetBinary") }
+pub unsafe extern "C" fn fmi3GetBinary(
+    i: *mut c_void,
+    _vr: *const u32,
+    nvr: usize,
+    _sizes: *mut usize,
+    _values: *mut *const u8,
+    _n: usize,
+) -> c_int {
+    if nvr == 0 {
+        with(i, |_| Ok(()))
+    } else {
+        unsupported(i, "fmi3GetBinary")
+    }
 }
 
 /// # Safety
 /// Called by an FMI importer.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3SetBinary(i: *mut c_void, _vr: *const u32, nvr: usize, _sizes: *const usize, _values: *const *const u8, _n: usize) -> c_int {
-    if nvr == 0 { with(i, |_| Ok(())) } else { unsupported(i, "fmi3SetBinary") }
+pub unsafe extern "C" fn fmi3SetBinary(
+    i: *mut c_void,
+    _vr: *const u32,
+    nvr: usize,
+    _sizes: *const usize,
+    _values: *const *const u8,
+    _n: usize,
+) -> c_int {
+    if nvr == 0 {
+        with(i, |_| Ok(()))
+    } else {
+        unsupported(i, "fmi3SetBinary")
+    }
 }
 
 /// # Safety
 /// Called by an FMI importer.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3GetClock(i: *mut c_void, _vr: *const u32, nvr: usize, _values: *mut bool) -> c_int {
-    if nvr == 0 { with(i, |_| Ok(())) } else { unsupported(i, "fmi3GetClock") }
+pub unsafe extern "C" fn fmi3GetClock(
+    i: *mut c_void,
+    _vr: *const u32,
+    nvr: usize,
+    _values: *mut bool,
+) -> c_int {
+    if nvr == 0 {
+        with(i, |_| Ok(()))
+    } else {
+        unsupported(i, "fmi3GetClock")
+    }
 }
 
 /// # Safety
 /// Called by an FMI importer.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3SetClock(i: *mut c_void, _vr: *const u32, nvr: usize, _values: *const bool) -> c_int {
-    if nvr == 0 { with(i, |_| Ok(())) } else { unsupported(i, "fmi3SetClock") }
+pub unsafe extern "C" fn fmi3SetClock(
+    i: *mut c_void,
+    _vr: *const u32,
+    nvr: usize,
+    _values: *const bool,
+) -> c_int {
+    if nvr == 0 {
+        with(i, |_| Ok(()))
+    } else {
+        unsupported(i, "fmi3SetClock")
+    }
 }
 
 /// One communication step: z ← F z + G u + K y, refused unless the step is dt.
@@ -294,7 +381,13 @@ pub unsafe extern "C" fn fmi3DoStep(
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3EnterStepMode(i: *mut c_void) -> c_int {
     // No event mode: the instance is in step mode as soon as initialization ends.
-    with(i, |inst| if inst.mode == Mode::Step { Ok(()) } else { Err("fmi3EnterStepMode: no event mode".into()) })
+    with(i, |inst| {
+        if inst.mode == Mode::Step {
+            Ok(())
+        } else {
+            Err("fmi3EnterStepMode: no event mode".into())
+        }
+    })
 }
 
 /// Functions of the standard this FMU does not support: fmi3Error with a message.

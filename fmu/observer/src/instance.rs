@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use fmu_export::resource::{ObserverResource, FILE};
+use fmu_export::resource::{FILE, ObserverResource};
 use fmu_export::variables::{Layout, Role};
 
 use crate::observer::Observer;
@@ -48,12 +48,26 @@ impl Instance {
     /// token.
     pub fn new(dir: &Path, token: &str, log: Log) -> Result<Instance, String> {
         let path = dir.join(FILE);
-        let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
-        let (res, dims) = ObserverResource::from_json(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+        let (res, dims) =
+            ObserverResource::from_json(&text).map_err(|e| format!("{}: {e}", path.display()))?;
         if res.token != token {
-            return Err(format!("{}: made for token {}, the modelDescription gives {token}", path.display(), res.token));
+            return Err(format!(
+                "{}: made for token {}, the modelDescription gives {token}",
+                path.display(),
+                res.token
+            ));
         }
-        Ok(Instance { log, layout: Layout { dims }, observer: Observer::new(&res), dt: res.dt, start_time: 0.0, steps: 0, mode: Mode::Instantiated })
+        Ok(Instance {
+            log,
+            layout: Layout { dims },
+            observer: Observer::new(&res),
+            dt: res.dt,
+            start_time: 0.0,
+            steps: 0,
+            mode: Mode::Instantiated,
+        })
     }
 
     /// Logs `e` if it is an error; whether all went well.
@@ -69,7 +83,9 @@ impl Instance {
     /// Enter initialization mode at `start_time`.
     pub fn enter_initialization(&mut self, start_time: f64) -> Result<(), String> {
         if self.mode != Mode::Instantiated {
-            return Err("enter initialization mode: only right after instantiation or reset".into());
+            return Err(
+                "enter initialization mode: only right after instantiation or reset".into(),
+            );
         }
         if !start_time.is_finite() {
             return Err(format!("the start time {start_time} is not finite"));
@@ -130,7 +146,11 @@ impl Instance {
         }
         let roles = self.roles(vr)?;
         if let Some(&role) = roles.iter().find(|r| !matches!(r, Role::U(_) | Role::Y(_))) {
-            return Err(format!("{} (value reference {}) is not an input", self.layout.name(role), self.layout.vr(role)));
+            return Err(format!(
+                "{} (value reference {}) is not an input",
+                self.layout.name(role),
+                self.layout.vr(role)
+            ));
         }
         for (&v, role) in values.iter().zip(roles) {
             match role {
@@ -154,7 +174,10 @@ impl Instance {
         // NaN h fails this too.
         let within = m >= 1.0 && (h - m * self.dt).abs() <= STEP_TOLERANCE * h;
         if !within {
-            return Err(format!("doStep(t = {t}, h = {h}): this observer was sampled with dt = {}; it takes steps of whole multiples of dt only", self.dt));
+            return Err(format!(
+                "doStep(t = {t}, h = {h}): this observer was sampled with dt = {}; it takes steps of whole multiples of dt only",
+                self.dt
+            ));
         }
         for _ in 0..m as u64 {
             self.observer.advance();
@@ -164,7 +187,16 @@ impl Instance {
     }
 
     fn roles(&self, vr: &[u32]) -> Result<Vec<Role>, String> {
-        vr.iter().map(|&v| self.layout.role(v).ok_or_else(|| format!("unknown value reference {v} (this FMU has 0 … {})", self.layout.len() - 1))).collect()
+        vr.iter()
+            .map(|&v| {
+                self.layout.role(v).ok_or_else(|| {
+                    format!(
+                        "unknown value reference {v} (this FMU has 0 … {})",
+                        self.layout.len() - 1
+                    )
+                })
+            })
+            .collect()
     }
 }
 
@@ -174,22 +206,59 @@ mod tests {
     use lti::MatData;
 
     fn instance() -> (Instance, std::path::PathBuf) {
-        let one = |v: f64| MatData { rows: 1, cols: 1, data: vec![v] };
-        let res = ObserverResource::new("o", 0.1, one(0.5), one(1.0), one(1.0), one(1.0), one(2.0), one(1.0), None).unwrap();
-        let dir = std::env::temp_dir().join(format!("fmu-observer-test-{}-{:?}", std::process::id(), std::thread::current().id()));
+        let one = |v: f64| MatData {
+            rows: 1,
+            cols: 1,
+            data: vec![v],
+        };
+        let res = ObserverResource::new(
+            "o",
+            0.1,
+            one(0.5),
+            one(1.0),
+            one(1.0),
+            one(1.0),
+            one(2.0),
+            one(1.0),
+            None,
+        )
+        .unwrap();
+        let dir = std::env::temp_dir().join(format!(
+            "fmu-observer-test-{}-{:?}",
+            std::process::id(),
+            std::thread::current().id()
+        ));
         std::fs::create_dir_all(&dir).unwrap();
         std::fs::write(dir.join(FILE), res.to_json()).unwrap();
-        (Instance::new(&dir, &res.token, Box::new(|_| ())).unwrap(), dir)
+        (
+            Instance::new(&dir, &res.token, Box::new(|_| ())).unwrap(),
+            dir,
+        )
     }
 
     #[test]
     fn refuses_a_wrong_token_a_garbled_file_and_a_missing_one() {
         let (_, dir) = instance();
-        assert!(Instance::new(&dir, "{other}", Box::new(|_| ())).err().unwrap().contains("token"));
+        assert!(
+            Instance::new(&dir, "{other}", Box::new(|_| ()))
+                .err()
+                .unwrap()
+                .contains("token")
+        );
         std::fs::write(dir.join(FILE), "{\"format\": 1").unwrap();
-        assert!(Instance::new(&dir, "", Box::new(|_| ())).err().unwrap().contains("not an observer resource"));
+        assert!(
+            Instance::new(&dir, "", Box::new(|_| ()))
+                .err()
+                .unwrap()
+                .contains("not an observer resource")
+        );
         std::fs::remove_dir_all(&dir).unwrap();
-        assert!(Instance::new(&dir, "", Box::new(|_| ())).err().unwrap().contains("cannot read"));
+        assert!(
+            Instance::new(&dir, "", Box::new(|_| ()))
+                .err()
+                .unwrap()
+                .contains("cannot read")
+        );
     }
 
     #[test]
@@ -207,7 +276,11 @@ mod tests {
         inst.get(&[3, 4], &mut v).unwrap();
         assert_eq!(v, [6.0, -3.0]);
         assert!(inst.do_step(0.0, 0.25).unwrap_err().contains("dt = 0.1"));
-        assert!(inst.do_step(0.0, 0.04).unwrap_err().contains("whole multiples"));
+        assert!(
+            inst.do_step(0.0, 0.04)
+                .unwrap_err()
+                .contains("whole multiples")
+        );
         inst.do_step(0.0, 0.1 * (1.0 + 1e-12)).unwrap();
         inst.set(&[2], &[1.0]).unwrap();
         inst.get(&[0, 3], &mut v).unwrap();

@@ -75,7 +75,15 @@ impl Observer {
             y: vec![0.0; outputs],
             xhat: vec![0.0; n],
             r: vec![0.0; outputs],
-            op: res.operating_point.as_ref().map(|o| [o.u.clone(), o.y.clone(), o.c_z.clone(), o.c_x.clone(), o.c_r.clone()]),
+            op: res.operating_point.as_ref().map(|o| {
+                [
+                    o.u.clone(),
+                    o.y.clone(),
+                    o.c_z.clone(),
+                    o.c_x.clone(),
+                    o.c_r.clone(),
+                ]
+            }),
         };
         o.start_inputs();
         o
@@ -184,13 +192,28 @@ mod tests {
     use lti::MatData;
 
     fn one(v: f64) -> MatData {
-        MatData { rows: 1, cols: 1, data: vec![v] }
+        MatData {
+            rows: 1,
+            cols: 1,
+            data: vec![v],
+        }
     }
 
     #[test]
     fn steps_like_the_runtime() {
         // z⁺ = 0.5 z + u + y, x̂ = z + 2y, C = 1 (observer/src/runtime.rs's first test).
-        let res = ObserverResource::new("o", 0.1, one(0.5), one(1.0), one(1.0), one(1.0), one(2.0), one(1.0), None).unwrap();
+        let res = ObserverResource::new(
+            "o",
+            0.1,
+            one(0.5),
+            one(1.0),
+            one(1.0),
+            one(1.0),
+            one(2.0),
+            one(1.0),
+            None,
+        )
+        .unwrap();
         let mut o = Observer::new(&res);
         o.y[0] = 3.0;
         o.outputs();
@@ -205,9 +228,28 @@ mod tests {
     #[test]
     fn the_initial_estimate_follows_y0_until_the_first_step() {
         // P = [1; 1], Q = [0; 1]: z0 = P⁺(x̂₀ − Q y0) (observer/src/runtime.rs's second test).
-        let col = |a: f64, b: f64| MatData { rows: 2, cols: 1, data: vec![a, b] };
-        let c = MatData { rows: 1, cols: 2, data: vec![1.0, 0.0] };
-        let res = ObserverResource::new("o", 0.1, one(0.5), one(0.0), one(1.0), col(1.0, 1.0), col(0.0, 1.0), c, Some(vec![4.0, 2.0])).unwrap();
+        let col = |a: f64, b: f64| MatData {
+            rows: 2,
+            cols: 1,
+            data: vec![a, b],
+        };
+        let c = MatData {
+            rows: 1,
+            cols: 2,
+            data: vec![1.0, 0.0],
+        };
+        let res = ObserverResource::new(
+            "o",
+            0.1,
+            one(0.5),
+            one(0.0),
+            one(1.0),
+            col(1.0, 1.0),
+            col(0.0, 1.0),
+            c,
+            Some(vec![4.0, 2.0]),
+        )
+        .unwrap();
         let mut o = Observer::new(&res);
         o.y[0] = 3.0;
         o.outputs();

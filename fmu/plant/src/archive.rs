@@ -8,7 +8,10 @@ use std::path::Path;
 
 use fmi::schema::fmi2::Initial as I2;
 use fmi::schema::fmi2::{Causality as C2, Fmi2ModelDescription, ScalarVariableElement};
-use fmi::schema::fmi3::{AbstractVariableTrait, ArrayableVariableTrait, Causality as C3, Fmi3ModelDescription, Initial as I3, InitializableVariableTrait, Variable};
+use fmi::schema::fmi3::{
+    AbstractVariableTrait, ArrayableVariableTrait, Causality as C3, Fmi3ModelDescription,
+    Initial as I3, InitializableVariableTrait, Variable,
+};
 use fmi::schema::minimal::MinModelDescription;
 use fmi::schema::traits::FmiModelDescription;
 use scenario::untrusted::quoted;
@@ -126,30 +129,48 @@ pub const MAX_ENTRIES: usize = 10_000;
 pub fn read(path: &Path) -> Result<Fmu, String> {
     let at = |why: String| format!("{}: {why}", path.display());
     let file = std::fs::File::open(path).map_err(|e| at(format!("cannot open: {e}")))?;
-    let mut zip = zip::ZipArchive::new(file).map_err(|e| at(format!("not an FMU: not a zip archive ({e})")))?;
+    let mut zip = zip::ZipArchive::new(file)
+        .map_err(|e| at(format!("not an FMU: not a zip archive ({e})")))?;
     if zip.len() > MAX_ENTRIES {
-        return Err(at(format!("holds {} entries, more than the {MAX_ENTRIES} an FMU plant may", zip.len())));
+        return Err(at(format!(
+            "holds {} entries, more than the {MAX_ENTRIES} an FMU plant may",
+            zip.len()
+        )));
     }
     for i in 0..zip.len() {
-        let f = zip.by_index_raw(i).map_err(|e| at(format!("entry {}: {e}", i + 1)))?;
+        let f = zip
+            .by_index_raw(i)
+            .map_err(|e| at(format!("entry {}: {e}", i + 1)))?;
         let mode = f.unix_mode().unwrap_or(0);
         if mode & 0o170000 == 0o120000 {
-            return Err(at(format!("entry {} is a symbolic link: an FMU plant's archive holds files only", quoted(f.name()))));
+            return Err(at(format!(
+                "entry {} is a symbolic link: an FMU plant's archive holds files only",
+                quoted(f.name())
+            )));
         }
         if mode & 0o6000 != 0 {
-            return Err(at(format!("entry {} has the setuid or setgid bit ({mode:o}): refused", quoted(f.name()))));
+            return Err(at(format!(
+                "entry {} has the setuid or setgid bit ({mode:o}): refused",
+                quoted(f.name())
+            )));
         }
     }
     // The run extracts the whole archive: what it unpacks to is bounded before anything is, by
     // inflating every entry here (a declared size can lie; the CRC does not bound it).
     let mut unpacked = 0u64;
     for i in 0..zip.len() {
-        let mut f = zip.by_index(i).map_err(|e| at(format!("entry {}: {e}", i + 1)))?;
+        let mut f = zip
+            .by_index(i)
+            .map_err(|e| at(format!("entry {}: {e}", i + 1)))?;
         let left = MAX_UNPACKED - unpacked;
-        let n = std::io::copy(&mut (&mut f).take(left + 1), &mut std::io::sink()).map_err(|e| at(format!("entry {}: {e}", quoted(f.name()))))?;
+        let n = std::io::copy(&mut (&mut f).take(left + 1), &mut std::io::sink())
+            .map_err(|e| at(format!("entry {}: {e}", quoted(f.name()))))?;
         unpacked += n;
         if n > left {
-            return Err(at(format!("unpacks to more than the {MAX_UNPACKED} bytes an FMU plant may (entry {} alone inflates past it)", quoted(f.name()))));
+            return Err(at(format!(
+                "unpacks to more than the {MAX_UNPACKED} bytes an FMU plant may (entry {} alone inflates past it)",
+                quoted(f.name())
+            )));
         }
     }
     let mut xml = String::new();
@@ -159,13 +180,25 @@ pub fn read(path: &Path) -> Result<Fmu, String> {
         .read_to_string(&mut xml)
         .map_err(|e| at(format!("modelDescription.xml: {e}")))?;
     if xml.len() as u64 > MAX_DESCRIPTION {
-        return Err(at(format!("modelDescription.xml is longer than {MAX_DESCRIPTION} bytes")));
+        return Err(at(format!(
+            "modelDescription.xml is longer than {MAX_DESCRIPTION} bytes"
+        )));
     }
-    let min = MinModelDescription::deserialize(&xml).map_err(|e| at(format!("modelDescription.xml: {}", first_line(&e.to_string()))))?;
+    let min = MinModelDescription::deserialize(&xml).map_err(|e| {
+        at(format!(
+            "modelDescription.xml: {}",
+            first_line(&e.to_string())
+        ))
+    })?;
     let version = match min.fmi_version.split('.').next() {
         Some("2") => Version::Two,
         Some("3") => Version::Three,
-        _ => return Err(at(format!("FMI version {} is not supported (FMI 2.0 and 3.0 co-simulation are)", min.fmi_version))),
+        _ => {
+            return Err(at(format!(
+                "FMI version {} is not supported (FMI 2.0 and 3.0 co-simulation are)",
+                min.fmi_version
+            )));
+        }
     };
     let fmu = match version {
         Version::Two => from_fmi2(&xml).map_err(at)?,
@@ -174,22 +207,40 @@ pub fn read(path: &Path) -> Result<Fmu, String> {
     // The library is binaries/<platform>/<modelIdentifier>.so inside the extraction: the
     // identifier must be a plain file name, so the path cannot leave it.
     let id = &fmu.model_identifier;
-    if id.is_empty() || id.starts_with('.') || !id.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-' || c == '.') {
-        return Err(at(format!("modelIdentifier {} is not a plain file name (letters, digits, _ - .): refused", quoted(id))));
+    if id.is_empty()
+        || id.starts_with('.')
+        || !id
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-' || c == '.')
+    {
+        return Err(at(format!(
+            "modelIdentifier {} is not a plain file name (letters, digits, _ - .): refused",
+            quoted(id)
+        )));
     }
     let binary = binary_path(version, &fmu.model_identifier);
     if zip.index_for_name(&binary).is_none() {
-        let present: Vec<String> = zip.file_names().filter(|n| n.starts_with("binaries/") && !n.ends_with('/')).map(str::to_string).collect();
+        let present: Vec<String> = zip
+            .file_names()
+            .filter(|n| n.starts_with("binaries/") && !n.ends_with('/'))
+            .map(str::to_string)
+            .collect();
         let has = if present.is_empty() {
             "none (a source-only FMU is not compiled here)".to_string()
         } else {
             present.join(", ")
         };
-        return Err(at(format!("no binary for this platform: {binary} is not in the archive (binaries: {has})")));
+        return Err(at(format!(
+            "no binary for this platform: {binary} is not in the archive (binaries: {has})"
+        )));
     }
     let mut library = Vec::new();
     zip.by_name(&binary)
-        .and_then(|f| f.take(MAX_UNPACKED).read_to_end(&mut library).map_err(Into::into))
+        .and_then(|f| {
+            f.take(MAX_UNPACKED)
+                .read_to_end(&mut library)
+                .map_err(Into::into)
+        })
         .map_err(|e| at(format!("{binary}: {e}")))?;
     if let Some(why) = crate::library::problem(&binary, &library, version) {
         return Err(at(why));
@@ -213,8 +264,15 @@ fn no_cs(me: bool) -> String {
 }
 
 fn from_fmi2(xml: &str) -> Result<Fmu, String> {
-    let md = <Fmi2ModelDescription as FmiModelDescription>::deserialize(xml).map_err(|e| format!("modelDescription.xml (FMI 2.0): {}", first_line(&e.to_string())))?;
-    let Some(cs) = &md.co_simulation else { return Err(no_cs(md.model_exchange.is_some())) };
+    let md = <Fmi2ModelDescription as FmiModelDescription>::deserialize(xml).map_err(|e| {
+        format!(
+            "modelDescription.xml (FMI 2.0): {}",
+            first_line(&e.to_string())
+        )
+    })?;
+    let Some(cs) = &md.co_simulation else {
+        return Err(no_cs(md.model_exchange.is_some()));
+    };
     let mut vars = BTreeMap::new();
     for v in md.get_model_variables() {
         let causality = match v.causality {
@@ -232,7 +290,10 @@ fn from_fmi2(xml: &str) -> Result<Fmu, String> {
             ScalarVariableElement::String => Type::Other("String"),
             ScalarVariableElement::Enumeration => Type::Other("Enumeration"),
         };
-        let initial = v.initial.as_ref().map(|i| matches!(i, I2::Exact | I2::Approx));
+        let initial = v
+            .initial
+            .as_ref()
+            .map(|i| matches!(i, I2::Exact | I2::Approx));
         vars.insert(
             v.name.clone(),
             Var {
@@ -253,12 +314,22 @@ fn from_fmi2(xml: &str) -> Result<Fmu, String> {
 }
 
 fn from_fmi3(xml: &str) -> Result<Fmu, String> {
-    let md = <Fmi3ModelDescription as FmiModelDescription>::deserialize(xml).map_err(|e| format!("modelDescription.xml (FMI 3.0): {}", first_line(&e.to_string())))?;
-    let Some(cs) = &md.co_simulation else { return Err(no_cs(md.model_exchange.is_some())) };
+    let md = <Fmi3ModelDescription as FmiModelDescription>::deserialize(xml).map_err(|e| {
+        format!(
+            "modelDescription.xml (FMI 3.0): {}",
+            first_line(&e.to_string())
+        )
+    })?;
+    let Some(cs) = &md.co_simulation else {
+        return Err(no_cs(md.model_exchange.is_some()));
+    };
     let mut vars = BTreeMap::new();
     for v in &md.model_variables.variables {
         // Its type, and the variable as the traits every kind shares (a Clock has no dimensions).
-        fn of<T: ArrayableVariableTrait>(ty: Type, x: &T) -> (Type, &dyn AbstractVariableTrait, bool) {
+        fn of<T: ArrayableVariableTrait>(
+            ty: Type,
+            x: &T,
+        ) -> (Type, &dyn AbstractVariableTrait, bool) {
             (ty, x, !x.dimensions().is_empty())
         }
         let (ty, a, array) = match v {

@@ -32,47 +32,77 @@ pub struct Map {
 /// The FMU at `p.path`, its map resolved.
 pub fn resolve(p: &Params) -> Result<(Fmu, Map), String> {
     let fmu = archive::read(Path::new(&p.path))?;
-    let file = Path::new(&p.path).file_name().map_or(p.path.clone(), |f| f.to_string_lossy().into_owned());
+    let file = Path::new(&p.path)
+        .file_name()
+        .map_or(p.path.clone(), |f| f.to_string_lossy().into_owned());
     let find = |field: String, name: &str, ok: &[Causality], role: &str| -> Result<&Var, String> {
         let Some(v) = fmu.vars.get(name) else {
             let hint = scenario::suggest::did_you_mean(name, fmu.vars.keys().map(String::as_str));
-            return Err(format!("{field}: {file} has no variable named {}{hint}", scenario::untrusted::quoted(name)));
+            return Err(format!(
+                "{field}: {file} has no variable named {}{hint}",
+                scenario::untrusted::quoted(name)
+            ));
         };
         if !ok.contains(&v.causality) {
-            return Err(format!("{field}: '{name}' of {file} is {}, not {role}", v.causality.name()));
+            return Err(format!(
+                "{field}: '{name}' of {file} is {}, not {role}",
+                v.causality.name()
+            ));
         }
         if v.array {
-            return Err(format!("{field}: '{name}' of {file} is an array variable; the plant exchanges scalars"));
+            return Err(format!(
+                "{field}: '{name}' of {file} is an array variable; the plant exchanges scalars"
+            ));
         }
         Ok(v)
     };
     let real = |field: String, name: &str, ok: &[Causality], role: &str| -> Result<u32, String> {
         let v = find(field.clone(), name, ok, role)?;
         if v.ty != Type::Real {
-            return Err(format!("{field}: '{name}' of {file} is of type {}, not {}", v.ty.name(fmu.version), Type::Real.name(fmu.version)));
+            return Err(format!(
+                "{field}: '{name}' of {file} is of type {}, not {}",
+                v.ty.name(fmu.version),
+                Type::Real.name(fmu.version)
+            ));
         }
         Ok(v.vr)
     };
-    let list = |key: &str, names: &[String], ok: &[Causality], role: &str| -> Result<Vec<u32>, String> {
-        names.iter().enumerate().map(|(i, n)| real(format!("plant.fmu.{key}[{}]", i + 1), n, ok, role)).collect()
-    };
+    let list =
+        |key: &str, names: &[String], ok: &[Causality], role: &str| -> Result<Vec<u32>, String> {
+            names
+                .iter()
+                .enumerate()
+                .map(|(i, n)| real(format!("plant.fmu.{key}[{}]", i + 1), n, ok, role))
+                .collect()
+        };
     let input = [Causality::Input];
     let inputs = list("inputs", &p.inputs, &input, "an input")?;
     let disturbances = list("disturbances", &p.disturbances, &input, "an input")?;
     let outputs = list("outputs", &p.outputs, &[Causality::Output], "an output")?;
-    let states = list("states", &p.states, &[Causality::Output, Causality::Local], "an output or a local variable")?;
+    let states = list(
+        "states",
+        &p.states,
+        &[Causality::Output, Causality::Local],
+        "an output or a local variable",
+    )?;
     let mut parameters = Vec::new();
     for (name, value) in &p.parameters {
         let field = format!("plant.fmu.parameters.{name}");
         let v = find(field.clone(), name, &[Causality::Parameter], "a parameter")?;
         let start = match (v.ty, value) {
             (Type::Real, serde_json::Value::Number(x)) => x.as_f64().map(Start::Real),
-            (Type::Integer, serde_json::Value::Number(x)) => x.as_i64().and_then(|i| i32::try_from(i).ok()).map(Start::Integer),
+            (Type::Integer, serde_json::Value::Number(x)) => x
+                .as_i64()
+                .and_then(|i| i32::try_from(i).ok())
+                .map(Start::Integer),
             (Type::Boolean, serde_json::Value::Bool(b)) => Some(Start::Boolean(*b)),
             _ => None,
         };
         let Some(start) = start else {
-            return Err(format!("{field}: '{name}' of {file} is of type {}; {value} is not a value of it", v.ty.name(fmu.version)));
+            return Err(format!(
+                "{field}: '{name}' of {file} is of type {}; {value} is not a value of it",
+                v.ty.name(fmu.version)
+            ));
         };
         parameters.push((v.vr, start));
     }
@@ -90,7 +120,9 @@ pub fn resolve(p: &Params) -> Result<(Fmu, Map), String> {
         x0.push((v.vr, value));
     }
     let python = match &fmu.python {
-        Some(symbol) => Some(crate::python::find(symbol).map_err(|e| format!("plant.fmu.path: {file}: {e}"))?),
+        Some(symbol) => {
+            Some(crate::python::find(symbol).map_err(|e| format!("plant.fmu.path: {file}: {e}"))?)
+        }
         None => None,
     };
     Ok((
@@ -109,5 +141,9 @@ pub fn resolve(p: &Params) -> Result<(Fmu, Map), String> {
 
 /// `fmu_plant --check`: the map (the plant's `params`) on stdin; exit 0, or 2 with one line.
 pub fn main() -> std::process::ExitCode {
-    crate::request::answer(crate::request::read::<Params>("params").and_then(|p| resolve(&p)).map(|_| None))
+    crate::request::answer(
+        crate::request::read::<Params>("params")
+            .and_then(|p| resolve(&p))
+            .map(|_| None),
+    )
 }

@@ -28,12 +28,24 @@ pub fn fatal() -> bool {
 
 unsafe extern "C" {
     /// c/fmi2_logger.c: formats the message and calls [`uio_fmi2_log`].
-    fn uio_fmi2_logger(env: b::fmi2ComponentEnvironment, instance: b::fmi2String, status: b::fmi2Status, category: b::fmi2String, message: b::fmi2String, ...);
+    fn uio_fmi2_logger(
+        env: b::fmi2ComponentEnvironment,
+        instance: b::fmi2String,
+        status: b::fmi2Status,
+        category: b::fmi2String,
+        message: b::fmi2String,
+        ...
+    );
 }
 
 /// What c/fmi2_logger.c hands over: one formatted message. Any pointer may be NULL.
 #[unsafe(no_mangle)]
-extern "C" fn uio_fmi2_log(instance: *const c_char, status: std::ffi::c_int, category: *const c_char, text: *const c_char) {
+extern "C" fn uio_fmi2_log(
+    instance: *const c_char,
+    status: std::ffi::c_int,
+    category: *const c_char,
+    text: *const c_char,
+) {
     // SAFETY: each is NULL or a NUL-terminated string that lives for this call.
     let s = |p: *const c_char| {
         if p.is_null() {
@@ -78,8 +90,14 @@ impl Cs2 {
     /// fmi2Instantiate for co-simulation, logging on.
     pub fn instantiate(import: &Fmi2Import, name: &str) -> Result<Self, String> {
         let md = import.model_description();
-        let id = md.co_simulation.as_ref().map(|cs| cs.model_identifier.clone()).ok_or("no co-simulation interface")?;
-        let bind = import.binding(&id).map_err(|e| format!("cannot load the library: {e}"))?;
+        let id = md
+            .co_simulation
+            .as_ref()
+            .map(|cs| cs.model_identifier.clone())
+            .ok_or("no co-simulation interface")?;
+        let bind = import
+            .binding(&id)
+            .map_err(|e| format!("cannot load the library: {e}"))?;
         let callbacks = Box::new(b::fmi2CallbackFunctions {
             logger: Some(uio_fmi2_logger),
             allocateMemory: Some(libc::calloc),
@@ -88,9 +106,23 @@ impl Cs2 {
             componentEnvironment: std::ptr::null_mut(),
         });
         let cstr = |s: &str| CString::new(s).map_err(|_| format!("'{s}' holds a NUL byte"));
-        let (name_c, guid, resources) = (cstr(name)?, cstr(&md.guid)?, cstr(&import.canonical_resource_path_string())?);
+        let (name_c, guid, resources) = (
+            cstr(name)?,
+            cstr(&md.guid)?,
+            cstr(&import.canonical_resource_path_string())?,
+        );
         // SAFETY: valid C strings and a callbacks struct that outlives the instance.
-        let c = unsafe { bind.fmi2Instantiate(name_c.as_ptr(), b::fmi2Type_fmi2CoSimulation, guid.as_ptr(), resources.as_ptr(), &*callbacks, 0, 1) };
+        let c = unsafe {
+            bind.fmi2Instantiate(
+                name_c.as_ptr(),
+                b::fmi2Type_fmi2CoSimulation,
+                guid.as_ptr(),
+                resources.as_ptr(),
+                &*callbacks,
+                0,
+                1,
+            )
+        };
         if c.is_null() {
             return Err(format!("fmi2Instantiate failed{}", log_capture::take()));
         }
@@ -110,7 +142,11 @@ impl Cs2 {
             self.fatal = true;
             FATAL.store(true, std::sync::atomic::Ordering::Relaxed);
         }
-        Err(format!("{call} at t = {t} returned {}{}", status_name(s), log_capture::take()))
+        Err(format!(
+            "{call} at t = {t} returned {}{}",
+            status_name(s),
+            log_capture::take()
+        ))
     }
 
     pub fn setup_experiment(&mut self, start: f64) -> Result<(), String> {
@@ -131,25 +167,37 @@ impl Cs2 {
 
     pub fn set_real(&mut self, vrs: &[u32], values: &[f64], t: f64) -> Result<(), String> {
         assert_eq!(vrs.len(), values.len());
-        let s = unsafe { self.bind.fmi2SetReal(self.c, vrs.as_ptr(), vrs.len(), values.as_ptr()) };
+        let s = unsafe {
+            self.bind
+                .fmi2SetReal(self.c, vrs.as_ptr(), vrs.len(), values.as_ptr())
+        };
         self.check("fmi2SetReal", t, s)
     }
 
     pub fn set_integer(&mut self, vrs: &[u32], values: &[i32], t: f64) -> Result<(), String> {
         assert_eq!(vrs.len(), values.len());
-        let s = unsafe { self.bind.fmi2SetInteger(self.c, vrs.as_ptr(), vrs.len(), values.as_ptr()) };
+        let s = unsafe {
+            self.bind
+                .fmi2SetInteger(self.c, vrs.as_ptr(), vrs.len(), values.as_ptr())
+        };
         self.check("fmi2SetInteger", t, s)
     }
 
     pub fn set_boolean(&mut self, vrs: &[u32], values: &[i32], t: f64) -> Result<(), String> {
         assert_eq!(vrs.len(), values.len());
-        let s = unsafe { self.bind.fmi2SetBoolean(self.c, vrs.as_ptr(), vrs.len(), values.as_ptr()) };
+        let s = unsafe {
+            self.bind
+                .fmi2SetBoolean(self.c, vrs.as_ptr(), vrs.len(), values.as_ptr())
+        };
         self.check("fmi2SetBoolean", t, s)
     }
 
     pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64], t: f64) -> Result<(), String> {
         assert_eq!(vrs.len(), out.len());
-        let s = unsafe { self.bind.fmi2GetReal(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) };
+        let s = unsafe {
+            self.bind
+                .fmi2GetReal(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
+        };
         self.check("fmi2GetReal", t, s)
     }
 

@@ -34,7 +34,12 @@ impl log::Log for Capture {
 /// Keeps one message of the FMU (instance `instance`); a warning or an error also goes to
 /// stderr at once.
 pub fn record(instance: &str, level: log::Level, category: &str, text: &str) {
-    let line = text.lines().map(str::trim).filter(|l| !l.is_empty()).collect::<Vec<_>>().join(" / ");
+    let line = text
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join(" / ");
     if line.is_empty() {
         return;
     }
@@ -44,8 +49,15 @@ pub fn record(instance: &str, level: log::Level, category: &str, text: &str) {
     let (instance, category) = (one_line_capped(instance), one_line_capped(category));
     let (instance, category) = (instance.as_str(), category.as_str());
     if level <= log::Level::Warn {
-        let category = if category.is_empty() { String::new() } else { format!(", {category}") };
-        eprintln!("FMU {instance} ({}{category}): {line}", level.as_str().to_lowercase());
+        let category = if category.is_empty() {
+            String::new()
+        } else {
+            format!(", {category}")
+        };
+        eprintln!(
+            "FMU {instance} ({}{category}): {line}",
+            level.as_str().to_lowercase()
+        );
     }
     if let Ok(mut last) = LAST.lock() {
         if last.len() == KEPT {
@@ -66,8 +78,15 @@ pub fn install() {
 /// Takes what the FMU logged since the last take, if anything: ": <m1> | <m2>", ready to
 /// append.
 pub fn take() -> String {
-    let last: Vec<String> = LAST.lock().map(|mut l| l.drain(..).collect()).unwrap_or_default();
-    if last.is_empty() { String::new() } else { format!(": the FMU logged: {}", last.join(" | ")) }
+    let last: Vec<String> = LAST
+        .lock()
+        .map(|mut l| l.drain(..).collect())
+        .unwrap_or_default();
+    if last.is_empty() {
+        String::new()
+    } else {
+        format!(": the FMU logged: {}", last.join(" | "))
+    }
 }
 
 /// The longest FMU log line kept or shown, characters.
@@ -89,12 +108,24 @@ mod tests {
 
     #[test]
     fn an_fmus_log_text_cannot_forge_a_line_or_flood_the_message() {
-        record("inst\rfake", log::Level::Info, "", "ok\rerror: forged\x1b[2K\u{202e}x\nsecond line");
+        record(
+            "inst\rfake",
+            log::Level::Info,
+            "",
+            "ok\rerror: forged\x1b[2K\u{202e}x\nsecond line",
+        );
         let got = take();
         assert!(!got.contains(['\r', '\n', '\x1b', '\u{202e}']), "{got:?}");
-        assert!(got.contains("second line") && got.contains("forged"), "{got}");
+        assert!(
+            got.contains("second line") && got.contains("forged"),
+            "{got}"
+        );
         record("i", log::Level::Info, "", &"y".repeat(5_000_000));
         let got = take();
-        assert!(got.len() < 1100 && got.ends_with("(5000000 characters)"), "{}", got.len());
+        assert!(
+            got.len() < 1100 && got.ends_with("(5000000 characters)"),
+            "{}",
+            got.len()
+        );
     }
 }

@@ -24,7 +24,8 @@ fn main() -> std::process::ExitCode {
         Some("--linearize") => return linearize::main(),
         _ => {}
     }
-    let code = lockstep::component::exit_status::<plant::FmuPlant>("fmu_plant", std::env::args().skip(1));
+    let code =
+        lockstep::component::exit_status::<plant::FmuPlant>("fmu_plant", std::env::args().skip(1));
     end(code)
 }
 

@@ -11,14 +11,14 @@
 //! as for the built-in plant, u and w are zero-order held over the step: an FMU sees its
 //! inputs piecewise constant (a sine w enters as its samples).
 
-use lockstep::component::{Component, ComponentConfig, Inputs, StepError};
 use lockstep::PlantLayout;
-use lti::kernel::mul_acc;
+use lockstep::component::{Component, ComponentConfig, Inputs, StepError};
 use lti::Mat;
+use lti::kernel::mul_acc;
 use plant::shell::EXIT_DIVERGED;
 use plant::{PlantConfig, Sensing};
 
-use crate::check::{resolve, Map};
+use crate::check::{Map, resolve};
 use crate::params::Params;
 use crate::slave::{Archive, Slave};
 
@@ -64,12 +64,39 @@ impl Component for FmuPlant {
         let (fmu, map) = resolve(&p)?;
         let s = PlantConfig::from_protocol(cfg)?;
         let d: Mat = (&s.d).into();
-        let lay = PlantLayout { n: s.a.rows, p: s.c.rows, q: s.e.cols, r: s.d.cols, l: s.b.cols, f: s.faults.len() };
-        if (map.states.len(), map.outputs.len(), map.inputs.len(), map.disturbances.len()) != (lay.n, lay.p, lay.l, lay.q) {
-            return Err(format!("the map has {} states, {} outputs, {} inputs, {} disturbances; the model n = {}, p = {}, l = {}, q = {}", map.states.len(), map.outputs.len(), map.inputs.len(), map.disturbances.len(), lay.n, lay.p, lay.l, lay.q));
+        let lay = PlantLayout {
+            n: s.a.rows,
+            p: s.c.rows,
+            q: s.e.cols,
+            r: s.d.cols,
+            l: s.b.cols,
+            f: s.faults.len(),
+        };
+        if (
+            map.states.len(),
+            map.outputs.len(),
+            map.inputs.len(),
+            map.disturbances.len(),
+        ) != (lay.n, lay.p, lay.l, lay.q)
+        {
+            return Err(format!(
+                "the map has {} states, {} outputs, {} inputs, {} disturbances; the model n = {}, p = {}, l = {}, q = {}",
+                map.states.len(),
+                map.outputs.len(),
+                map.inputs.len(),
+                map.disturbances.len(),
+                lay.n,
+                lay.p,
+                lay.l,
+                lay.q
+            ));
         }
-        let file = std::path::Path::new(&p.path).file_name().map_or(p.path.clone(), |f| f.to_string_lossy().into_owned());
-        let slave = Archive::open(&p.path, fmu.version, map.python.as_ref()).and_then(|a| a.start(&cfg.name, &map.parameters, &map.x0)).map_err(|e| format!("{file}: {e}"))?;
+        let file = std::path::Path::new(&p.path)
+            .file_name()
+            .map_or(p.path.clone(), |f| f.to_string_lossy().into_owned());
+        let slave = Archive::open(&p.path, fmu.version, map.python.as_ref())
+            .and_then(|a| a.start(&cfg.name, &map.parameters, &map.x0))
+            .map_err(|e| format!("{file}: {e}"))?;
         Ok(FmuPlant {
             slave,
             map,
@@ -96,8 +123,12 @@ impl Component for FmuPlant {
                 Some(i) => inputs.get(i),
                 None => &self.r,
             });
-            self.sensing.actuate(k - 1, &self.u, &mut self.u_applied, true);
-            let r = self.slave.set(&self.map.inputs, &self.u_applied, t).and_then(|_| self.slave.set(&self.map.disturbances, &self.w, t));
+            self.sensing
+                .actuate(k - 1, &self.u, &mut self.u_applied, true);
+            let r = self
+                .slave
+                .set(&self.map.inputs, &self.u_applied, t)
+                .and_then(|_| self.slave.set(&self.map.disturbances, &self.w, t));
             r.map_err(|e| self.fail(e))?;
             let h = dt / self.substeps as f64;
             for j in 0..self.substeps {
@@ -106,17 +137,28 @@ impl Component for FmuPlant {
             }
         }
         let (lay, t) = (self.lay, k as f64 * dt);
-        let r = self.slave.get(&self.map.states, &mut out[lay.x()], t).and_then(|_| self.slave.get(&self.map.outputs, &mut out[lay.y()], t));
+        let r = self
+            .slave
+            .get(&self.map.states, &mut out[lay.x()], t)
+            .and_then(|_| self.slave.get(&self.map.outputs, &mut out[lay.y()], t));
         r.map_err(|e| self.fail(e))?;
         if k > 0
-            && let Some(i) = out[lay.x()].iter().position(|v| !v.is_finite() || v.abs() > self.s.state_bound)
+            && let Some(i) = out[lay.x()]
+                .iter()
+                .position(|v| !v.is_finite() || v.abs() > self.s.state_bound)
         {
-            return Err(StepError { code: EXIT_DIVERGED, message: format!("diverged: x{} = {} at step {k}", i + 1, out[i]) });
+            return Err(StepError {
+                code: EXIT_DIVERGED,
+                message: format!("diverged: x{} = {} at step {k}", i + 1, out[i]),
+            });
         }
         for (o, s) in out[lay.w()].iter_mut().zip(&self.s.disturbances) {
             *o = s.sample_step(k, dt);
         }
-        for (o, s) in out[lay.v()].iter_mut().zip(&self.s.measurement_disturbances) {
+        for (o, s) in out[lay.v()]
+            .iter_mut()
+            .zip(&self.s.measurement_disturbances)
+        {
             *o = s.sample_step(k, dt);
         }
         for (o, s) in out[lay.r()].iter_mut().zip(&self.s.inputs) {
@@ -128,7 +170,11 @@ impl Component for FmuPlant {
         // y = (the FMU's y) + D v, then noise and sensor faults, as the built-in plant measures.
         let (head, tail) = out.split_at_mut(lay.w().start);
         let y = &mut head[lay.y()];
-        mul_acc(y, &self.d, &tail[lay.v().start - lay.w().start..lay.v().end - lay.w().start]);
+        mul_acc(
+            y,
+            &self.d,
+            &tail[lay.v().start - lay.w().start..lay.v().end - lay.w().start],
+        );
         let slots = lay.faults().start - lay.w().start;
         self.sensing.sense(k, y, &mut tail[slots..]);
         Ok(())

@@ -36,7 +36,9 @@ pub struct Python {
 /// The `python3` on PATH as a host for an FMU whose library needs `symbol`; the refusal names
 /// what is missing.
 pub fn find(symbol: &str) -> Result<Python, String> {
-    let why = |what: String| format!("its library embeds Python (it needs {symbol} from libpython): {what}");
+    let why = |what: String| {
+        format!("its library embeds Python (it needs {symbol} from libpython): {what}")
+    };
     const ASK: &str = "import os, sys, sysconfig\n\
         d, so = sysconfig.get_config_var('LIBDIR') or '', sysconfig.get_config_var('INSTSONAME') or ''\n\
         print(os.path.join(d, so) if so and '.so' in so else '')\n\
@@ -47,16 +49,27 @@ pub fn find(symbol: &str) -> Result<Python, String> {
         .output()
         .map_err(|e| why(format!("no python3 on PATH ({e})")))?;
     if !out.status.success() {
-        return Err(why(format!("python3 failed: {}", String::from_utf8_lossy(&out.stderr).lines().last().unwrap_or(""))));
+        return Err(why(format!(
+            "python3 failed: {}",
+            String::from_utf8_lossy(&out.stderr)
+                .lines()
+                .last()
+                .unwrap_or("")
+        )));
     }
     let text = String::from_utf8_lossy(&out.stdout);
     let mut lines = text.lines();
-    let (library, path) = (lines.next().unwrap_or("").to_string(), lines.next().unwrap_or("").to_string());
+    let (library, path) = (
+        lines.next().unwrap_or("").to_string(),
+        lines.next().unwrap_or("").to_string(),
+    );
     if library.is_empty() {
         return Err(why("the python3 on PATH was built without a shared libpython (sysconfig INSTSONAME is not a .so)".into()));
     }
     if !std::path::Path::new(&library).is_file() {
-        return Err(why(format!("the python3 on PATH names {library}, which is not there (Debian: the libpython3.X package)")));
+        return Err(why(format!(
+            "the python3 on PATH names {library}, which is not there (Debian: the libpython3.X package)"
+        )));
     }
     Ok(Python { library, path })
 }
@@ -72,7 +85,8 @@ pub fn loaded() -> bool {
 /// interpreter. Call before the FMU's library is loaded, while the process has one thread
 /// (it sets an environment variable).
 pub fn load(py: &Python) -> Result<(), String> {
-    let name = CString::new(py.library.as_str()).map_err(|_| format!("{}: a path with a NUL byte", py.library))?;
+    let name = CString::new(py.library.as_str())
+        .map_err(|_| format!("{}: a path with a NUL byte", py.library))?;
     // SAFETY: dlopen with a valid C string; the handle is kept for the life of the process
     // (never closed: the FMU's library refers to its symbols until the process ends).
     let handle = unsafe { libc::dlopen(name.as_ptr(), libc::RTLD_NOW | libc::RTLD_GLOBAL) };
@@ -82,7 +96,9 @@ pub fn load(py: &Python) -> Result<(), String> {
         let msg = if e.is_null() {
             "unknown error".to_string()
         } else {
-            unsafe { std::ffi::CStr::from_ptr(e) }.to_string_lossy().into_owned()
+            unsafe { std::ffi::CStr::from_ptr(e) }
+                .to_string_lossy()
+                .into_owned()
         };
         return Err(format!("cannot load {}: {msg}", py.library));
     }

@@ -25,7 +25,11 @@ pub enum Archive {
 impl Archive {
     /// Extracts the FMU at `path`; an FMU whose library embeds Python gets `python` loaded
     /// first.
-    pub fn open(path: &str, version: Version, python: Option<&crate::python::Python>) -> Result<Self, String> {
+    pub fn open(
+        path: &str,
+        version: Version,
+        python: Option<&crate::python::Python>,
+    ) -> Result<Self, String> {
         log_capture::install();
         if let Some(py) = python {
             crate::python::load(py)?;
@@ -33,23 +37,45 @@ impl Archive {
         let cannot = |e: fmi::Error| format!("cannot extract: {e}");
         Ok(match version {
             Version::Two => Archive::Two(Rc::new(fmi::import::from_path(path).map_err(cannot)?)),
-            Version::Three => Archive::Three(Rc::new(fmi::import::from_path(path).map_err(cannot)?)),
+            Version::Three => {
+                Archive::Three(Rc::new(fmi::import::from_path(path).map_err(cannot)?))
+            }
         })
     }
 
     /// Instantiates the FMU for co-simulation, sets the parameters' and the states' start
     /// values (`x0`, may be empty) and initialises it at t = 0.
-    pub fn start(&self, name: &str, parameters: &[(u32, Start)], x0: &[(u32, f64)]) -> Result<Slave, String> {
+    pub fn start(
+        &self,
+        name: &str,
+        parameters: &[(u32, Start)],
+        x0: &[(u32, f64)],
+    ) -> Result<Slave, String> {
         let mut s = match self {
-            Archive::Two(import) => Slave::Two { inst: Cs2::instantiate(import, name)?, _import: import.clone() },
+            Archive::Two(import) => Slave::Two {
+                inst: Cs2::instantiate(import, name)?,
+                _import: import.clone(),
+            },
             Archive::Three(import) => {
                 let inst = import
                     .instantiate_cs(name, false, true, false, false, &[])
-                    .map_err(|e| format!("fmi3InstantiateCoSimulation failed ({e}){}", log_capture::take()))?;
-                Slave::Three { inst, _import: import.clone() }
+                    .map_err(|e| {
+                        format!(
+                            "fmi3InstantiateCoSimulation failed ({e}){}",
+                            log_capture::take()
+                        )
+                    })?;
+                Slave::Three {
+                    inst,
+                    _import: import.clone(),
+                }
             }
         };
-        let starts: Vec<(u32, Start)> = parameters.iter().cloned().chain(x0.iter().map(|&(vr, x)| (vr, Start::Real(x)))).collect();
+        let starts: Vec<(u32, Start)> = parameters
+            .iter()
+            .cloned()
+            .chain(x0.iter().map(|&(vr, x)| (vr, Start::Real(x))))
+            .collect();
         s.initialise(&starts)?;
         Ok(s)
     }
@@ -64,7 +90,10 @@ pub enum Slave {
 }
 
 fn failed(call: &str, t: f64, status: impl std::fmt::Debug) -> String {
-    format!("{call} at t = {t} returned {status:?}{}", log_capture::take())
+    format!(
+        "{call} at t = {t} returned {status:?}{}",
+        log_capture::take()
+    )
 }
 
 impl Slave {
@@ -92,8 +121,10 @@ impl Slave {
                     }
                     .map_err(|e| failed("setting a start value", 0.0, e))?;
                 }
-                i.enter_initialization_mode(None, 0.0, None).map_err(|e| failed("fmi3EnterInitializationMode", 0.0, e))?;
-                i.exit_initialization_mode().map_err(|e| failed("fmi3ExitInitializationMode", 0.0, e))?;
+                i.enter_initialization_mode(None, 0.0, None)
+                    .map_err(|e| failed("fmi3EnterInitializationMode", 0.0, e))?;
+                i.exit_initialization_mode()
+                    .map_err(|e| failed("fmi3ExitInitializationMode", 0.0, e))?;
             }
         }
         Ok(())
@@ -106,7 +137,10 @@ impl Slave {
         }
         match self {
             Slave::Two { inst: i, .. } => i.set_real(vrs, values, t),
-            Slave::Three { inst: i, .. } => i.set_float64(vrs, values).map(drop).map_err(|e| failed("fmi3SetFloat64", t, e)),
+            Slave::Three { inst: i, .. } => i
+                .set_float64(vrs, values)
+                .map(drop)
+                .map_err(|e| failed("fmi3SetFloat64", t, e)),
         }
     }
 
@@ -117,7 +151,10 @@ impl Slave {
         }
         match self {
             Slave::Two { inst: i, .. } => i.get_real(vrs, out, t),
-            Slave::Three { inst: i, .. } => i.get_float64(vrs, out).map(drop).map_err(|e| failed("fmi3GetFloat64", t, e)),
+            Slave::Three { inst: i, .. } => i
+                .get_float64(vrs, out)
+                .map(drop)
+                .map_err(|e| failed("fmi3GetFloat64", t, e)),
         }
     }
 
@@ -127,12 +164,26 @@ impl Slave {
             Slave::Two { inst: i, .. } => i.do_step(t, h),
             Slave::Three { inst: i, .. } => {
                 let (mut event, mut terminate, mut early, mut last) = (false, false, false, t);
-                i.do_step(t, h, true, &mut event, &mut terminate, &mut early, &mut last).map_err(|e| failed("fmi3DoStep", t, e))?;
+                i.do_step(
+                    t,
+                    h,
+                    true,
+                    &mut event,
+                    &mut terminate,
+                    &mut early,
+                    &mut last,
+                )
+                .map_err(|e| failed("fmi3DoStep", t, e))?;
                 if terminate {
-                    return Err(format!("fmi3DoStep at t = {t} asked to terminate the simulation{}", log_capture::take()));
+                    return Err(format!(
+                        "fmi3DoStep at t = {t} asked to terminate the simulation{}",
+                        log_capture::take()
+                    ));
                 }
                 if early {
-                    return Err(format!("fmi3DoStep at t = {t} returned early at t = {last}: intermediate updates are not supported"));
+                    return Err(format!(
+                        "fmi3DoStep at t = {t} returned early at t = {last}: intermediate updates are not supported"
+                    ));
                 }
                 Ok(())
             }

@@ -11,8 +11,8 @@ use std::os::unix::process::CommandExt;
 use std::process::{Command, Stdio};
 use std::time::Instant;
 
-use lockstep::{die_with_parent, ready_then_wait_for_go, Bus, RunSpace, Wait};
-use recording::write::{histogram, Latency, Percentiles};
+use lockstep::{Bus, RunSpace, Wait, die_with_parent, ready_then_wait_for_go};
+use recording::write::{Latency, Percentiles, histogram};
 use serde::{Deserialize, Serialize};
 
 use crate::error::LaunchError;
@@ -29,7 +29,13 @@ pub struct FloorLoop {
 const TOPICS: [&str; 3] = ["floor/plant", "floor/observer", "floor/controller"];
 
 /// One node of the ring (the hidden `launcher floor-node` command).
-pub fn node(run: &str, index: usize, steps: u64, lens: [usize; 3], wait: Wait) -> Result<(), String> {
+pub fn node(
+    run: &str,
+    index: usize,
+    steps: u64,
+    lens: [usize; 3],
+    wait: Wait,
+) -> Result<(), String> {
     die_with_parent();
     let e = |x: lockstep::LockstepError| x.to_string();
     let space = RunSpace::open(run).map_err(e)?;
@@ -55,7 +61,10 @@ pub fn node(run: &str, index: usize, steps: u64, lens: [usize; 3], wait: Wait) -
         let _ = hist.record(h.received_ns.saturating_sub(sent).max(1));
     }
     let wall = start.elapsed().as_secs_f64();
-    let out = FloorLoop { loop_steps_per_s: steps as f64 / wall.max(1e-9), step_ns: Latency::percentiles(&hist) };
+    let out = FloorLoop {
+        loop_steps_per_s: steps as f64 / wall.max(1e-9),
+        step_ns: Latency::percentiles(&hist),
+    };
     println!("{}", serde_json::to_string(&out).expect("serialises"));
     Ok(())
 }
@@ -80,8 +89,14 @@ pub fn floor(steps: u64, lens: [usize; 3], wait: Wait, pin: bool) -> Result<Floo
     let result = (|| {
         for (i, &cpu) in cpus.iter().enumerate() {
             let mut c = Command::new(&exe);
-            c.arg("floor-node").arg(space.id()).args([i.to_string(), steps.to_string()]).args(lens.map(|l| l.to_string())).arg(wait.to_string());
-            c.stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::inherit());
+            c.arg("floor-node")
+                .arg(space.id())
+                .args([i.to_string(), steps.to_string()])
+                .args(lens.map(|l| l.to_string()))
+                .arg(wait.to_string());
+            c.stdin(Stdio::piped())
+                .stdout(Stdio::piped())
+                .stderr(Stdio::inherit());
             // Placed as the run's ring is (the plant on a CPU of its own).
             if let Some(cpu) = cpu {
                 // SAFETY: the closure only calls sched_setaffinity (async-signal-safe).
@@ -92,9 +107,15 @@ pub fn floor(steps: u64, lens: [usize; 3], wait: Wait, pin: bool) -> Result<Floo
                     })
                 };
             }
-            children.push(c.spawn().map_err(|x| fail(format!("{}: {x}", exe.display())))?);
+            children.push(
+                c.spawn()
+                    .map_err(|x| fail(format!("{}: {x}", exe.display())))?,
+            );
         }
-        let mut outs: Vec<BufReader<_>> = children.iter_mut().map(|c| BufReader::new(c.stdout.take().expect("piped"))).collect();
+        let mut outs: Vec<BufReader<_>> = children
+            .iter_mut()
+            .map(|c| BufReader::new(c.stdout.take().expect("piped")))
+            .collect();
         for (i, o) in outs.iter_mut().enumerate() {
             let mut line = String::new();
             o.read_line(&mut line).map_err(|x| fail(x.to_string()))?;
@@ -104,11 +125,17 @@ pub fn floor(steps: u64, lens: [usize; 3], wait: Wait, pin: bool) -> Result<Floo
         }
         for c in &mut children {
             let stdin = c.stdin.as_mut().expect("piped");
-            stdin.write_all(b"go\n").and_then(|_| stdin.flush()).map_err(|x| fail(x.to_string()))?;
+            stdin
+                .write_all(b"go\n")
+                .and_then(|_| stdin.flush())
+                .map_err(|x| fail(x.to_string()))?;
         }
         let mut line = String::new();
-        outs[0].read_line(&mut line).map_err(|x| fail(x.to_string()))?;
-        let inner: FloorLoop = serde_json::from_str(line.trim()).map_err(|x| fail(format!("node 0 said {line:?}: {x}")))?;
+        outs[0]
+            .read_line(&mut line)
+            .map_err(|x| fail(x.to_string()))?;
+        let inner: FloorLoop = serde_json::from_str(line.trim())
+            .map_err(|x| fail(format!("node 0 said {line:?}: {x}")))?;
         for (i, c) in children.iter_mut().enumerate() {
             let status = c.wait().map_err(|x| fail(x.to_string()))?;
             if !status.success() {
@@ -124,5 +151,8 @@ pub fn floor(steps: u64, lens: [usize; 3], wait: Wait, pin: bool) -> Result<Floo
     let wall = start.elapsed().as_secs_f64();
     space.remove();
     let inner = result?;
-    Ok(Floor { steps_per_s: steps as f64 / wall.max(1e-9), inner })
+    Ok(Floor {
+        steps_per_s: steps as f64 / wall.max(1e-9),
+        inner,
+    })
 }

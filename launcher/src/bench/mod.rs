@@ -14,8 +14,8 @@ use serde::Serialize;
 
 use crate::error::LaunchError;
 use crate::plan::plan;
+use crate::run::{Mode, Options, Stop, run};
 use recording::write::Percentiles;
-use crate::run::{run, Mode, Options, Stop};
 use scenario::Scenario;
 
 /// One benchmark run.
@@ -34,7 +34,15 @@ pub struct BenchRun {
 }
 
 /// Runs the benchmark on `scenario` (seed002-sine) for `steps` steps, `repeat` times over.
-pub fn bench(scenario: &Path, steps: u64, wait: Wait, pin: bool, modes: &[Mode], recording: &[bool], repeat: usize) -> Result<Vec<BenchRun>, LaunchError> {
+pub fn bench(
+    scenario: &Path,
+    steps: u64,
+    wait: Wait,
+    pin: bool,
+    modes: &[Mode],
+    recording: &[bool],
+    repeat: usize,
+) -> Result<Vec<BenchRun>, LaunchError> {
     let mut s = Scenario::load(scenario)?;
     s.steps = steps;
     s.duration = steps as f64 * s.dt;
@@ -46,7 +54,13 @@ pub fn bench(scenario: &Path, steps: u64, wait: Wait, pin: bool, modes: &[Mode],
     for _ in 0..repeat.max(1) {
         if modes.contains(&Mode::Processes) {
             let f = floor::floor(steps, [lay.len(), lay.n, lay.l], wait, pin)?;
-            out.push(BenchRun { mode: "floor".into(), recording: false, steps, steps_per_s: f.steps_per_s, step_ns: f.inner.step_ns });
+            out.push(BenchRun {
+                mode: "floor".into(),
+                recording: false,
+                steps,
+                steps_per_s: f.steps_per_s,
+                step_ns: f.inner.step_ns,
+            });
         }
         for &mode in modes {
             for &record in recording {
@@ -67,19 +81,38 @@ pub fn bench(scenario: &Path, steps: u64, wait: Wait, pin: bool, modes: &[Mode],
 
 /// One benchmark run of `s` (outputs overwritten in `tmp`, no progress bar, no pacing); a run
 /// that stops early is an error.
-pub(crate) fn measure(s: &Scenario, p: &crate::plan::Plan, tmp: &Path, mode: Mode, wait: Wait, record: bool, pin: bool) -> Result<crate::run::Outcome, LaunchError> {
-    let opts = Options { pin, ..Options::quiet(tmp, mode, wait, record) };
+pub(crate) fn measure(
+    s: &Scenario,
+    p: &crate::plan::Plan,
+    tmp: &Path,
+    mode: Mode,
+    wait: Wait,
+    record: bool,
+    pin: bool,
+) -> Result<crate::run::Outcome, LaunchError> {
+    let opts = Options {
+        pin,
+        ..Options::quiet(tmp, mode, wait, record)
+    };
     let o = run(s, p, &opts)?;
     if o.stop != Stop::Completed {
-        return Err(LaunchError::Component(format!("{}: benchmark run stopped: {:?}", s.name, o.stop)));
+        return Err(LaunchError::Component(format!(
+            "{}: benchmark run stopped: {:?}",
+            s.name, o.stop
+        )));
     }
     Ok(o)
 }
 
 /// The printed table.
 pub fn table(runs: &[BenchRun], wait: Wait) -> String {
-    let mut t = format!("seed002 closed loop (plant, 2 observers, controller), wait = {wait}; floor: bare 3-process ring, same transport and payloads\n");
-    t += &format!("{:<12} {:<10} {:>10} {:>14} {:>9} {:>9} {:>9} {:>9} {:>9}\n", "mode", "recording", "steps", "steps/s", "p50 µs", "p90 µs", "p99 µs", "p99.9 µs", "max µs");
+    let mut t = format!(
+        "seed002 closed loop (plant, 2 observers, controller), wait = {wait}; floor: bare 3-process ring, same transport and payloads\n"
+    );
+    t += &format!(
+        "{:<12} {:<10} {:>10} {:>14} {:>9} {:>9} {:>9} {:>9} {:>9}\n",
+        "mode", "recording", "steps", "steps/s", "p50 µs", "p90 µs", "p99 µs", "p99.9 µs", "max µs"
+    );
     for r in runs {
         let us = |ns: u64| format!("{:.2}", ns as f64 / 1000.0);
         t += &format!(
@@ -105,24 +138,53 @@ pub fn table(runs: &[BenchRun], wait: Wait) -> String {
 /// median over the repetitions and their range.
 fn sentence(name: &str, (min, median, max, n): (f64, f64, f64, usize)) -> String {
     let pct = |x: f64| format!("{:.1} %", 100.0 * x);
-    let over = format!("(median of {n} repetition(s); range {} – {})", pct(min), pct(max));
+    let over = format!(
+        "(median of {n} repetition(s); range {} – {})",
+        pct(min),
+        pct(max)
+    );
     let times = format!("(median of {n} repetition(s); range {min:.2} – {max:.2}×)");
-    let rec = |with: bool| if with { "with recording" } else { "without recording" };
+    let rec = |with: bool| {
+        if with {
+            "with recording"
+        } else {
+            "without recording"
+        }
+    };
     match name {
         "processes (no recording) / floor, steps/s" | "processes (recording) / floor, steps/s" => {
             let with = name.contains("(recording)");
-            format!("across processes {}, the lockstep ring makes {} of the steps per second of a bare iceoryx2 ring (the floor) {over}\n", rec(with), pct(median))
+            format!(
+                "across processes {}, the lockstep ring makes {} of the steps per second of a bare iceoryx2 ring (the floor) {over}\n",
+                rec(with),
+                pct(median)
+            )
         }
-        "processes (no recording) / floor, step p50" | "processes (recording) / floor, step p50" => {
+        "processes (no recording) / floor, step p50"
+        | "processes (recording) / floor, step p50" => {
             let with = name.contains("(recording)");
-            format!("across processes {}, a step's median time is {median:.2}× the floor's {times}\n", rec(with))
+            format!(
+                "across processes {}, a step's median time is {median:.2}× the floor's {times}\n",
+                rec(with)
+            )
         }
         "processes / in-process, steps/s (no recording)" => {
-            format!("without recording, running across processes makes {} of the steps per second of running in one process {over}\n", pct(median))
+            format!(
+                "without recording, running across processes makes {} of the steps per second of running in one process {over}\n",
+                pct(median)
+            )
         }
-        "in-process: share of steps/s recording costs" | "processes: share of steps/s recording costs" => {
-            let m = if name.starts_with("in-process") { "in one process" } else { "across processes" };
-            format!("{m}, recording costs {} of the steps per second a run makes without it {over}\n", pct(median))
+        "in-process: share of steps/s recording costs"
+        | "processes: share of steps/s recording costs" => {
+            let m = if name.starts_with("in-process") {
+                "in one process"
+            } else {
+                "across processes"
+            };
+            format!(
+                "{m}, recording costs {} of the steps per second a run makes without it {over}\n",
+                pct(median)
+            )
         }
         _ => format!("{name}: median {median:.3} [{min:.3} – {max:.3}] over {n} repetition(s)\n"),
     }
@@ -132,7 +194,12 @@ fn sentence(name: &str, (min, median, max, n): (f64, f64, f64, usize)) -> String
 /// one), as (name, (min, median, max, count)).
 pub fn ratios(runs: &[BenchRun]) -> Vec<(String, (f64, f64, f64, usize))> {
     let mut reps: Vec<&[BenchRun]> = Vec::new();
-    let starts: Vec<usize> = runs.iter().enumerate().filter(|(_, r)| r.mode == "floor").map(|(i, _)| i).collect();
+    let starts: Vec<usize> = runs
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| r.mode == "floor")
+        .map(|(i, _)| i)
+        .collect();
     if starts.is_empty() {
         reps.push(runs);
     } else {
@@ -151,17 +218,29 @@ pub fn ratios(runs: &[BenchRun]) -> Vec<(String, (f64, f64, f64, usize))> {
             for rec in [false, true] {
                 if let Some(p) = get("processes", rec) {
                     let what = if rec { "recording" } else { "no recording" };
-                    add(format!("processes ({what}) / floor, steps/s"), p.steps_per_s / f.steps_per_s);
-                    add(format!("processes ({what}) / floor, step p50"), p.step_ns.p50 as f64 / f.step_ns.p50.max(1) as f64);
+                    add(
+                        format!("processes ({what}) / floor, steps/s"),
+                        p.steps_per_s / f.steps_per_s,
+                    );
+                    add(
+                        format!("processes ({what}) / floor, step p50"),
+                        p.step_ns.p50 as f64 / f.step_ns.p50.max(1) as f64,
+                    );
                 }
             }
         }
         if let (Some(p), Some(i)) = (get("processes", false), get("in-process", false)) {
-            add("processes / in-process, steps/s (no recording)".into(), p.steps_per_s / i.steps_per_s);
+            add(
+                "processes / in-process, steps/s (no recording)".into(),
+                p.steps_per_s / i.steps_per_s,
+            );
         }
         for m in ["in-process", "processes"] {
             if let (Some(a), Some(b)) = (get(m, true), get(m, false)) {
-                add(format!("{m}: share of steps/s recording costs"), 1.0 - a.steps_per_s / b.steps_per_s);
+                add(
+                    format!("{m}: share of steps/s recording costs"),
+                    1.0 - a.steps_per_s / b.steps_per_s,
+                );
             }
         }
     }
@@ -181,11 +260,26 @@ mod sentence_tests {
     /// Each ratio reads as a sentence with its median and range, not as an algebraic name.
     #[test]
     fn ratios_read_as_sentences() {
-        let s = sentence("in-process: share of steps/s recording costs", (0.78, 0.791, 0.80, 3));
-        assert_eq!(s, "in one process, recording costs 79.1 % of the steps per second a run makes without it (median of 3 repetition(s); range 78.0 % – 80.0 %)\n");
-        let s = sentence("processes (recording) / floor, steps/s", (0.5, 0.52, 0.55, 3));
+        let s = sentence(
+            "in-process: share of steps/s recording costs",
+            (0.78, 0.791, 0.80, 3),
+        );
+        assert_eq!(
+            s,
+            "in one process, recording costs 79.1 % of the steps per second a run makes without it (median of 3 repetition(s); range 78.0 % – 80.0 %)\n"
+        );
+        let s = sentence(
+            "processes (recording) / floor, steps/s",
+            (0.5, 0.52, 0.55, 3),
+        );
         assert!(s.starts_with("across processes with recording, the lockstep ring makes 52.0 % of the steps per second of a bare iceoryx2 ring"), "{s}");
-        let s = sentence("processes (no recording) / floor, step p50", (1.1, 1.25, 1.4, 2));
-        assert!(s.contains("a step's median time is 1.25× the floor's"), "{s}");
+        let s = sentence(
+            "processes (no recording) / floor, step p50",
+            (1.1, 1.25, 1.4, 2),
+        );
+        assert!(
+            s.contains("a step's median time is 1.25× the floor's"),
+            "{s}"
+        );
     }
 }

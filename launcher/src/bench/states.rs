@@ -45,18 +45,40 @@ pub struct StatesRun {
 }
 
 fn rows(m: &[Vec<f64>]) -> String {
-    let r: Vec<String> = m.iter().map(|row| format!("[{}]", row.iter().map(|v| format!("{v:?}")).collect::<Vec<_>>().join(", "))).collect();
+    let r: Vec<String> = m
+        .iter()
+        .map(|row| {
+            format!(
+                "[{}]",
+                row.iter()
+                    .map(|v| format!("{v:?}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        })
+        .collect();
     format!("[{}]", r.join(", "))
 }
 
 fn poles(n: usize, base: f64) -> String {
-    (0..n).map(|i| format!("{:?}", base - 0.05 * i as f64)).collect::<Vec<_>>().join(", ")
+    (0..n)
+        .map(|i| format!("{:?}", base - 0.05 * i as f64))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// The scenario text for n states, `steps` steps of 1 ms.
 pub fn scenario_text(n: usize, steps: u64) -> String {
     let mut rng = ChaCha8Rng::seed_from_u64(n as u64);
-    let mut normal = |r: usize, c: usize| -> Vec<Vec<f64>> { (0..r).map(|_| (0..c).map(|_| rng.sample::<f64, _>(StandardNormal)).collect()).collect() };
+    let mut normal = |r: usize, c: usize| -> Vec<Vec<f64>> {
+        (0..r)
+            .map(|_| {
+                (0..c)
+                    .map(|_| rng.sample::<f64, _>(StandardNormal))
+                    .collect()
+            })
+            .collect()
+    };
     let scale = 1.0 / (n as f64).sqrt();
     let mut a = normal(n, n);
     for (i, row) in a.iter_mut().enumerate() {
@@ -66,7 +88,10 @@ pub fn scenario_text(n: usize, steps: u64) -> String {
         row[i] -= 2.0;
     }
     let (b, c, e) = (normal(n, 2), normal(n, n), normal(n, 1));
-    let g: Vec<Vec<f64>> = normal(2, n).into_iter().map(|r| r.into_iter().map(|v| 0.1 * v * scale).collect()).collect();
+    let g: Vec<Vec<f64>> = normal(2, n)
+        .into_iter()
+        .map(|r| r.into_iter().map(|v| 0.1 * v * scale).collect())
+        .collect();
     format!(
         r#"name = "states-{n}"
 dt = 0.001
@@ -114,12 +139,21 @@ gain = {g}
 }
 
 /// Measures each n in `states` for `steps` steps in `modes` × `recording`.
-pub fn states(states: &[usize], steps: u64, wait: Wait, pin: bool, modes: &[Mode], recording: &[bool]) -> Result<Vec<StatesRun>, LaunchError> {
+pub fn states(
+    states: &[usize],
+    steps: u64,
+    wait: Wait,
+    pin: bool,
+    modes: &[Mode],
+    recording: &[bool],
+) -> Result<Vec<StatesRun>, LaunchError> {
     let tmp = std::env::temp_dir().join(format!("uio-bench-states-{}", std::process::id()));
     let mut out = Vec::new();
     for &n in states {
         if n == 0 {
-            return Err(LaunchError::BadInput("--states: a plant has at least one state".into()));
+            return Err(LaunchError::BadInput(
+                "--states: a plant has at least one state".into(),
+            ));
         }
         let text = scenario_text(n, steps);
         let s = Scenario::parse(std::path::Path::new(&format!("states-{n}.toml")), &text)?;
@@ -129,7 +163,11 @@ pub fn states(states: &[usize], steps: u64, wait: Wait, pin: bool, modes: &[Mode
         for &mode in modes {
             for &record in recording {
                 let o = super::measure(&s, &p, &tmp, mode, wait, record, pin)?;
-                let bytes = o.rrd.as_ref().and_then(|f| std::fs::metadata(f).ok()).map(|m| m.len() as f64 / o.summary.steps.max(1) as f64);
+                let bytes = o
+                    .rrd
+                    .as_ref()
+                    .and_then(|f| std::fs::metadata(f).ok())
+                    .map(|m| m.len() as f64 / o.summary.steps.max(1) as f64);
                 out.push(StatesRun {
                     n,
                     mode: mode.name().into(),
@@ -148,7 +186,10 @@ pub fn states(states: &[usize], steps: u64, wait: Wait, pin: bool, modes: &[Mode
 
 /// The printed table.
 pub fn table(runs: &[StatesRun]) -> String {
-    let mut t = format!("{:>6} {:<12} {:<10} {:>12} {:>10} {:>12} {:>9}\n", "n", "mode", "recording", "steps/s", "p50 µs", "bytes/step", "design s");
+    let mut t = format!(
+        "{:>6} {:<12} {:<10} {:>12} {:>10} {:>12} {:>9}\n",
+        "n", "mode", "recording", "steps/s", "p50 µs", "bytes/step", "design s"
+    );
     for r in runs {
         t += &format!(
             "{:>6} {:<12} {:<10} {:>12.0} {:>10.2} {:>12} {:>9.2}\n",
@@ -157,7 +198,8 @@ pub fn table(runs: &[StatesRun]) -> String {
             r.recording,
             r.steps_per_s,
             r.step_p50_ns as f64 / 1000.0,
-            r.bytes_per_step.map_or_else(|| "—".into(), |b| format!("{b:.0}")),
+            r.bytes_per_step
+                .map_or_else(|| "—".into(), |b| format!("{b:.0}")),
             r.design_s
         );
     }

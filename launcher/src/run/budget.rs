@@ -37,7 +37,12 @@ pub fn recorded_paths(s: &Scenario, plan: &Plan, paced: bool) -> Vec<String> {
     if s.controller.is_some() {
         p.extend((0..m.l()).map(sig::control));
     }
-    for (o, (_, d)) in s.observers.iter().zip(&plan.observers).filter(|(o, _)| o.member.is_none()) {
+    for (o, (_, d)) in s
+        .observers
+        .iter()
+        .zip(&plan.observers)
+        .filter(|(o, _)| o.member.is_none())
+    {
         p.extend((0..m.n()).map(|i| sig::estimate(&o.name, i)));
         p.extend((0..m.n()).map(|i| sig::error(&o.name, i)));
         p.extend((0..m.p()).map(|j| sig::residual(&o.name, j)));
@@ -50,7 +55,11 @@ pub fn recorded_paths(s: &Scenario, plan: &Plan, paced: bool) -> Vec<String> {
         let d = &b.spec.name;
         for (i, mb) in b.members.iter().enumerate() {
             p.extend(mb.outputs.iter().map(|&j| sig::member_residual(d, i, j)));
-            p.extend([sig::evaluation(d, i), sig::threshold(d, i), sig::alarm(d, i)]);
+            p.extend([
+                sig::evaluation(d, i),
+                sig::threshold(d, i),
+                sig::alarm(d, i),
+            ]);
         }
         p.push(sig::isolated(d));
     }
@@ -68,15 +77,28 @@ pub fn recorded_paths(s: &Scenario, plan: &Plan, paced: bool) -> Vec<String> {
 /// Bytes the run's recording will take, about: recorded steps × (values × [`BYTES_PER_VALUE`] +
 /// entity rows × [`BYTES_PER_ROW`]). Returns (steps, values, entity rows, bytes).
 pub fn recording_bytes(s: &Scenario, plan: &Plan, opts: &Options) -> (u64, u64, u64, u64) {
-    let paths: Vec<String> = recorded_paths(s, plan, opts.realtime.is_some()).into_iter().filter(|p| opts.select.entity(p)).collect();
+    let paths: Vec<String> = recorded_paths(s, plan, opts.realtime.is_some())
+        .into_iter()
+        .filter(|p| opts.select.entity(p))
+        .collect();
     let mut entities: Vec<String> = paths.iter().map(|p| sig::entity_of(p)).collect();
     entities.sort();
     entities.dedup();
     // ŵ is a row of its own (one step late), beside its observer's.
-    let late = paths.iter().filter(|p| p.contains("/what/")).map(|p| sig::entity_of(p)).collect::<std::collections::BTreeSet<_>>().len();
+    let late = paths
+        .iter()
+        .filter(|p| p.contains("/what/"))
+        .map(|p| sig::entity_of(p))
+        .collect::<std::collections::BTreeSet<_>>()
+        .len();
     let (scalars, rows) = (paths.len() as u64, (entities.len() + late) as u64);
     let steps = s.steps.div_ceil(opts.select.every());
-    (steps, scalars, rows, steps.saturating_mul(scalars * BYTES_PER_VALUE + rows * BYTES_PER_ROW))
+    (
+        steps,
+        scalars,
+        rows,
+        steps.saturating_mul(scalars * BYTES_PER_VALUE + rows * BYTES_PER_ROW),
+    )
 }
 
 /// Memory one run's buffers take that grow with the scenario: each `rms` member's window and
@@ -90,7 +112,10 @@ pub fn memory_bytes(s: &Scenario, plan: &Plan) -> u64 {
             _ => 0,
         })
         .sum();
-    let blocks = s.steps.div_ceil(recording::write::tail::block_len(s.steps)).max(1);
+    let blocks = s
+        .steps
+        .div_ceil(recording::write::tail::block_len(s.steps))
+        .max(1);
     windows + s.observers.len() as u64 * 2 * blocks * 8
 }
 
@@ -100,13 +125,28 @@ pub fn shared_memory_bytes(s: &Scenario, plant_len: usize) -> u64 {
     use lockstep::settings::{MAX_SUBSCRIBERS, SUBSCRIBER_MAX_BUFFER};
     let n = s.model.n();
     // An observer process publishes n values per observer it steps (a bank's, all its members').
-    let lens = std::iter::once(plant_len).chain(s.observer_processes().into_iter().map(|p| p.observers.len() * n)).chain(s.controller.as_ref().map(|_| s.model.l()));
-    let per_sample = |len: usize| (len as u64 * 8 + std::mem::size_of::<lockstep::WireHeader>() as u64) * (MAX_SUBSCRIBERS * SUBSCRIBER_MAX_BUFFER) as u64;
+    let lens = std::iter::once(plant_len)
+        .chain(
+            s.observer_processes()
+                .into_iter()
+                .map(|p| p.observers.len() * n),
+        )
+        .chain(s.controller.as_ref().map(|_| s.model.l()));
+    let per_sample = |len: usize| {
+        (len as u64 * 8 + std::mem::size_of::<lockstep::WireHeader>() as u64)
+            * (MAX_SUBSCRIBERS * SUBSCRIBER_MAX_BUFFER) as u64
+    };
     lens.map(per_sample).sum()
 }
 
 /// Checks a run's recording, memory and shared memory against the machine; `jobs` runs at once.
-pub fn check(s: &Scenario, plan: &Plan, opts: &Options, plant_len: usize, jobs: u64) -> Result<(), LaunchError> {
+pub fn check(
+    s: &Scenario,
+    plan: &Plan,
+    opts: &Options,
+    plant_len: usize,
+    jobs: u64,
+) -> Result<(), LaunchError> {
     if opts.record {
         let (steps, scalars, rows, bytes) = recording_bytes(s, plan, opts);
         if let Some(free) = free_bytes(&opts.out)
@@ -177,5 +217,9 @@ fn available_memory() -> Option<u64> {
 /// "1.6 GB", "430 MB".
 fn size(bytes: u64) -> String {
     let b = bytes as f64;
-    if b >= 1e9 { format!("{:.1} GB", b / 1e9) } else { format!("{:.0} MB", (b / 1e6).max(1.0)) }
+    if b >= 1e9 {
+        format!("{:.1} GB", b / 1e9)
+    } else {
+        format!("{:.0} MB", (b / 1e6).max(1.0))
+    }
 }

@@ -39,7 +39,9 @@ pub const FOLLOWER_SLEEP_US: u32 = 5000;
 
 /// In closed loop, observers the controller does not read are off the critical path.
 pub fn is_follower(s: &Scenario, observer: &str) -> bool {
-    s.controller.as_ref().is_some_and(|c| c.observer != observer)
+    s.controller
+        .as_ref()
+        .is_some_and(|c| c.observer != observer)
 }
 
 /// The plant's noise: the scenario's covariances and seed; a run with only noise-burst faults
@@ -48,8 +50,16 @@ pub fn noise(s: &Scenario) -> Option<plant::Noise> {
     let bursts = s.faults.iter().any(|f| f.kind == plant::fault::Kind::Noise);
     let (n, p) = (s.model.n(), s.model.p());
     match &s.noise {
-        Some(z) => Some(plant::Noise { seed: s.seed, qd: (&z.qd).into(), r: (&z.r).into() }),
-        None if bursts => Some(plant::Noise { seed: s.seed, qd: (&lti::Mat::zeros(n, n)).into(), r: (&lti::Mat::zeros(p, p)).into() }),
+        Some(z) => Some(plant::Noise {
+            seed: s.seed,
+            qd: (&z.qd).into(),
+            r: (&z.r).into(),
+        }),
+        None if bursts => Some(plant::Noise {
+            seed: s.seed,
+            qd: (&lti::Mat::zeros(n, n)).into(),
+            r: (&lti::Mat::zeros(p, p)).into(),
+        }),
         None => None,
     }
 }
@@ -57,26 +67,37 @@ pub fn noise(s: &Scenario) -> Option<plant::Noise> {
 /// Builds the configurations.
 pub fn configs(s: &Scenario, plan: &Plan) -> Configs {
     let m = &s.model;
-    let layout = PlantLayout { n: m.n(), p: m.p(), q: m.e.ncols(), r: m.d.ncols(), l: m.l(), f: s.faults.len() };
-    let plant = PlantConfig {
-            a: (&m.a).into(),
-            b: (&m.b).into(),
-            c: (&m.c).into(),
-            e: (&m.e).into(),
-            d: (&m.d).into(),
-            x0: s.x0.clone(),
-            disturbances: s.disturbances.clone(),
-            measurement_disturbances: s.measurement_disturbances.clone(),
-            inputs: s.inputs.clone(),
-            dt: s.dt,
-            steps: s.steps,
-            state_bound: s.state_bound,
-            ff: (&s.ff).into(),
-            faults: s.faults.clone(),
-            noise: noise(s),
-            discrete: s.discrete,
+    let layout = PlantLayout {
+        n: m.n(),
+        p: m.p(),
+        q: m.e.ncols(),
+        r: m.d.ncols(),
+        l: m.l(),
+        f: s.faults.len(),
     };
-    let followers = s.observers.iter().map(|o| is_follower(s, &o.name)).collect();
+    let plant = PlantConfig {
+        a: (&m.a).into(),
+        b: (&m.b).into(),
+        c: (&m.c).into(),
+        e: (&m.e).into(),
+        d: (&m.d).into(),
+        x0: s.x0.clone(),
+        disturbances: s.disturbances.clone(),
+        measurement_disturbances: s.measurement_disturbances.clone(),
+        inputs: s.inputs.clone(),
+        dt: s.dt,
+        steps: s.steps,
+        state_bound: s.state_bound,
+        ff: (&s.ff).into(),
+        faults: s.faults.clone(),
+        noise: noise(s),
+        discrete: s.discrete,
+    };
+    let followers = s
+        .observers
+        .iter()
+        .map(|o| is_follower(s, &o.name))
+        .collect();
     let observers = plan
         .observers
         .iter()
@@ -90,8 +111,18 @@ pub fn configs(s: &Scenario, plan: &Plan) -> Configs {
             dt: s.dt,
             observer: c.observer.clone(),
             integral: fb.integral.as_ref().map(|(gi, ct, m)| match m {
-                Some(m) => IntegralConfig { gi: gi.into(), ct: m.into(), y: Some([layout.y().start, layout.y().end]), references: integrated(fb) },
-                None => IntegralConfig { gi: gi.into(), ct: ct.into(), y: None, references: integrated(fb) },
+                Some(m) => IntegralConfig {
+                    gi: gi.into(),
+                    ct: m.into(),
+                    y: Some([layout.y().start, layout.y().end]),
+                    references: integrated(fb),
+                },
+                None => IntegralConfig {
+                    gi: gi.into(),
+                    ct: ct.into(),
+                    y: None,
+                    references: integrated(fb),
+                },
             }),
             feedforward: fb.feedforward.as_ref().map(|[mw, a, b]| FeedforwardConfig {
                 mw: mw.into(),
@@ -99,20 +130,44 @@ pub fn configs(s: &Scenario, plan: &Plan) -> Configs {
                 mw_c_gamma_b: b.into(),
                 y: [layout.y().start, layout.y().end],
                 u_prev: [layout.u_prev().start, layout.u_prev().end],
-                offset: s.operating_point.as_ref().filter(|op| !op.is_origin()).map(|op| {
-                    // M(c − w_op) = −M(W y_op − WCΦ x_op − WCΓ_B u_op): what cancels Mδŵ.
-                    lti::input_estimate::at_rest(mw, a, b, &op.x, &op.u, &op.y).iter().map(|v| -v).collect()
-                }),
+                offset: s
+                    .operating_point
+                    .as_ref()
+                    .filter(|op| !op.is_origin())
+                    .map(|op| {
+                        // M(c − w_op) = −M(W y_op − WCΦ x_op − WCΓ_B u_op): what cancels Mδŵ.
+                        lti::input_estimate::at_rest(mw, a, b, &op.x, &op.u, &op.y)
+                            .iter()
+                            .map(|v| -v)
+                            .collect()
+                    }),
             }),
-            offset: s.operating_point.as_ref().filter(|op| !op.is_origin()).map(|op| fb.offset_at(c.track.as_ref(), op)),
+            offset: s
+                .operating_point
+                .as_ref()
+                .filter(|op| !op.is_origin())
+                .map(|op| fb.offset_at(c.track.as_ref(), op)),
         }),
         _ => None,
     };
-    Configs { plant, followers, closed_loop: s.controller.is_some(), observers, processes: s.observer_processes(), controller, layout, pace_s: None }
+    Configs {
+        plant,
+        followers,
+        closed_loop: s.controller.is_some(),
+        observers,
+        processes: s.observer_processes(),
+        controller,
+        layout,
+        pace_s: None,
+    }
 }
 
 /// The references the integrators compare with: the commanded inputs' (all, as an empty list,
 /// without measured disturbances).
 fn integrated(fb: &controller::design::FeedbackDesign) -> Vec<usize> {
-    if fb.measured.is_empty() { Vec::new() } else { controller::design::measured::commanded(fb.g.nrows(), &fb.measured) }
+    if fb.measured.is_empty() {
+        Vec::new()
+    } else {
+        controller::design::measured::commanded(fb.g.nrows(), &fb.measured)
+    }
 }

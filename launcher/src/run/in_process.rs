@@ -8,7 +8,7 @@ use plant::Plant;
 
 use super::configs::Configs;
 use super::session::Session;
-use super::{interrupt, Stop};
+use super::{Stop, interrupt};
 use crate::error::LaunchError;
 use recording::write::StepRow;
 
@@ -16,9 +16,21 @@ use recording::write::StepRow;
 pub fn run(cfg: &Configs, session: &mut Session) -> Result<Stop, LaunchError> {
     let mut plant = Plant::new(&cfg.plant).map_err(LaunchError::Component)?;
     // External components were refused before the run (`run::run`): every observer is ours.
-    let mut observers: Vec<ObserverState> = cfg.observers.iter().map(|(_, o)| o.as_ref().expect("built-in").instantiate()).collect();
-    let mut controller = cfg.controller.as_ref().map(Controller::new).transpose().map_err(LaunchError::Component)?;
-    let ctrl_obs = cfg.controller.as_ref().and_then(|c| cfg.observers.iter().position(|(n, _)| *n == c.observer));
+    let mut observers: Vec<ObserverState> = cfg
+        .observers
+        .iter()
+        .map(|(_, o)| o.as_ref().expect("built-in").instantiate())
+        .collect();
+    let mut controller = cfg
+        .controller
+        .as_ref()
+        .map(Controller::new)
+        .transpose()
+        .map_err(LaunchError::Component)?;
+    let ctrl_obs = cfg
+        .controller
+        .as_ref()
+        .and_then(|c| cfg.observers.iter().position(|(n, _)| *n == c.observer));
     let lay = cfg.layout;
     let mut row = StepRow::new(lay, observers.len(), controller.is_some());
     let mut u = vec![0.0; lay.l];

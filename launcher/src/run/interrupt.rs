@@ -69,6 +69,9 @@ mod tests {
 
     #[test]
     fn exit_codes_follow_the_signal() {
-        assert_eq!([libc::SIGHUP, libc::SIGINT, libc::SIGQUIT, libc::SIGTERM].map(exit_code_of), [129, 130, 131, 130]);
+        assert_eq!(
+            [libc::SIGHUP, libc::SIGINT, libc::SIGQUIT, libc::SIGTERM].map(exit_code_of),
+            [129, 130, 131, 130]
+        );
     }
 }

@@ -3,8 +3,8 @@
 pub mod budget;
 mod configs;
 mod envelope;
-pub mod interrupt;
 mod in_process;
+pub mod interrupt;
 pub mod preflight;
 mod processes;
 mod progress;
@@ -17,15 +17,15 @@ use std::time::Instant;
 
 use lockstep::Wait;
 
-pub use configs::{configs, Configs};
-pub use envelope::{bridge_path, envelopes, Launchable, Program};
-pub use session::{hop_entity, hop_names, Finished, RealtimeFigures, Session};
+pub use configs::{Configs, configs};
+pub use envelope::{Launchable, Program, bridge_path, envelopes};
 pub(crate) use processes::placement::{pin_self, ring_cpus};
+pub use session::{Finished, RealtimeFigures, Session, hop_entity, hop_names};
 
 use crate::error::LaunchError;
 use crate::plan::Plan;
-use scenario::Scenario;
 use crate::summary::Summary;
+use scenario::Scenario;
 
 /// Where the components run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -118,29 +118,49 @@ pub struct Outcome {
 
 /// The recording and summary paths of a scenario in `out`.
 pub fn output_paths(out: &Path, name: &str) -> (PathBuf, PathBuf) {
-    (out.join(format!("{name}.rrd")), out.join(format!("{name}.summary.json")))
+    (
+        out.join(format!("{name}.rrd")),
+        out.join(format!("{name}.summary.json")),
+    )
 }
 
 /// Makes sure the outputs can be written, before anything runs.
 fn prepare_output(out: &Path, name: &str, force: bool) -> Result<(PathBuf, PathBuf), LaunchError> {
-    fs::create_dir_all(out).map_err(|e| LaunchError::BadInput(format!("{}: cannot create the output directory: {e}", out.display())))?;
-    outputs::probe(out).map_err(|e| LaunchError::BadInput(format!("{}: output directory is not writable: {e}", out.display())))?;
+    fs::create_dir_all(out).map_err(|e| {
+        LaunchError::BadInput(format!(
+            "{}: cannot create the output directory: {e}",
+            out.display()
+        ))
+    })?;
+    outputs::probe(out).map_err(|e| {
+        LaunchError::BadInput(format!(
+            "{}: output directory is not writable: {e}",
+            out.display()
+        ))
+    })?;
     let (rrd, summary) = output_paths(out, name);
     for p in [&rrd, &summary] {
         if p.exists() {
             if !force {
-                return Err(LaunchError::BadInput(format!("{}: already exists (pass --force to overwrite)", p.display())));
+                return Err(LaunchError::BadInput(format!(
+                    "{}: already exists (pass --force to overwrite)",
+                    p.display()
+                )));
             }
             // Overwritten now, not when the new run ends: a run that fails must not leave the
             // previous run's outputs looking like its own.
-            fs::remove_file(p).map_err(|e| LaunchError::BadInput(format!("{}: cannot overwrite: {e}", p.display())))?;
+            fs::remove_file(p).map_err(|e| {
+                LaunchError::BadInput(format!("{}: cannot overwrite: {e}", p.display()))
+            })?;
         }
     }
     // What a killed launcher left, or anything planted at that name (a link is removed, never
     // followed): the recording is then made there as a new file (`outputs::create_new`).
     let partial = rrd.with_extension("rrd.partial");
     if fs::symlink_metadata(&partial).is_ok() {
-        fs::remove_file(&partial).map_err(|e| LaunchError::BadInput(format!("{}: cannot replace: {e}", partial.display())))?;
+        fs::remove_file(&partial).map_err(|e| {
+            LaunchError::BadInput(format!("{}: cannot replace: {e}", partial.display()))
+        })?;
     }
     Ok((rrd, summary))
 }
@@ -153,7 +173,10 @@ fn external_component(s: &Scenario) -> Option<String> {
     if let Some(o) = s.observers.iter().find(|o| o.process.is_some()) {
         return Some(format!("observer '{}'", o.name));
     }
-    s.controller.as_ref().filter(|c| c.process.is_some()).map(|_| "the controller".into())
+    s.controller
+        .as_ref()
+        .filter(|c| c.process.is_some())
+        .map(|_| "the controller".into())
 }
 
 /// Runs a designed scenario.
@@ -162,7 +185,10 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
         && let Some(why) = fb.instability()
         && !opts.allow_unstable
     {
-        return Err(LaunchError::BadInput(format!("{}: controller: {why}; pass --allow-unstable to run it anyway", s.path.display())));
+        return Err(LaunchError::BadInput(format!(
+            "{}: controller: {why}; pass --allow-unstable to run it anyway",
+            s.path.display()
+        )));
     }
     if opts.mode == Mode::InProcess && s.plant_fmu.is_some() {
         return Err(LaunchError::BadInput(format!(
@@ -174,7 +200,10 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
     if opts.mode == Mode::InProcess
         && let Some(what) = external_component(s)
     {
-        return Err(LaunchError::BadInput(format!("{}: {what} is an external process: --mode in-process runs only built-in components", s.path.display())));
+        return Err(LaunchError::BadInput(format!(
+            "{}: {what} is an external process: --mode in-process runs only built-in components",
+            s.path.display()
+        )));
     }
     // An FMU or recorded data that cannot be the plant is refused before anything runs, by the
     // component that would read it.
@@ -188,14 +217,27 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
     let mut cfg = configs(s, plan);
     // What the run will take of disk, memory and shared memory, before any output exists.
     budget::check(s, plan, opts, cfg.layout.len(), 1)?;
-    let (rrd, summary_path) = if opts.record { prepare_output(&opts.out, &s.name, opts.force).map(|(a, b)| (Some(a), Some(b)))? } else { (None, None) };
+    let (rrd, summary_path) = if opts.record {
+        prepare_output(&opts.out, &s.name, opts.force).map(|(a, b)| (Some(a), Some(b)))?
+    } else {
+        (None, None)
+    };
     // The recording is written under a temporary name and renamed when the run ends, however it
     // ends: a finished `<name>.rrd` is never half-written, and what a killed launcher leaves
     // (`<name>.rrd.partial`, without footer) does not stand in the next run's way.
     let partial = rrd.as_ref().map(|p| p.with_extension("rrd.partial"));
     interrupt::install();
     cfg.pace_s = opts.realtime.map(|x| s.dt / x);
-    let mut session = Session::new(s, cfg.layout, plan, partial.as_deref(), &opts.select, cfg.pace_s, opts.mode == Mode::Processes).inspect_err(|_| {
+    let mut session = Session::new(
+        s,
+        cfg.layout,
+        plan,
+        partial.as_deref(),
+        &opts.select,
+        cfg.pace_s,
+        opts.mode == Mode::Processes,
+    )
+    .inspect_err(|_| {
         // A recording that could not even be started is of no use to anyone.
         if let Some(p) = &partial {
             let _ = fs::remove_file(p);
@@ -214,18 +256,31 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
     // recording is closed and a summary says why, so the outputs stay consistent.
     let stop = match stop {
         Ok(stop) => stop,
-        Err(LaunchError::Interrupted(_)) => Stop::Interrupted(interrupt::received().unwrap_or("SIGINT")),
+        Err(LaunchError::Interrupted(_)) => {
+            Stop::Interrupted(interrupt::received().unwrap_or("SIGINT"))
+        }
         Err(e) => Stop::Failed(e.to_string()),
     };
     let steps_done = session.steps;
-    let Finished { mut metrics, latency, digest, diagnosis, realtime } = session.finish().map_err(|e| {
+    let Finished {
+        mut metrics,
+        latency,
+        digest,
+        diagnosis,
+        realtime,
+    } = session.finish().map_err(|e| {
         // Say why the run had stopped too, when the recording's failure is not the whole story.
         let why = match &stop {
             Stop::Completed => String::new(),
             Stop::Diverged(w) | Stop::Failed(w) => format!(" (the run had stopped: {w})"),
             Stop::Interrupted(sig) => format!(" (the run had been interrupted by {sig})"),
         };
-        salvage::recording_failed(&s.name, partial.as_deref(), &format!("{e}{why}"), steps_done)
+        salvage::recording_failed(
+            &s.name,
+            partial.as_deref(),
+            &format!("{e}{why}"),
+            steps_done,
+        )
     })?;
     metrics.finish();
     // A run that failed before any step completed has nothing to show: it leaves no recording
@@ -234,15 +289,37 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
         if let Some(p) = &partial {
             let _ = fs::remove_file(p);
         }
-        let mut summary = Summary::new(s, plan, opts, &metrics, &latency, wall, &stop, None, diagnosis);
+        let mut summary = Summary::new(
+            s, plan, opts, &metrics, &latency, wall, &stop, None, diagnosis,
+        );
         summary.realtime = realtime;
-        return Ok(Outcome { summary, rrd: None, summary_path: None, stop });
+        return Ok(Outcome {
+            summary,
+            rrd: None,
+            summary_path: None,
+            stop,
+        });
     }
     // Failures after the run are of the run's outputs (a full disk, say): exit code 3, the file named.
     if let (Some(from), Some(to)) = (&partial, &rrd) {
-        fs::rename(from, to).map_err(|e| LaunchError::Component(format!("{}: cannot rename the recording into place: {e}", to.display())))?;
+        fs::rename(from, to).map_err(|e| {
+            LaunchError::Component(format!(
+                "{}: cannot rename the recording into place: {e}",
+                to.display()
+            ))
+        })?;
     }
-    let mut summary = Summary::new(s, plan, opts, &metrics, &latency, wall, &stop, rrd.as_deref(), diagnosis);
+    let mut summary = Summary::new(
+        s,
+        plan,
+        opts,
+        &metrics,
+        &latency,
+        wall,
+        &stop,
+        rrd.as_deref(),
+        diagnosis,
+    );
     summary.realtime = realtime;
     summary.recording_digest = digest;
     if let Some(facts) = replay {
@@ -251,5 +328,10 @@ pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchE
     if let Some(path) = &summary_path {
         summary.write(path).map_err(LaunchError::Component)?;
     }
-    Ok(Outcome { summary, rrd, summary_path, stop })
+    Ok(Outcome {
+        summary,
+        rrd,
+        summary_path,
+        stop,
+    })
 }

@@ -22,7 +22,11 @@ pub struct Progress {
 impl Progress {
     /// A progress for `total` steps, or `None` when stderr is not a terminal.
     pub fn new(total: u64) -> Option<Self> {
-        std::io::stderr().is_terminal().then(|| Progress { total, start: Instant::now(), bar: None })
+        std::io::stderr().is_terminal().then(|| Progress {
+            total,
+            start: Instant::now(),
+            bar: None,
+        })
     }
 
     /// Notes that `done` steps are complete.
@@ -34,8 +38,12 @@ impl Progress {
         match &self.bar {
             Some(bar) => bar.set_position(done),
             None if self.start.elapsed() >= SHOW_AFTER => {
-                let bar = ProgressBar::with_draw_target(Some(self.total), ProgressDrawTarget::stderr());
-                let style = ProgressStyle::with_template("{bar:40} {pos}/{len} steps  {elapsed} elapsed, eta {eta}").unwrap_or_else(|_| ProgressStyle::default_bar());
+                let bar =
+                    ProgressBar::with_draw_target(Some(self.total), ProgressDrawTarget::stderr());
+                let style = ProgressStyle::with_template(
+                    "{bar:40} {pos}/{len} steps  {elapsed} elapsed, eta {eta}",
+                )
+                .unwrap_or_else(|_| ProgressStyle::default_bar());
                 bar.set_style(style);
                 bar.set_position(done);
                 self.bar = Some(bar);

@@ -10,10 +10,10 @@ use diagnosis::{Diagnosis, FaultInfo, Judge, Monitor};
 use observer::design::InputEstimator;
 
 use crate::plan::Plan;
-use recording::write::Selection;
 use recording::palette;
 use recording::signals as sig;
-use recording::write::{blueprint, Latency, Metrics, RrdSink, SeriesId, StepRow};
+use recording::write::Selection;
+use recording::write::{Latency, Metrics, RrdSink, SeriesId, StepRow, blueprint};
 use scenario::Scenario;
 
 /// Series of one observer.
@@ -102,10 +102,25 @@ pub struct Session {
 /// to name, the plant's own check stops that run.
 fn estimate_divergence(row: &StepRow, x: &[f64], names: &[String], bound: f64) -> Option<String> {
     for (xhat, name) in row.xhat.iter().zip(names) {
-        let bad = xhat.iter().zip(x).enumerate().find(|(_, (e, x))| !e.is_finite() || (*e - *x).abs() > bound);
+        let bad = xhat
+            .iter()
+            .zip(x)
+            .enumerate()
+            .find(|(_, (e, x))| !e.is_finite() || (*e - *x).abs() > bound);
         if let Some((i, (&e, &xi))) = bad {
-            let value = if e.is_finite() { format!("x̂{n} − x{n} = {:.6e} left the bound ±{bound:.3e}", e - xi, n = i + 1) } else { format!("x̂{} = {e}", i + 1) };
-            return Some(format!("observer '{name}': its error grows without bound: {value} at step {}", row.k));
+            let value = if e.is_finite() {
+                format!(
+                    "x̂{n} − x{n} = {:.6e} left the bound ±{bound:.3e}",
+                    e - xi,
+                    n = i + 1
+                )
+            } else {
+                format!("x̂{} = {e}", i + 1)
+            };
+            return Some(format!(
+                "observer '{name}': its error grows without bound: {value} at step {}",
+                row.k
+            ));
         }
     }
     None
@@ -164,7 +179,13 @@ fn fault_infos(s: &Scenario) -> Vec<FaultInfo> {
                 Target::Sensor(j) => (diagnosis::Channels::Sensor, j),
                 Target::Component(j) => (diagnosis::Channels::Component, j),
             };
-            FaultInfo { name: f.name.clone(), channels, channel, start: f.profile.start(), active: f.active_steps(s.dt) }
+            FaultInfo {
+                name: f.name.clone(),
+                channels,
+                channel,
+                start: f.profile.start(),
+                active: f.active_steps(s.dt),
+            }
         })
         .collect()
 }
@@ -174,7 +195,11 @@ pub type Digest = std::collections::BTreeMap<String, String>;
 
 /// Hop names of a run, in the order [`Session`] records them.
 pub fn hop_names(s: &Scenario) -> Vec<String> {
-    let mut hops: Vec<String> = s.observers.iter().map(|o| format!("plant->observer/{}", o.name)).collect();
+    let mut hops: Vec<String> = s
+        .observers
+        .iter()
+        .map(|o| format!("plant->observer/{}", o.name))
+        .collect();
     if let Some(c) = &s.controller {
         hops.push(format!("observer/{}->controller", c.observer));
         hops.push("controller->plant".into());
@@ -192,7 +217,15 @@ impl Session {
     /// `select` thins and filters what is written; the figures see every step.
     /// `measures_hops`: the run measures hop latencies (across processes; in one process there
     /// are none).
-    pub fn new(s: &Scenario, layout: PlantLayout, plan: &Plan, rrd: Option<&Path>, select: &Selection, pace_s: Option<f64>, measures_hops: bool) -> Result<Self, LaunchError> {
+    pub fn new(
+        s: &Scenario,
+        layout: PlantLayout,
+        plan: &Plan,
+        rrd: Option<&Path>,
+        select: &Selection,
+        pace_s: Option<f64>,
+        measures_hops: bool,
+    ) -> Result<Self, LaunchError> {
         let banks = &plan.banks[..];
         // ŵ of the scenario's own observers (a bank member's model widens E with its blind
         // channels: its estimator is not of the plant's w).
@@ -200,43 +233,114 @@ impl Session {
             .observers
             .iter()
             .zip(&s.observers)
-            .map(|((_, d), o)| d.as_ref().and_then(|d| d.what.as_ref()).filter(|_| o.member.is_none()))
+            .map(|((_, d), o)| {
+                d.as_ref()
+                    .and_then(|d| d.what.as_ref())
+                    .filter(|_| o.member.is_none())
+            })
             .collect();
-        let pace = pace_s.map(|p| Pace { period_ns: (p * 1e9).round() as u64, t0: None, steps: 0, overruns: 0, max_late_ns: 0, last_end: 0 });
+        let pace = pace_s.map(|p| Pace {
+            period_ns: (p * 1e9).round() as u64,
+            t0: None,
+            steps: 0,
+            overruns: 0,
+            max_late_ns: 0,
+            last_end: 0,
+        });
         let mut overrun = None;
         let monitors: Vec<Monitor> = banks
             .iter()
             .map(|b| {
-                let index = b.members.iter().map(|mb| s.observers.iter().position(|o| o.name == mb.name).expect("members are observers")).collect();
+                let index = b
+                    .members
+                    .iter()
+                    .map(|mb| {
+                        s.observers
+                            .iter()
+                            .position(|o| o.name == mb.name)
+                            .expect("members are observers")
+                    })
+                    .collect();
                 Monitor::new(b, index, s.dt)
             })
             .collect();
-        let judge = (!banks.is_empty()).then(|| Judge::new(fault_infos(s), &monitors, s.dt, s.isolated_fraction));
-        let controller_observer = s.controller.as_ref().and_then(|c| s.observers.iter().position(|o| o.name == c.observer));
+        let judge = (!banks.is_empty())
+            .then(|| Judge::new(fault_infos(s), &monitors, s.dt, s.isolated_fraction));
+        let controller_observer = s
+            .controller
+            .as_ref()
+            .and_then(|c| s.observers.iter().position(|o| o.name == c.observer));
         let hops = hop_names(s);
         let sink = match rrd {
             Some(path) => {
                 let scenario = s.clone();
-                let mut sink = RrdSink::create(path, &s.name, move |layout| blueprint(&scenario, layout), &s.source, select.clone()).map_err(LaunchError::BadInput)?;
+                let mut sink = RrdSink::create(
+                    path,
+                    &s.name,
+                    move |layout| blueprint(&scenario, layout),
+                    &s.source,
+                    select.clone(),
+                )
+                .map_err(LaunchError::BadInput)?;
                 let (signals, latency) = (sink.group("signals"), sink.group("latency"));
-                let estimates_late = estimates.iter().any(Option::is_some).then(|| sink.group("what"));
+                let estimates_late = estimates
+                    .iter()
+                    .any(Option::is_some)
+                    .then(|| sink.group("what"));
                 let overrun_group = pace.is_some().then(|| sink.group("overrun"));
                 let names = &s.names;
-                let observer_names: Vec<String> = s.observers.iter().map(|o| o.name.clone()).collect();
+                let observer_names: Vec<String> =
+                    s.observers.iter().map(|o| o.name.clone()).collect();
                 let mut paths: Vec<String> = Vec::new();
                 // Colours and widths by the palette's rule, which the PNG plots follow too.
                 let mut series = |g: usize, path: String, legend: String| {
                     paths.push(path.clone());
                     let line = palette::line(&path, &observer_names);
-                    sink.series(g, &path, &legend, line.color, palette::viewer_width(&path, &observer_names))
+                    sink.series(
+                        g,
+                        &path,
+                        &legend,
+                        line.color,
+                        palette::viewer_width(&path, &observer_names),
+                    )
                 };
-                let x = (0..layout.n).map(|i| series(signals, sig::state(i), format!("{} (true)", names.state[i].name))).collect();
-                let y = (0..layout.p).map(|j| series(signals, sig::output(j), names.output[j].name.clone())).collect();
-                let w = (0..layout.q).map(|k| series(signals, sig::disturbance(k), names.disturbance[k].name.clone())).collect();
-                let v = (0..layout.r).map(|k| series(signals, sig::measurement_disturbance(k), names.measurement_disturbance[k].name.clone())).collect();
-                let r = (0..layout.l).map(|k| series(signals, sig::input(k), names.input[k].name.clone())).collect();
+                let x = (0..layout.n)
+                    .map(|i| {
+                        series(
+                            signals,
+                            sig::state(i),
+                            format!("{} (true)", names.state[i].name),
+                        )
+                    })
+                    .collect();
+                let y = (0..layout.p)
+                    .map(|j| series(signals, sig::output(j), names.output[j].name.clone()))
+                    .collect();
+                let w = (0..layout.q)
+                    .map(|k| {
+                        series(
+                            signals,
+                            sig::disturbance(k),
+                            names.disturbance[k].name.clone(),
+                        )
+                    })
+                    .collect();
+                let v = (0..layout.r)
+                    .map(|k| {
+                        series(
+                            signals,
+                            sig::measurement_disturbance(k),
+                            names.measurement_disturbance[k].name.clone(),
+                        )
+                    })
+                    .collect();
+                let r = (0..layout.l)
+                    .map(|k| series(signals, sig::input(k), names.input[k].name.clone()))
+                    .collect();
                 let u = if s.controller.is_some() {
-                    (0..layout.l).map(|k| series(signals, sig::control(k), sig::control_name(s, k))).collect()
+                    (0..layout.l)
+                        .map(|k| series(signals, sig::control(k), sig::control_name(s, k)))
+                        .collect()
                 } else {
                     Vec::new()
                 };
@@ -247,12 +351,51 @@ impl Session {
                     .map(|(i, o)| {
                         let name = &o.name;
                         o.member.is_none().then(|| ObserverChannels {
-                            xhat: (0..layout.n).map(|i| series(signals, sig::estimate(name, i), format!("{} ({name})", names.state[i].name))).collect(),
-                            error: (0..layout.n).map(|i| series(signals, sig::error(name, i), format!("e{} ({name})", i + 1))).collect(),
-                            residual: (0..layout.p).map(|j| series(signals, sig::residual(name, j), format!("r{} ({name})", j + 1))).collect(),
-                            log_error: series(signals, sig::log_error(name), format!("log10 max|e| ({name})")),
+                            xhat: (0..layout.n)
+                                .map(|i| {
+                                    series(
+                                        signals,
+                                        sig::estimate(name, i),
+                                        format!("{} ({name})", names.state[i].name),
+                                    )
+                                })
+                                .collect(),
+                            error: (0..layout.n)
+                                .map(|i| {
+                                    series(
+                                        signals,
+                                        sig::error(name, i),
+                                        format!("e{} ({name})", i + 1),
+                                    )
+                                })
+                                .collect(),
+                            residual: (0..layout.p)
+                                .map(|j| {
+                                    series(
+                                        signals,
+                                        sig::residual(name, j),
+                                        format!("r{} ({name})", j + 1),
+                                    )
+                                })
+                                .collect(),
+                            log_error: series(
+                                signals,
+                                sig::log_error(name),
+                                format!("log10 max|e| ({name})"),
+                            ),
                             what: match (estimates[i], estimates_late) {
-                                (Some(_), Some(g)) => (0..layout.q).map(|k| series(g, sig::input_estimate(name, k), format!("{} estimate ({name})", names.disturbance[k].name))).collect(),
+                                (Some(_), Some(g)) => (0..layout.q)
+                                    .map(|k| {
+                                        series(
+                                            g,
+                                            sig::input_estimate(name, k),
+                                            format!(
+                                                "{} estimate ({name})",
+                                                names.disturbance[k].name
+                                            ),
+                                        )
+                                    })
+                                    .collect(),
                                 _ => Vec::new(),
                             },
                         })
@@ -265,7 +408,18 @@ impl Session {
                         b.members
                             .iter()
                             .enumerate()
-                            .map(|(i, mb)| mb.outputs.iter().map(|&j| series(signals, sig::member_residual(d, i, j), format!("r{} {} ({d})", i + 1, names.output[j].name))).collect())
+                            .map(|(i, mb)| {
+                                mb.outputs
+                                    .iter()
+                                    .map(|&j| {
+                                        series(
+                                            signals,
+                                            sig::member_residual(d, i, j),
+                                            format!("r{} {} ({d})", i + 1, names.output[j].name),
+                                        )
+                                    })
+                                    .collect()
+                            })
                             .collect()
                     })
                     .collect();
@@ -276,29 +430,85 @@ impl Session {
                         let per = (0..b.members.len())
                             .map(|i| {
                                 [
-                                    series(signals, sig::evaluation(d, i), format!("J{} ({d})", i + 1)),
-                                    series(signals, sig::threshold(d, i), format!("threshold {} ({d})", i + 1)),
-                                    series(signals, sig::alarm(d, i), format!("alarm {} ({d})", i + 1)),
+                                    series(
+                                        signals,
+                                        sig::evaluation(d, i),
+                                        format!("J{} ({d})", i + 1),
+                                    ),
+                                    series(
+                                        signals,
+                                        sig::threshold(d, i),
+                                        format!("threshold {} ({d})", i + 1),
+                                    ),
+                                    series(
+                                        signals,
+                                        sig::alarm(d, i),
+                                        format!("alarm {} ({d})", i + 1),
+                                    ),
                                 ]
                             })
                             .collect();
-                        (per, series(signals, sig::isolated(d), format!("isolated channel ({d})")))
+                        (
+                            per,
+                            series(signals, sig::isolated(d), format!("isolated channel ({d})")),
+                        )
                     })
                     .collect();
                 let faults = s
                     .faults
                     .iter()
-                    .map(|f| [series(signals, sig::fault_active(&f.name), format!("{} active", f.name)), series(signals, sig::fault_value(&f.name), format!("{} value", f.name))])
+                    .map(|f| {
+                        [
+                            series(
+                                signals,
+                                sig::fault_active(&f.name),
+                                format!("{} active", f.name),
+                            ),
+                            series(
+                                signals,
+                                sig::fault_value(&f.name),
+                                format!("{} value", f.name),
+                            ),
+                        ]
+                    })
                     .collect();
                 let step_latency = series(latency, "/latency/step".into(), "step".into());
                 if let Some(g) = overrun_group {
                     overrun = Some((g, series(g, "/latency/overrun".into(), "overrun".into())));
                 }
-                let hop_ids = if measures_hops { hops.iter().map(|h| series(latency, hop_entity(h), h.clone())).collect() } else { Vec::new() };
+                let hop_ids = if measures_hops {
+                    hops.iter()
+                        .map(|h| series(latency, hop_entity(h), h.clone()))
+                        .collect()
+                } else {
+                    Vec::new()
+                };
                 for p in select.unmatched(paths.iter().map(String::as_str)) {
-                    eprintln!("warning: --record {}: matches no signal of this run, so records nothing", scenario::quoted(&p));
+                    eprintln!(
+                        "warning: --record {}: matches no signal of this run, so records nothing",
+                        scenario::quoted(&p)
+                    );
                 }
-                Some((sink, Channels { signals, estimates_late, latency, x, y, w, v, r, u, observers, members, decisions, faults, step_latency, hops: hop_ids }))
+                Some((
+                    sink,
+                    Channels {
+                        signals,
+                        estimates_late,
+                        latency,
+                        x,
+                        y,
+                        w,
+                        v,
+                        r,
+                        u,
+                        observers,
+                        members,
+                        decisions,
+                        faults,
+                        step_latency,
+                        hops: hop_ids,
+                    },
+                ))
             }
             None => None,
         };
@@ -306,12 +516,24 @@ impl Session {
         if let Some(op) = &s.operating_point {
             metrics.residual_offset(op.output_offset(&s.model.c));
         }
-        if let Some(first) = s.faults.iter().flat_map(|f| f.active_steps(s.dt)).map(|(on, _)| on).min() {
+        if let Some(first) = s
+            .faults
+            .iter()
+            .flat_map(|f| f.active_steps(s.dt))
+            .map(|(on, _)| on)
+            .min()
+        {
             metrics.fault_free_until(first, s.dt);
         }
         for (o, e) in estimates.iter().enumerate() {
             if let Some(e) = e {
-                metrics.estimate_inputs(o, e.w.clone(), &e.w_c_phi, &e.w_c_gamma_b, e.offset.clone());
+                metrics.estimate_inputs(
+                    o,
+                    e.w.clone(),
+                    &e.w_c_phi,
+                    &e.w_c_gamma_b,
+                    e.offset.clone(),
+                );
             }
         }
         Ok(Session {
@@ -344,10 +566,18 @@ impl Session {
         let mut hop_values = std::mem::take(&mut self.hop_values);
         hop_values.clear();
         for i in 0..nobs {
-            hop_values.push((i, row.xhat_hdr[i].taken_ns.saturating_sub(row.plant_hdr.sent_ns)));
+            hop_values.push((
+                i,
+                row.xhat_hdr[i]
+                    .taken_ns
+                    .saturating_sub(row.plant_hdr.sent_ns),
+            ));
         }
         if let Some(c) = self.controller_observer {
-            hop_values.push((nobs, row.u_hdr.taken_ns.saturating_sub(row.xhat_hdr[c].sent_ns)));
+            hop_values.push((
+                nobs,
+                row.u_hdr.taken_ns.saturating_sub(row.xhat_hdr[c].sent_ns),
+            ));
         }
         // The previous step ends when this row's plant sample says when it had u_{k−1}.
         let mut step_ns = None;
@@ -378,7 +608,8 @@ impl Session {
         done.extend_from_slice(&self.pending_hops);
         done.extend(hop_values.iter().filter(|&&(i, _)| i > nobs));
         self.pending_hops.clear();
-        self.pending_hops.extend(hop_values.iter().filter(|&&(i, _)| i <= nobs));
+        self.pending_hops
+            .extend(hop_values.iter().filter(|&&(i, _)| i <= nobs));
         let pushed = self.push(row, step_ns.map(|ns| (row.k - 1, ns)), &done);
         self.hop_values = hop_values;
         self.done_hops = done;
@@ -388,15 +619,24 @@ impl Session {
     /// Closes the timing of the last step K − 1 with the plant's end sample (step K, published
     /// after the run, carrying when the plant had u_{K−1}): its step time and controller→plant hop.
     pub fn close_last(&mut self, end: &lockstep::Header) -> Result<(), LaunchError> {
-        let Some((plant_sent, ctrl_sent)) = self.prev.take() else { return Ok(()) };
+        let Some((plant_sent, ctrl_sent)) = self.prev.take() else {
+            return Ok(());
+        };
         self.step_ended(end.step.saturating_sub(1), end.taken_ns)?;
         let step_ns = end.taken_ns.saturating_sub(plant_sent);
         self.latency.step(step_ns);
-        let late = self.controller_observer.map(|_| (self.metrics.observers.len() + 1, end.taken_ns.saturating_sub(ctrl_sent)));
+        let late = self.controller_observer.map(|_| {
+            (
+                self.metrics.observers.len() + 1,
+                end.taken_ns.saturating_sub(ctrl_sent),
+            )
+        });
         if let Some((i, ns)) = late {
             self.latency.hop(i, ns);
         }
-        let Some((sink, ch)) = &mut self.sink else { return Ok(()) };
+        let Some((sink, ch)) = &mut self.sink else {
+            return Ok(());
+        };
         let k = end.step.saturating_sub(1);
         sink.row(ch.latency, k, k as f64 * self.dt);
         sink.push(ch.step_latency, step_ns as f64);
@@ -409,7 +649,9 @@ impl Session {
     /// Step k of a paced run ended at `end_ns` (CLOCK_MONOTONIC): late if after its deadline
     /// t₀ + (k + 1)·period. In-process, the loop sets t₀ with [`Session::pace_start`].
     pub fn step_ended(&mut self, k: u64, end_ns: u64) -> Result<(), LaunchError> {
-        let Some(p) = &mut self.pace else { return Ok(()) };
+        let Some(p) = &mut self.pace else {
+            return Ok(());
+        };
         let Some(t0) = p.t0 else { return Ok(()) };
         let late = end_ns.saturating_sub(t0 + (k + 1) * p.period_ns);
         p.steps += 1;
@@ -433,17 +675,31 @@ impl Session {
     }
 
     /// Records one step of the in-process loop, with its step time when it was measured.
-    pub fn record_in_process(&mut self, row: &StepRow, step_ns: Option<u64>) -> Result<(), LaunchError> {
+    pub fn record_in_process(
+        &mut self,
+        row: &StepRow,
+        step_ns: Option<u64>,
+    ) -> Result<(), LaunchError> {
         if let Some(ns) = step_ns {
             self.latency.step(ns);
         }
         self.push(row, step_ns.map(|ns| (row.k, ns)), &[])
     }
 
-    fn push(&mut self, row: &StepRow, step_ns: Option<(u64, u64)>, hops: &[(usize, u64)]) -> Result<(), LaunchError> {
+    fn push(
+        &mut self,
+        row: &StepRow,
+        step_ns: Option<(u64, u64)>,
+        hops: &[(usize, u64)],
+    ) -> Result<(), LaunchError> {
         self.metrics.push(row);
         if self.diverged.is_none() {
-            self.diverged = estimate_divergence(row, &row.plant[self.layout.x()], &self.observer_names, self.state_bound);
+            self.diverged = estimate_divergence(
+                row,
+                &row.plant[self.layout.x()],
+                &self.observer_names,
+                self.state_bound,
+            );
         }
         let lay = self.layout;
         for m in &mut self.monitors {
@@ -456,7 +712,9 @@ impl Session {
         if let Some(p) = &mut self.progress {
             p.tick(self.steps);
         }
-        let Some((sink, ch)) = &mut self.sink else { return Ok(()) };
+        let Some((sink, ch)) = &mut self.sink else {
+            return Ok(());
+        };
         let (k, t) = (row.k, row.t);
         sink.row(ch.signals, k, t);
         let put = |sink: &mut RrdSink, ids: &[SeriesId], vals: &[f64]| {
@@ -476,11 +734,18 @@ impl Session {
             put(sink, &oc.error, &self.metrics.error[o]);
             put(sink, &oc.residual, &self.metrics.residual[o]);
             // max_i |e_i| of this step, as the figures took it.
-            sink.push(oc.log_error, sig::log10_floored(self.metrics.observers[o].final_abs_error));
+            sink.push(
+                oc.log_error,
+                sig::log10_floored(self.metrics.observers[o].final_abs_error),
+            );
         }
         // ŵ_{k−1}, completed by this row, at the step it estimates.
         if let Some(g) = ch.estimates_late
-            && self.metrics.what.iter().any(|w| w.as_ref().is_some_and(|w| w.ready))
+            && self
+                .metrics
+                .what
+                .iter()
+                .any(|w| w.as_ref().is_some_and(|w| w.ready))
         {
             sink.row(g, k - 1, (k - 1) as f64 * self.dt);
             for (oc, what) in ch.observers.iter().zip(&self.metrics.what) {
@@ -489,7 +754,9 @@ impl Session {
                 }
             }
         }
-        for ((m, members), (decisions, isolated)) in self.monitors.iter().zip(&ch.members).zip(&ch.decisions) {
+        for ((m, members), (decisions, isolated)) in
+            self.monitors.iter().zip(&ch.members).zip(&ch.decisions)
+        {
             for (i, ids) in members.iter().enumerate() {
                 put(sink, ids, &m.residuals[i]);
                 let [e, th, al] = decisions[i];
@@ -532,10 +799,17 @@ impl Session {
             steps: p.steps,
             overruns: p.overruns,
             max_lateness_us: p.max_late_ns as f64 / 1000.0,
-            paced_wall_s: p.t0.map_or(0.0, |t0| p.last_end.saturating_sub(t0) as f64 * 1e-9),
+            paced_wall_s: p
+                .t0
+                .map_or(0.0, |t0| p.last_end.saturating_sub(t0) as f64 * 1e-9),
             scheduled_s: p.steps as f64 * p.period_ns as f64 * 1e-9,
         });
-        Ok(Finished { metrics: self.metrics, latency: self.latency, digest, diagnosis, realtime })
+        Ok(Finished {
+            metrics: self.metrics,
+            latency: self.latency,
+            digest,
+            diagnosis,
+            realtime,
+        })
     }
 }
-

@@ -13,14 +13,14 @@ mod outcome;
 mod stats;
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use serde::Serialize;
 
 pub use outcome::Failed;
-pub use stats::{spread, Spread};
+pub use stats::{Spread, spread};
 
 use crate::error::LaunchError;
 use crate::plan::Plan;
@@ -140,18 +140,32 @@ fn one(s: &Scenario, plan: &Plan, seed: u64, opts: &SweepOptions, record: bool) 
     if record {
         s.name = format!("{}-seed{seed}", s.name);
     }
-    let outcome = run::run(&s, plan, &Options::quiet(&opts.out, opts.mode, opts.wait, record))?;
+    let outcome = run::run(
+        &s,
+        plan,
+        &Options::quiet(&opts.out, opts.mode, opts.wait, record),
+    )?;
     if let Stop::Interrupted(sig) = outcome.stop {
-        return Err(LaunchError::Interrupted(format!("{}: sweep interrupted by {sig}", s.name)));
+        return Err(LaunchError::Interrupted(format!(
+            "{}: sweep interrupted by {sig}",
+            s.name
+        )));
     }
     Ok((outcome.summary, outcome.stop))
 }
 
 /// How bad a realisation went: wrong isolations, then false alarms, then the longest delay.
 fn badness(s: &Summary) -> (usize, u64, u64) {
-    let Some(d) = &s.diagnosis else { return (0, 0, 0) };
+    let Some(d) = &s.diagnosis else {
+        return (0, 0, 0);
+    };
     let wrong = d.faults.iter().filter(|f| !f.correct).count();
-    let delay = d.faults.iter().map(|f| f.delay.map_or(u64::MAX, |x| (x * 1e9) as u64)).max().unwrap_or(0);
+    let delay = d
+        .faults
+        .iter()
+        .map(|f| f.delay.map_or(u64::MAX, |x| (x * 1e9) as u64))
+        .max()
+        .unwrap_or(0);
     (wrong, d.false_alarms, delay)
 }
 
@@ -159,30 +173,41 @@ fn badness(s: &Summary) -> (usize, u64, u64) {
 pub fn sweep(s: &Scenario, plan: &Plan, opts: &SweepOptions) -> Result<SweepSummary, LaunchError> {
     crate::limits::sweep_runs(opts.runs)?;
     crate::limits::jobs(opts.jobs)?;
-    let jobs = if opts.mode == Mode::Processes { 1 } else { opts.jobs.clamp(1, opts.runs) };
+    let jobs = if opts.mode == Mode::Processes {
+        1
+    } else {
+        opts.jobs.clamp(1, opts.runs)
+    };
     run::budget::check_memory(s, plan, jobs as u64)?;
-    std::fs::create_dir_all(&opts.out).map_err(|e| LaunchError::BadInput(format!("{}: cannot create the output directory: {e}", opts.out.display())))?;
+    std::fs::create_dir_all(&opts.out).map_err(|e| {
+        LaunchError::BadInput(format!(
+            "{}: cannot create the output directory: {e}",
+            opts.out.display()
+        ))
+    })?;
     let start = Instant::now();
     let next = AtomicUsize::new(0);
     let results: Mutex<Vec<Option<Ran>>> = Mutex::new((0..opts.runs).map(|_| None).collect());
     let bar = progress_bar(opts.runs);
     std::thread::scope(|scope| {
         for _ in 0..jobs {
-            scope.spawn(|| loop {
-                let i = next.fetch_add(1, Ordering::Relaxed);
-                if i >= opts.runs || run::interrupt::received().is_some() {
-                    break;
-                }
-                let r = one(s, plan, opts.seed.wrapping_add(i as u64), opts, false);
-                // A realisation that could not run at all (or was interrupted) ends the sweep; one
-                // that ran and failed is counted, and the others go on.
-                let fatal = r.is_err();
-                results.lock().expect("no worker panics")[i] = Some(r);
-                if let Some(b) = &bar {
-                    b.inc(1);
-                }
-                if fatal {
-                    next.store(opts.runs, Ordering::Relaxed);
+            scope.spawn(|| {
+                loop {
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    if i >= opts.runs || run::interrupt::received().is_some() {
+                        break;
+                    }
+                    let r = one(s, plan, opts.seed.wrapping_add(i as u64), opts, false);
+                    // A realisation that could not run at all (or was interrupted) ends the sweep; one
+                    // that ran and failed is counted, and the others go on.
+                    let fatal = r.is_err();
+                    results.lock().expect("no worker panics")[i] = Some(r);
+                    if let Some(b) = &bar {
+                        b.inc(1);
+                    }
+                    if fatal {
+                        next.store(opts.runs, Ordering::Relaxed);
+                    }
                 }
             });
         }
@@ -192,7 +217,12 @@ pub fn sweep(s: &Scenario, plan: &Plan, opts: &SweepOptions) -> Result<SweepSumm
     }
     let interrupted = run::interrupt::received();
     let (mut completed, mut failed, mut finished) = (Vec::new(), Vec::new(), 0);
-    for (i, r) in results.into_inner().expect("no worker panics").into_iter().enumerate() {
+    for (i, r) in results
+        .into_inner()
+        .expect("no worker panics")
+        .into_iter()
+        .enumerate()
+    {
         let seed = opts.seed.wrapping_add(i as u64);
         match r {
             None => {}
@@ -232,7 +262,9 @@ fn progress_bar(total: usize) -> Option<indicatif::ProgressBar> {
     use std::io::IsTerminal;
     std::io::stderr().is_terminal().then(|| {
         let b = indicatif::ProgressBar::new(total as u64);
-        if let Ok(style) = indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} realisations, {eta} left") {
+        if let Ok(style) =
+            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} realisations, {eta} left")
+        {
             b.set_style(style);
         }
         b
@@ -241,14 +273,23 @@ fn progress_bar(total: usize) -> Option<indicatif::ProgressBar> {
 
 /// The distributions over the completed realisations' summaries (with their seeds), in seed
 /// order; `finished`, `failed` and `partial` are the caller's.
-pub fn gather(s: &Scenario, opts: &SweepOptions, jobs: usize, completed: &[(u64, Summary)]) -> SweepSummary {
+pub fn gather(
+    s: &Scenario,
+    opts: &SweepOptions,
+    jobs: usize,
+    completed: &[(u64, Summary)],
+) -> SweepSummary {
     let runs: Vec<&Summary> = completed.iter().map(|(_, r)| r).collect();
-    let diag: Vec<&diagnosis::Diagnosis> = runs.iter().filter_map(|r| r.diagnosis.as_ref()).collect();
+    let diag: Vec<&diagnosis::Diagnosis> =
+        runs.iter().filter_map(|r| r.diagnosis.as_ref()).collect();
     let faults = s
         .faults
         .iter()
         .map(|f| {
-            let figs: Vec<&diagnosis::FaultFigure> = diag.iter().filter_map(|d| d.faults.iter().find(|x| x.name == f.name)).collect();
+            let figs: Vec<&diagnosis::FaultFigure> = diag
+                .iter()
+                .filter_map(|d| d.faults.iter().find(|x| x.name == f.name))
+                .collect();
             let delays: Vec<f64> = figs.iter().filter_map(|x| x.delay).collect();
             let correct = figs.iter().filter(|x| x.correct).count();
             let fractions: Vec<f64> = figs.iter().filter_map(|x| x.isolated_fraction).collect();
@@ -285,13 +326,22 @@ pub fn gather(s: &Scenario, opts: &SweepOptions, jobs: usize, completed: &[(u64,
         }
     }
     for x in &mut residuals {
-        x.measured_false_alarm = (x.fault_free_steps > 0).then(|| x.exceedances as f64 / x.fault_free_steps as f64);
+        x.measured_false_alarm =
+            (x.fault_free_steps > 0).then(|| x.exceedances as f64 / x.fault_free_steps as f64);
     }
     let tail = s
         .observers
         .iter()
         .map(|o| {
-            let v: Vec<f64> = runs.iter().filter_map(|r| r.observers.iter().find(|x| x.name == o.name).and_then(|x| x.tail_max_abs_error)).collect();
+            let v: Vec<f64> = runs
+                .iter()
+                .filter_map(|r| {
+                    r.observers
+                        .iter()
+                        .find(|x| x.name == o.name)
+                        .and_then(|x| x.tail_max_abs_error)
+                })
+                .collect();
             (o.name.clone(), spread(&v))
         })
         .collect();
@@ -303,7 +353,10 @@ pub fn gather(s: &Scenario, opts: &SweepOptions, jobs: usize, completed: &[(u64,
         partial: false,
         isolated_fraction: s.isolated_fraction,
         interrupted_by: None,
-        seeds: [opts.seed, opts.seed.wrapping_add(opts.runs.saturating_sub(1) as u64)],
+        seeds: [
+            opts.seed,
+            opts.seed.wrapping_add(opts.runs.saturating_sub(1) as u64),
+        ],
         mode: opts.mode.name().into(),
         jobs,
         wall_s: 0.0,
@@ -312,7 +365,8 @@ pub fn gather(s: &Scenario, opts: &SweepOptions, jobs: usize, completed: &[(u64,
         false_alarms,
         runs_with_false_alarms: diag.iter().filter(|d| d.false_alarms > 0).count(),
         fault_free_time_s: fault_free,
-        false_alarm_rate_per_hour: (fault_free > 0.0).then(|| false_alarms as f64 / fault_free * 3600.0),
+        false_alarm_rate_per_hour: (fault_free > 0.0)
+            .then(|| false_alarms as f64 / fault_free * 3600.0),
         residuals,
         tail_max_abs_error: tail,
         kept: Vec::new(),
@@ -322,7 +376,13 @@ pub fn gather(s: &Scenario, opts: &SweepOptions, jobs: usize, completed: &[(u64,
 impl SweepSummary {
     /// The sweep's failure, if it is one: interrupted, a realisation failed or diverged.
     pub fn verdict(&self) -> Option<LaunchError> {
-        outcome::verdict(&self.scenario, self.requested, self.finished, &self.failed, self.interrupted_by)
+        outcome::verdict(
+            &self.scenario,
+            self.requested,
+            self.finished,
+            &self.failed,
+            self.interrupted_by,
+        )
     }
 
     /// Writes `<out>/<name>.sweep.json` (atomically).
@@ -335,13 +395,39 @@ impl SweepSummary {
 
     /// The table printed after a sweep.
     pub fn table(&self) -> String {
-        let f = |s: &Option<Spread>| s.as_ref().map_or_else(|| "—".to_string(), |s| format!("{:.4} / {:.4} / {:.4} / {:.4}", s.min, s.median, s.p95, s.max));
-        let mut t = format!("{} sweep: {} realisations (seeds {}–{}), {}, {} job(s), {:.1} s wall\n", self.scenario, self.requested, self.seeds[0], self.seeds[1], self.mode, self.jobs, self.wall_s);
+        let f = |s: &Option<Spread>| {
+            s.as_ref().map_or_else(
+                || "—".to_string(),
+                |s| {
+                    format!(
+                        "{:.4} / {:.4} / {:.4} / {:.4}",
+                        s.min, s.median, s.p95, s.max
+                    )
+                },
+            )
+        };
+        let mut t = format!(
+            "{} sweep: {} realisations (seeds {}–{}), {}, {} job(s), {:.1} s wall\n",
+            self.scenario,
+            self.requested,
+            self.seeds[0],
+            self.seeds[1],
+            self.mode,
+            self.jobs,
+            self.wall_s
+        );
         if self.partial {
-            t += &format!("  PARTIAL: interrupted after {} of {} realisations\n", self.finished, self.requested);
+            t += &format!(
+                "  PARTIAL: interrupted after {} of {} realisations\n",
+                self.finished, self.requested
+            );
         }
         if self.runs != self.requested {
-            t += &format!("  statistics of {} completed realisation(s); {} failed\n", self.runs, self.failed.len());
+            t += &format!(
+                "  statistics of {} completed realisation(s); {} failed\n",
+                self.runs,
+                self.failed.len()
+            );
         }
         for x in &self.faults {
             t += &format!(
@@ -351,7 +437,10 @@ impl SweepSummary {
                 self.runs,
                 f(&x.detection_delay),
                 lti::eig::sig(100.0 * self.isolated_fraction),
-                x.isolation_accuracy.map_or_else(|| "—".to_string(), |a| format!("{:.1} % of the realisations", 100.0 * a)),
+                x.isolation_accuracy.map_or_else(
+                    || "—".to_string(),
+                    |a| format!("{:.1} % of the realisations", 100.0 * a)
+                ),
                 x.first_isolation_correct,
                 self.runs,
                 f(&x.isolated_fraction)
@@ -361,16 +450,28 @@ impl SweepSummary {
             "  false alarms: {} over {:.1} s fault-free ({} per hour; {} realisation(s) with one)\n",
             self.false_alarms,
             self.fault_free_time_s,
-            self.false_alarm_rate_per_hour.map_or_else(|| "—".to_string(), |r| format!("{r:.3}")),
+            self.false_alarm_rate_per_hour
+                .map_or_else(|| "—".to_string(), |r| format!("{r:.3}")),
             self.runs_with_false_alarms
         );
         for r in &self.residuals {
-            let asked = r.asked_false_alarm.map_or_else(|| "—".to_string(), |a| format!("{a:.1e}"));
-            let measured = r.measured_false_alarm.map_or_else(|| "—".to_string(), |m| format!("{m:.3e}"));
-            t += &format!("  residual {:<12} P(J > threshold) asked {asked}, measured {measured} ({} of {} fault-free samples)\n", r.residual, r.exceedances, r.fault_free_steps);
+            let asked = r
+                .asked_false_alarm
+                .map_or_else(|| "—".to_string(), |a| format!("{a:.1e}"));
+            let measured = r
+                .measured_false_alarm
+                .map_or_else(|| "—".to_string(), |m| format!("{m:.3e}"));
+            t += &format!(
+                "  residual {:<12} P(J > threshold) asked {asked}, measured {measured} ({} of {} fault-free samples)\n",
+                r.residual, r.exceedances, r.fault_free_steps
+            );
         }
         for (name, s) in &self.tail_max_abs_error {
-            t += &format!("  observer {:<12} tail max|e| min/median/p95/max {}\n", name, f(s));
+            t += &format!(
+                "  observer {:<12} tail max|e| min/median/p95/max {}\n",
+                name,
+                f(s)
+            );
         }
         for x in &self.failed {
             t += &format!("  seed {} {}: {}\n", x.seed, x.kind, x.reason);

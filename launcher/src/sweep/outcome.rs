@@ -34,17 +34,39 @@ impl Failed {
 /// The sweep's exit, from how its realisations ended (README "Commands"): interrupted (130,
 /// 129 or 131 as for a run) before any failure, then a failed realisation (3), then a diverged
 /// one (4); `None` when every realisation asked for completed.
-pub fn verdict(name: &str, requested: usize, finished: usize, failed: &[Failed], interrupted: Option<&str>) -> Option<LaunchError> {
+pub fn verdict(
+    name: &str,
+    requested: usize,
+    finished: usize,
+    failed: &[Failed],
+    interrupted: Option<&str>,
+) -> Option<LaunchError> {
     if let Some(sig) = interrupted {
-        return Some(LaunchError::Interrupted(format!("{name}: sweep interrupted by {sig} after {finished} of {requested} realisations; their statistics are written, marked partial")));
+        return Some(LaunchError::Interrupted(format!(
+            "{name}: sweep interrupted by {sig} after {finished} of {requested} realisations; their statistics are written, marked partial"
+        )));
     }
     let count = |kind: &str| failed.iter().filter(|f| f.kind == kind).count();
-    let first = |kind: &str| failed.iter().find(|f| f.kind == kind).map(|f| format!("seed {}: {}", f.seed, f.reason)).unwrap_or_default();
+    let first = |kind: &str| {
+        failed
+            .iter()
+            .find(|f| f.kind == kind)
+            .map(|f| format!("seed {}: {}", f.seed, f.reason))
+            .unwrap_or_default()
+    };
     if count("failed") > 0 {
-        return Some(LaunchError::Component(format!("{name}: {} of {requested} realisations failed (first, {})", count("failed"), first("failed"))));
+        return Some(LaunchError::Component(format!(
+            "{name}: {} of {requested} realisations failed (first, {})",
+            count("failed"),
+            first("failed")
+        )));
     }
     if count("diverged") > 0 {
-        return Some(LaunchError::Diverged(format!("{name}: {} of {requested} realisations diverged (first, {})", count("diverged"), first("diverged"))));
+        return Some(LaunchError::Diverged(format!(
+            "{name}: {} of {requested} realisations diverged (first, {})",
+            count("diverged"),
+            first("diverged")
+        )));
     }
     None
 }
@@ -57,13 +79,31 @@ mod tests {
     #[test]
     fn failures_outrank_divergence_and_completion_is_silent() {
         let f = |seed, stop: Stop| Failed::of(seed, &stop).unwrap();
-        let both = [f(3, Stop::Diverged("x".into())), f(5, Stop::Failed("observer 'bad' (pid 1, stopped) published no sample".into()))];
+        let both = [
+            f(3, Stop::Diverged("x".into())),
+            f(
+                5,
+                Stop::Failed("observer 'bad' (pid 1, stopped) published no sample".into()),
+            ),
+        ];
         let e = verdict("s", 10, 10, &both, None).unwrap();
         assert_eq!(e.exit_code(), EXIT_COMPONENT);
-        assert!(e.to_string().contains("1 of 10 realisations failed (first, seed 5: observer 'bad'"), "{e}");
-        assert_eq!(verdict("s", 10, 10, &both[..1], None).unwrap().exit_code(), EXIT_DIVERGED);
+        assert!(
+            e.to_string()
+                .contains("1 of 10 realisations failed (first, seed 5: observer 'bad'"),
+            "{e}"
+        );
+        assert_eq!(
+            verdict("s", 10, 10, &both[..1], None).unwrap().exit_code(),
+            EXIT_DIVERGED
+        );
         assert!(verdict("s", 10, 10, &[], None).is_none());
         assert!(Failed::of(1, &Stop::Completed).is_none());
-        assert!(verdict("s", 10, 4, &both, Some("SIGTERM")).unwrap().to_string().contains("after 4 of 10 realisations"));
+        assert!(
+            verdict("s", 10, 4, &both, Some("SIGTERM"))
+                .unwrap()
+                .to_string()
+                .contains("after 4 of 10 realisations")
+        );
     }
 }

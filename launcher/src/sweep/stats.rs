@@ -25,7 +25,13 @@ pub fn spread(values: &[f64]) -> Option<Spread> {
     let mut v = values.to_vec();
     v.sort_by(f64::total_cmp);
     let rank = |q: f64| v[((q * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1];
-    Some(Spread { count: v.len(), min: v[0], median: rank(0.5), p95: rank(0.95), max: v[v.len() - 1] })
+    Some(Spread {
+        count: v.len(),
+        min: v[0],
+        median: rank(0.5),
+        p95: rank(0.95),
+        max: v[v.len() - 1],
+    })
 }
 
 #[cfg(test)]
@@ -36,7 +42,10 @@ mod tests {
     fn nearest_rank_percentiles() {
         let v: Vec<f64> = (1..=20).map(f64::from).rev().collect();
         let s = spread(&v).unwrap();
-        assert_eq!((s.min, s.median, s.p95, s.max, s.count), (1.0, 10.0, 19.0, 20.0, 20));
+        assert_eq!(
+            (s.min, s.median, s.p95, s.max, s.count),
+            (1.0, 10.0, 19.0, 20.0, 20)
+        );
         assert!(spread(&[]).is_none());
     }
 }

@@ -114,7 +114,10 @@ pub struct ComponentConfig {
 impl Iceoryx2Place {
     /// The prefix and root of `space` (PROTOCOL.md §2).
     pub fn of(space: &crate::RunSpace) -> Self {
-        Iceoryx2Place { prefix: format!("uio{}_", space.id()), root: format!("{}/", space.iox2_root().display()) }
+        Iceoryx2Place {
+            prefix: format!("uio{}_", space.id()),
+            root: format!("{}/", space.iox2_root().display()),
+        }
     }
 }
 
@@ -137,7 +140,10 @@ impl ComponentConfig {
             ("UIO_NAME", self.name.clone().into()),
             ("UIO_ROLE", self.role.name().into()),
             ("UIO_CONFIG", space.config_path(&self.file()).into()),
-            (crate::RUNS_DIR_ENV, space.dir().parent().unwrap_or(space.dir()).into()),
+            (
+                crate::RUNS_DIR_ENV,
+                space.dir().parent().unwrap_or(space.dir()).into(),
+            ),
         ]
     }
 

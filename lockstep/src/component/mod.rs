@@ -26,7 +26,7 @@ pub use config::{ComponentConfig, Iceoryx2Place, PublishSpec, ReadSpec, Role};
 pub use runner::{Inputs, Runner};
 
 use crate::error::LockstepError;
-use crate::handshake::{die_with_parent, parse_launch, ready_then_wait_for_go, EXIT_USAGE};
+use crate::handshake::{EXIT_USAGE, die_with_parent, parse_launch, ready_then_wait_for_go};
 use crate::port::Bus;
 use crate::sample::PROTOCOL_VERSION;
 
@@ -57,7 +57,10 @@ pub struct StepError {
 impl StepError {
     /// A failure with [`EXIT_FAILED`].
     pub fn failed(message: impl Into<String>) -> Self {
-        StepError { code: EXIT_FAILED, message: message.into() }
+        StepError {
+            code: EXIT_FAILED,
+            message: message.into(),
+        }
     }
 
     /// A transport failure.
@@ -71,14 +74,25 @@ impl StepError {
 pub fn read_config() -> Result<ComponentConfig, String> {
     match std::env::var("UIO_PROTOCOL") {
         Ok(v) if v.trim() == PROTOCOL_VERSION.to_string() => {}
-        Ok(v) => return Err(format!("the run speaks protocol version {v}, this component {PROTOCOL_VERSION}")),
-        Err(_) => return Err("UIO_PROTOCOL is not set: components are started by the launcher".into()),
+        Ok(v) => {
+            return Err(format!(
+                "the run speaks protocol version {v}, this component {PROTOCOL_VERSION}"
+            ));
+        }
+        Err(_) => {
+            return Err("UIO_PROTOCOL is not set: components are started by the launcher".into());
+        }
     }
     let path = std::env::var_os("UIO_CONFIG").ok_or("UIO_CONFIG is not set")?;
-    let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.to_string_lossy()))?;
-    let cfg: ComponentConfig = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.to_string_lossy()))?;
+    let text =
+        std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.to_string_lossy()))?;
+    let cfg: ComponentConfig =
+        serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.to_string_lossy()))?;
     if cfg.protocol != PROTOCOL_VERSION {
-        return Err(format!("configuration of protocol version {}, this component speaks {PROTOCOL_VERSION}", cfg.protocol));
+        return Err(format!(
+            "configuration of protocol version {}, this component speaks {PROTOCOL_VERSION}",
+            cfg.protocol
+        ));
     }
     Ok(cfg)
 }
@@ -90,7 +104,10 @@ pub fn main<C: Component>(kind: &str) -> ExitCode {
 }
 
 /// [`main`] with the command-line arguments given (the launcher's `component` fallback).
-pub fn main_with_args<C: Component>(kind: &str, args: impl IntoIterator<Item = String>) -> ExitCode {
+pub fn main_with_args<C: Component>(
+    kind: &str,
+    args: impl IntoIterator<Item = String>,
+) -> ExitCode {
     ExitCode::from(exit_status::<C>(kind, args) as u8)
 }
 
@@ -105,7 +122,11 @@ pub fn exit_status<C: Component>(kind: &str, args: impl IntoIterator<Item = Stri
             return EXIT_USAGE;
         }
     };
-    let label = if launch.name == kind { kind.to_string() } else { format!("{kind} {}", launch.name) };
+    let label = if launch.name == kind {
+        kind.to_string()
+    } else {
+        format!("{kind} {}", launch.name)
+    };
     let cfg = match read_config() {
         Ok(c) => c,
         Err(msg) => {
@@ -124,7 +145,10 @@ pub fn exit_status<C: Component>(kind: &str, args: impl IntoIterator<Item = Stri
 
 fn live<C: Component>(launch: &crate::Launch, cfg: &ComponentConfig) -> Result<(), StepError> {
     let comp = C::new(cfg).map_err(|e| StepError::failed(format!("configuration: {e}")))?;
-    let wait = cfg.wait.parse().map_err(|e| StepError::failed(format!("configuration: wait: {e}")))?;
+    let wait = cfg
+        .wait
+        .parse()
+        .map_err(|e| StepError::failed(format!("configuration: wait: {e}")))?;
     let bus = Bus::join(&launch.run, &cfg.name, wait).map_err(StepError::transport)?;
     let mut runner = Runner::new(cfg, &bus, comp).map_err(StepError::transport)?;
     ready_then_wait_for_go().map_err(StepError::transport)?;

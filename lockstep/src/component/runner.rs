@@ -20,7 +20,10 @@ impl Inputs {
     /// Zeroed inputs of these lengths.
     pub fn new(lens: impl IntoIterator<Item = usize>) -> Self {
         let values: Vec<Vec<f64>> = lens.into_iter().map(|n| vec![0.0; n]).collect();
-        Inputs { headers: vec![Header::default(); values.len()], values }
+        Inputs {
+            headers: vec![Header::default(); values.len()],
+            values,
+        }
     }
 
     /// The values of input `i`.
@@ -93,10 +96,13 @@ impl<C: Component> Runner<C> {
             done: vec![0; cfg.reads.len()],
             inputs: Inputs::new(cfg.reads.iter().map(|r| r.len)),
             out: vec![0.0; cfg.publishes.len],
-            pace_ns: cfg.pace_s.filter(|p| cfg.role == Role::Plant && p.is_finite() && *p > 0.0).map(|p| {
-                tight_timers();
-                (p * 1e9).round() as u64
-            }),
+            pace_ns: cfg
+                .pace_s
+                .filter(|p| cfg.role == Role::Plant && p.is_finite() && *p > 0.0)
+                .map(|p| {
+                    tight_timers();
+                    (p * 1e9).round() as u64
+                }),
             t0: 0,
         })
     }
@@ -126,13 +132,19 @@ impl<C: Component> Runner<C> {
             _ => {
                 let taken = self.take(k, false)?;
                 // t_k as the first exact input carries it; k·dt with none.
-                let t = self.lags.iter().position(|&l| l == 0).map_or(k as f64 * self.dt, |i| self.inputs.headers[i].sim_time);
+                let t = self
+                    .lags
+                    .iter()
+                    .position(|&l| l == 0)
+                    .map_or(k as f64 * self.dt, |i| self.inputs.headers[i].sim_time);
                 (taken, t)
             }
         };
         self.comp.step(k, &self.inputs, &mut self.out)?;
         self.pace(k);
-        self.outlet.send(k, sim_time, taken_ns, &self.out).map_err(StepError::transport)?;
+        self.outlet
+            .send(k, sim_time, taken_ns, &self.out)
+            .map_err(StepError::transport)?;
         Ok(())
     }
 
@@ -146,7 +158,9 @@ impl<C: Component> Runner<C> {
         let taken_ns = if k == 0 { 0 } else { self.take(k - 1, true)? };
         self.comp.step(k, &self.inputs, &mut self.out)?;
         self.pace(k);
-        self.outlet.send(k, k as f64 * self.dt, taken_ns, &self.out).map_err(StepError::transport)?;
+        self.outlet
+            .send(k, k as f64 * self.dt, taken_ns, &self.out)
+            .map_err(StepError::transport)?;
         Ok(())
     }
 
@@ -164,13 +178,22 @@ impl<C: Component> Runner<C> {
                 taken = Some(taken.map_or(h.received_ns, |t: u64| t.max(h.received_ns)));
                 continue;
             }
-            while let Some(h) = inlet.try_step(self.done[i], out).map_err(StepError::transport)? {
+            while let Some(h) = inlet
+                .try_step(self.done[i], out)
+                .map_err(StepError::transport)?
+            {
                 self.inputs.headers[i] = h;
                 self.done[i] += 1;
             }
-            let need = if all { j + 1 } else { (j + 1).saturating_sub(self.lags[i]) };
+            let need = if all {
+                j + 1
+            } else {
+                (j + 1).saturating_sub(self.lags[i])
+            };
             while self.done[i] < need {
-                self.inputs.headers[i] = inlet.wait_step(self.done[i], out).map_err(StepError::transport)?;
+                self.inputs.headers[i] = inlet
+                    .wait_step(self.done[i], out)
+                    .map_err(StepError::transport)?;
                 self.done[i] += 1;
             }
         }

@@ -39,7 +39,11 @@ fn csv_field(s: &str) -> String {
     if s.starts_with(['=', '+', '-', '@', '\t']) {
         s.insert(0, '\'');
     }
-    if s.contains([',', '"', '\n']) { format!("\"{}\"", s.replace('"', "\"\"")) } else { s }
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s
+    }
 }
 
 /// The files [`export`] writes for `r`, by name.
@@ -59,9 +63,17 @@ pub fn export(r: &Recording, dir: &Path, dt: Option<f64>) -> Result<Vec<PathBuf>
             text += &format!(",{}", csv_field(&m.label));
         }
         text.push('\n');
-        let mut columns: Vec<_> = group.members.iter().map(|m| aligned(&steps, m.series)).collect();
+        let mut columns: Vec<_> = group
+            .members
+            .iter()
+            .map(|m| aligned(&steps, m.series))
+            .collect();
         for &k in &steps {
-            let _ = write!(text, "{k},{}", sim_time(k, dt).map_or(String::new(), |t| format!("{t}")));
+            let _ = write!(
+                text,
+                "{k},{}",
+                sim_time(k, dt).map_or(String::new(), |t| format!("{t}"))
+            );
             for column in &mut columns {
                 text.push(',');
                 if let Some(v) = column.next().flatten() {
@@ -71,7 +83,10 @@ pub fn export(r: &Recording, dir: &Path, dt: Option<f64>) -> Result<Vec<PathBuf>
             text.push('\n');
         }
         let path = dir.join(file_name(&group.path));
-        staged::write(&path, |w| w.write_all(text.as_bytes()).map_err(|e| staged::cannot_write(&path, &e)))?;
+        staged::write(&path, |w| {
+            w.write_all(text.as_bytes())
+                .map_err(|e| staged::cannot_write(&path, &e))
+        })?;
         written.push(path);
     }
     Ok(written)

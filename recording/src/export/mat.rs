@@ -50,16 +50,35 @@ pub enum Class {
 /// The bytes of a matrix element up to its data: the miMATRIX tag, array flags, dimensions,
 /// name, and the tag of the `rows`·`cols` values that follow (8 bytes each, column by column).
 pub fn matrix_header(name: &str, rows: u64, cols: u64, class: Class) -> Result<Vec<u8>, String> {
-    let too_big = || format!("{name}: {rows}×{cols} values do not fit a MAT-file (level 5 holds 4 GiB a variable)");
-    let data = rows.checked_mul(cols).and_then(|n| n.checked_mul(8)).filter(|&n| n <= u32::MAX as u64 - 1024).ok_or_else(too_big)?;
-    let (r, c) = (i32::try_from(rows).map_err(|_| too_big())?, i32::try_from(cols).map_err(|_| too_big())?);
+    let too_big = || {
+        format!(
+            "{name}: {rows}×{cols} values do not fit a MAT-file (level 5 holds 4 GiB a variable)"
+        )
+    };
+    let data = rows
+        .checked_mul(cols)
+        .and_then(|n| n.checked_mul(8))
+        .filter(|&n| n <= u32::MAX as u64 - 1024)
+        .ok_or_else(too_big)?;
+    let (r, c) = (
+        i32::try_from(rows).map_err(|_| too_big())?,
+        i32::try_from(cols).map_err(|_| too_big())?,
+    );
     let (class, data_type) = match class {
         Class::Double => (MX_DOUBLE_CLASS, MI_DOUBLE),
         Class::Int64 => (MX_INT64_CLASS, MI_INT64),
     };
     let mut sub = Vec::new();
-    element(&mut sub, MI_UINT32, &[class.to_le_bytes(), 0u32.to_le_bytes()].concat());
-    element(&mut sub, MI_INT32, &[r.to_le_bytes(), c.to_le_bytes()].concat());
+    element(
+        &mut sub,
+        MI_UINT32,
+        &[class.to_le_bytes(), 0u32.to_le_bytes()].concat(),
+    );
+    element(
+        &mut sub,
+        MI_INT32,
+        &[r.to_le_bytes(), c.to_le_bytes()].concat(),
+    );
     element(&mut sub, MI_INT8, name.as_bytes());
     tag(&mut sub, data_type, data as u32);
     let mut out = Vec::with_capacity(sub.len() + 8);
@@ -84,8 +103,15 @@ fn element(out: &mut Vec<u8>, data_type: u32, data: &[u8]) {
 /// A valid MATLAB identifier for a group: other characters become `_`, a name not starting
 /// with a letter gets an `x` in front.
 pub fn variable_name(group: &str) -> String {
-    let name: String = array_name(group).chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '_' }).collect();
-    if name.starts_with(|c: char| c.is_ascii_alphabetic()) { name } else { format!("x{name}") }
+    let name: String = array_name(group)
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+        .collect();
+    if name.starts_with(|c: char| c.is_ascii_alphabetic()) {
+        name
+    } else {
+        format!("x{name}")
+    }
 }
 
 /// Writes `path`; returns how many variables it holds.
@@ -95,28 +121,41 @@ pub fn export(r: &Recording, path: &Path, dt: Option<f64>) -> Result<usize, Stri
     let steps = all_steps(&groups);
     let rows = steps.len() as u64;
     // Every header first, so that a variable too large is refused before anything is written.
-    let mut headers = vec![matrix_header("step", rows, 1, Class::Int64)?, matrix_header("t", rows, 1, Class::Double)?];
+    let mut headers = vec![
+        matrix_header("step", rows, 1, Class::Int64)?,
+        matrix_header("t", rows, 1, Class::Double)?,
+    ];
     for (g, name) in groups.iter().zip(&names) {
-        headers.push(matrix_header(name, rows, g.members.len() as u64, Class::Double)?);
+        headers.push(matrix_header(
+            name,
+            rows,
+            g.members.len() as u64,
+            Class::Double,
+        )?);
     }
     staged::write(path, |w| {
         let io = |e: std::io::Error| staged::cannot_write(path, &e);
         w.write_all(&file_header()).map_err(io)?;
         let mut headers = headers.iter();
-        let mut next = |w: &mut dyn Write| w.write_all(headers.next().expect("one header per variable")).map_err(io);
+        let mut next = |w: &mut dyn Write| {
+            w.write_all(headers.next().expect("one header per variable"))
+                .map_err(io)
+        };
         next(w)?;
         for &k in &steps {
             w.write_all(&k.to_le_bytes()).map_err(io)?;
         }
         next(w)?;
         for &k in &steps {
-            w.write_all(&sim_time(k, dt).unwrap_or(f64::NAN).to_le_bytes()).map_err(io)?;
+            w.write_all(&sim_time(k, dt).unwrap_or(f64::NAN).to_le_bytes())
+                .map_err(io)?;
         }
         for g in &groups {
             next(w)?;
             for m in &g.members {
                 for v in aligned(&steps, m.series) {
-                    w.write_all(&v.unwrap_or(f64::NAN).to_le_bytes()).map_err(io)?;
+                    w.write_all(&v.unwrap_or(f64::NAN).to_le_bytes())
+                        .map_err(io)?;
                 }
             }
         }
@@ -143,8 +182,14 @@ mod tests {
         let word = |i: usize| u32::from_le_bytes(h[i..i + 4].try_into().unwrap());
         // miMATRIX, counting everything after its tag: 16 flags + 16 dims + 16 name + 8 tag + 48 data.
         assert_eq!((word(0), word(4)), (MI_MATRIX, 16 + 16 + 16 + 8 + 48));
-        assert_eq!((word(8), word(12), word(16), word(20)), (MI_UINT32, 8, MX_DOUBLE_CLASS, 0));
-        assert_eq!((word(24), word(28), word(32), word(36)), (MI_INT32, 8, 3, 2));
+        assert_eq!(
+            (word(8), word(12), word(16), word(20)),
+            (MI_UINT32, 8, MX_DOUBLE_CLASS, 0)
+        );
+        assert_eq!(
+            (word(24), word(28), word(32), word(36)),
+            (MI_INT32, 8, 3, 2)
+        );
         assert_eq!((word(40), word(44)), (MI_INT8, 4));
         assert_eq!(&h[48..56], b"xhat\0\0\0\0");
         assert_eq!((word(56), word(60)), (MI_DOUBLE, 48));

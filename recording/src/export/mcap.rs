@@ -18,7 +18,7 @@ use mcap::records::MessageHeader;
 use mcap::{Compression, WriteOptions};
 
 use super::staged;
-use super::table::{aligned, array_name, labelled, sim_time, Group};
+use super::table::{Group, aligned, array_name, labelled, sim_time};
 use crate::read::Recording;
 
 /// Writes `path`; returns how many channels it holds.
@@ -65,22 +65,39 @@ fn identifier(name: &str) -> String {
         }
     }
     let out = out.trim_matches('_');
-    if out.starts_with(|c: char| c.is_ascii_digit()) { format!("_{out}") } else { out.to_string() }
+    if out.starts_with(|c: char| c.is_ascii_digit()) {
+        format!("_{out}")
+    } else {
+        out.to_string()
+    }
 }
 
 /// The JSON Schema of a group's messages.
 fn schema(g: &Group<'_>, fields: &[String]) -> serde_json::Value {
     let mut properties = serde_json::Map::new();
-    properties.insert("step".into(), serde_json::json!({ "type": "integer", "title": "step" }));
-    properties.insert("sim_time".into(), serde_json::json!({ "type": "number", "title": "sim_time [s]" }));
+    properties.insert(
+        "step".into(),
+        serde_json::json!({ "type": "integer", "title": "step" }),
+    );
+    properties.insert(
+        "sim_time".into(),
+        serde_json::json!({ "type": "number", "title": "sim_time [s]" }),
+    );
     for (m, f) in g.members.iter().zip(fields) {
         properties.insert(f.clone(), serde_json::json!({ "type": ["number", "null"], "title": m.label, "description": m.entity }));
     }
     serde_json::json!({ "type": "object", "title": g.path, "properties": properties, "required": ["step"] })
 }
 
-fn write<W: Write + Seek>(w: W, groups: &[Group<'_>], dt: Option<f64>) -> Result<(), Box<dyn std::error::Error>> {
-    let options = WriteOptions::new().compression(Some(Compression::Zstd)).profile("").library(concat!("uio-observers ", env!("CARGO_PKG_VERSION")));
+fn write<W: Write + Seek>(
+    w: W,
+    groups: &[Group<'_>],
+    dt: Option<f64>,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let options = WriteOptions::new()
+        .compression(Some(Compression::Zstd))
+        .profile("")
+        .library(concat!("uio-observers ", env!("CARGO_PKG_VERSION")));
     let mut out = options.create(w)?;
     // Per group: its channel, JSON keys (quoted, with the colon), steps, and a cursor per member.
     struct Open<'a> {
@@ -94,13 +111,34 @@ fn write<W: Write + Seek>(w: W, groups: &[Group<'_>], dt: Option<f64>) -> Result
     let mut open = Vec::with_capacity(groups.len());
     for (g, steps) in groups.iter().zip(&steps) {
         let fields = field_names(g);
-        let schema_id = out.add_schema(&array_name(&g.path), "jsonschema", serde_json::to_string(&schema(g, &fields))?.as_bytes())?;
+        let schema_id = out.add_schema(
+            &array_name(&g.path),
+            "jsonschema",
+            serde_json::to_string(&schema(g, &fields))?.as_bytes(),
+        )?;
         let channel = out.add_channel(schema_id, &g.path, "json", &BTreeMap::new())?;
-        let keys = fields.iter().map(|f| format!(",{}:", serde_json::to_string(f).unwrap_or_default())).collect();
-        let columns = g.members.iter().map(|m| Box::new(aligned(steps, m.series)) as Box<dyn Iterator<Item = Option<f64>>>).collect();
-        open.push(Open { channel, keys, steps, next: 0, columns });
+        let keys = fields
+            .iter()
+            .map(|f| format!(",{}:", serde_json::to_string(f).unwrap_or_default()))
+            .collect();
+        let columns = g
+            .members
+            .iter()
+            .map(|m| Box::new(aligned(steps, m.series)) as Box<dyn Iterator<Item = Option<f64>>>)
+            .collect();
+        open.push(Open {
+            channel,
+            keys,
+            steps,
+            next: 0,
+            columns,
+        });
     }
-    let all = super::table::union_steps(groups.iter().flat_map(|g| g.members.iter().map(|m| m.series)));
+    let all = super::table::union_steps(
+        groups
+            .iter()
+            .flat_map(|g| g.members.iter().map(|m| m.series)),
+    );
     let mut data = Vec::new();
     for &k in &all {
         let stamp = match dt {
@@ -121,7 +159,12 @@ fn write<W: Write + Seek>(w: W, groups: &[Group<'_>], dt: Option<f64>) -> Result
                 }
             }
             data.push(b'}');
-            let header = MessageHeader { channel_id: o.channel, sequence: o.next as u32, log_time: stamp, publish_time: stamp };
+            let header = MessageHeader {
+                channel_id: o.channel,
+                sequence: o.next as u32,
+                log_time: stamp,
+                publish_time: stamp,
+            };
             out.write_to_known_channel(&header, &data)?;
             o.next += 1;
         }

@@ -31,9 +31,18 @@ pub fn export(r: &Recording, path: &Path, dt: Option<f64>) -> Result<usize, Stri
         let mut zip = ZipWriter::new(w);
         let rows = steps.len() as u64;
         array(&mut zip, "step", &[rows], steps.iter().copied()).map_err(|e| fail(&e))?;
-        array(&mut zip, "t", &[rows], steps.iter().map(|&k| sim_time(k, dt).unwrap_or(f64::NAN))).map_err(|e| fail(&e))?;
+        array(
+            &mut zip,
+            "t",
+            &[rows],
+            steps.iter().map(|&k| sim_time(k, dt).unwrap_or(f64::NAN)),
+        )
+        .map_err(|e| fail(&e))?;
         for (g, name) in groups.iter().zip(&names) {
-            let values = g.members.iter().flat_map(|m| aligned(&steps, m.series).map(|v| v.unwrap_or(f64::NAN)));
+            let values = g
+                .members
+                .iter()
+                .flat_map(|m| aligned(&steps, m.series).map(|v| v.unwrap_or(f64::NAN)));
             array(&mut zip, name, &[rows, g.members.len() as u64], values).map_err(|e| fail(&e))?;
         }
         zip.finish().map_err(|e| fail(&e))?;
@@ -58,7 +67,12 @@ fn array<W: Write + Seek, T: npyz::AutoSerialize + npyz::Serialize>(
         .last_modified_time(zip::DateTime::default())
         .large_file(bytes >= u32::MAX as u64);
     zip.start_file(format!("{name}.npy"), options)?;
-    let mut npy = npyz::WriteOptions::<T>::new().default_dtype().shape(shape).order(npyz::Order::Fortran).writer(&mut *zip).begin_nd()?;
+    let mut npy = npyz::WriteOptions::<T>::new()
+        .default_dtype()
+        .shape(shape)
+        .order(npyz::Order::Fortran)
+        .writer(&mut *zip)
+        .begin_nd()?;
     for v in values {
         npy.push(&v)?;
     }
@@ -74,7 +88,13 @@ mod tests {
     fn an_entry_is_a_fortran_order_npy_of_its_shape() {
         let mut zip = ZipWriter::new(Cursor::new(Vec::new()));
         // Columns (1, 2, 3) and (4, NaN, 6) of a 3×2 array.
-        array(&mut zip, "g", &[3, 2], [1.0, 2.0, 3.0, 4.0, f64::NAN, 6.0].into_iter()).unwrap();
+        array(
+            &mut zip,
+            "g",
+            &[3, 2],
+            [1.0, 2.0, 3.0, 4.0, f64::NAN, 6.0].into_iter(),
+        )
+        .unwrap();
         let mut archive = zip::ZipArchive::new(zip.finish().unwrap()).unwrap();
         let mut entry = archive.by_name("g.npy").unwrap();
         assert_eq!(entry.compression(), CompressionMethod::Stored);
@@ -83,12 +103,21 @@ mod tests {
         assert_eq!(&bytes[..6], b"\x93NUMPY");
         let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
         assert_eq!((10 + header_len) % 16, 0, "data aligned as numpy aligns it");
-        let header: String = std::str::from_utf8(&bytes[10..10 + header_len]).unwrap().split_whitespace().collect();
+        let header: String = std::str::from_utf8(&bytes[10..10 + header_len])
+            .unwrap()
+            .split_whitespace()
+            .collect();
         for part in ["'descr':'<f8'", "'fortran_order':True", "'shape':(3,2"] {
             assert!(header.contains(part), "{header}");
         }
-        let data: Vec<u64> = bytes[10 + header_len..].chunks(8).map(|c| u64::from_le_bytes(c.try_into().unwrap())).collect();
-        let want: Vec<u64> = [1.0, 2.0, 3.0, 4.0, f64::NAN, 6.0].iter().map(|v: &f64| v.to_bits()).collect();
+        let data: Vec<u64> = bytes[10 + header_len..]
+            .chunks(8)
+            .map(|c| u64::from_le_bytes(c.try_into().unwrap()))
+            .collect();
+        let want: Vec<u64> = [1.0, 2.0, 3.0, 4.0, f64::NAN, 6.0]
+            .iter()
+            .map(|v: &f64| v.to_bits())
+            .collect();
         assert_eq!(data, want);
     }
 }

@@ -13,13 +13,18 @@ pub fn groups(r: &Recording) -> BTreeMap<String, Vec<(String, &Series)>> {
     let mut out: BTreeMap<String, Vec<(String, &Series)>> = BTreeMap::new();
     for (path, s) in &r.series {
         let (group, member) = match path.rsplit_once('/') {
-            Some((g, m)) if !g.is_empty() && (m.parse::<usize>().is_ok() || g == "/latency") => (g.to_string(), m.to_string()),
+            Some((g, m)) if !g.is_empty() && (m.parse::<usize>().is_ok() || g == "/latency") => {
+                (g.to_string(), m.to_string())
+            }
             _ => (path.clone(), "value".to_string()),
         };
         out.entry(group).or_default().push((member, s));
     }
     for members in out.values_mut() {
-        members.sort_by_key(|(m, _)| m.parse::<usize>().map_or((1, m.clone()), |i| (0, format!("{i:09}"))));
+        members.sort_by_key(|(m, _)| {
+            m.parse::<usize>()
+                .map_or((1, m.clone()), |i| (0, format!("{i:09}")))
+        });
     }
     out
 }
@@ -63,8 +68,16 @@ pub fn labelled(r: &Recording) -> Vec<Group<'_>> {
                 .into_iter()
                 .map(|(member, series)| {
                     let (name, label) = name_and_label(scenario.as_ref(), r, &path, &member);
-                    let entity = Some(format!("{path}/{member}")).filter(|e| r.series.contains_key(e)).unwrap_or_else(|| path.clone());
-                    Member { member, entity, name, label, series }
+                    let entity = Some(format!("{path}/{member}"))
+                        .filter(|e| r.series.contains_key(e))
+                        .unwrap_or_else(|| path.clone());
+                    Member {
+                        member,
+                        entity,
+                        name,
+                        label,
+                        series,
+                    }
                 })
                 .collect();
             Group { path, members }
@@ -75,10 +88,22 @@ pub fn labelled(r: &Recording) -> Vec<Group<'_>> {
 /// The name and labelled name of `member` of `group`: the signal's name and unit where the
 /// scenario is known (`eta`, `eta [rad]`), a latency's hop name in ns (the `step` member becomes
 /// `step_latency`, not a second `step` column), else the member itself.
-pub fn name_and_label(s: Option<&scenario::Scenario>, r: &Recording, group: &str, member: &str) -> (String, String) {
+pub fn name_and_label(
+    s: Option<&scenario::Scenario>,
+    r: &Recording,
+    group: &str,
+    member: &str,
+) -> (String, String) {
     let path = format!("{group}/{member}");
     if group == "/latency" {
-        let name = if member == "step" { "step_latency".to_string() } else { r.names.get(&path).cloned().unwrap_or_else(|| member.to_string()) };
+        let name = if member == "step" {
+            "step_latency".to_string()
+        } else {
+            r.names
+                .get(&path)
+                .cloned()
+                .unwrap_or_else(|| member.to_string())
+        };
         let label = format!("{name} [ns]");
         return (name, label);
     }
@@ -90,7 +115,10 @@ pub fn name_and_label(s: Option<&scenario::Scenario>, r: &Recording, group: &str
 
 /// The ascending union of the series' steps.
 pub fn union_steps<'a>(series: impl IntoIterator<Item = &'a Series>) -> Vec<i64> {
-    let mut steps: Vec<i64> = series.into_iter().flat_map(|s| s.steps.iter().copied()).collect();
+    let mut steps: Vec<i64> = series
+        .into_iter()
+        .flat_map(|s| s.steps.iter().copied())
+        .collect();
     steps.sort_unstable();
     steps.dedup();
     steps
@@ -124,18 +152,32 @@ pub fn array_name(group: &str) -> String {
 /// The steps of the whole recording, the rows of the npz and MAT arrays: the union over every
 /// group's members.
 pub fn all_steps(groups: &[Group<'_>]) -> Vec<i64> {
-    union_steps(groups.iter().flat_map(|g| g.members.iter().map(|m| m.series)))
+    union_steps(
+        groups
+            .iter()
+            .flat_map(|g| g.members.iter().map(|m| m.series)),
+    )
 }
 
 /// Each group's array name (through `name`), refused when two groups, or a group and one of
 /// the `reserved` arrays (`t`, `step`), would share one.
-pub fn unique_names(groups: &[Group<'_>], reserved: &[&str], name: impl Fn(&str) -> String) -> Result<Vec<String>, String> {
-    let mut seen: BTreeMap<String, &str> = reserved.iter().map(|r| (r.to_string(), "the export itself")).collect();
+pub fn unique_names(
+    groups: &[Group<'_>],
+    reserved: &[&str],
+    name: impl Fn(&str) -> String,
+) -> Result<Vec<String>, String> {
+    let mut seen: BTreeMap<String, &str> = reserved
+        .iter()
+        .map(|r| (r.to_string(), "the export itself"))
+        .collect();
     let mut out = Vec::with_capacity(groups.len());
     for g in groups {
         let n = name(&g.path);
         if let Some(other) = seen.insert(n.clone(), &g.path) {
-            return Err(format!("the groups {} and {other} would both be named {n}", g.path));
+            return Err(format!(
+                "the groups {} and {other} would both be named {n}",
+                g.path
+            ));
         }
         out.push(n);
     }

@@ -7,7 +7,7 @@ use std::path::Path;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
-use super::raster::{polyline, Canvas, Rect};
+use super::raster::{Canvas, Rect, polyline};
 use crate::palette::Line;
 
 /// Image size, pixels.
@@ -123,7 +123,11 @@ fn log_label(v: f64, step: f64) -> String {
     let value = 10f64.powf(v);
     if step >= 1.0 && (v - v.round()).abs() < 1e-9 {
         let e = v.round() as i32;
-        if (-3..=4).contains(&e) { format!("{}", 10f64.powi(e)) } else { format!("1e{e}") }
+        if (-3..=4).contains(&e) {
+            format!("{}", 10f64.powi(e))
+        } else {
+            format!("1e{e}")
+        }
     } else {
         format!("{value:.2e}").replace("e0", "")
     }
@@ -131,7 +135,11 @@ fn log_label(v: f64, step: f64) -> String {
 
 fn range(curves: &[Curve], axis: impl Fn(&(f64, f64)) -> f64) -> Option<(f64, f64)> {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for v in curves.iter().flat_map(|c| c.points.iter().map(&axis)).filter(|v| v.is_finite()) {
+    for v in curves
+        .iter()
+        .flat_map(|c| c.points.iter().map(&axis))
+        .filter(|v| v.is_finite())
+    {
         lo = lo.min(v);
         hi = hi.max(v);
     }
@@ -140,55 +148,107 @@ fn range(curves: &[Curve], axis: impl Fn(&(f64, f64)) -> f64) -> Option<(f64, f6
 
 /// Draws `fig` into the PNG `path`; false when it has no finite point (nothing written).
 pub fn draw(path: &Path, fig: &Figure) -> Result<bool, String> {
-    let Some((x0, mut x1)) = range(&fig.curves, |p| p.0) else { return Ok(false) };
-    let Some((lo, hi)) = range(&fig.curves, |p| p.1) else { return Ok(false) };
+    let Some((x0, mut x1)) = range(&fig.curves, |p| p.0) else {
+        return Ok(false);
+    };
+    let Some((lo, hi)) = range(&fig.curves, |p| p.1) else {
+        return Ok(false);
+    };
     if x1 <= x0 {
         x1 = x0 + 1.0;
     }
     // The y range holds every point with a 5 % margin; a flat series gets a band around it.
-    let pad = if hi > lo { 0.05 * (hi - lo) } else if fig.scale == Scale::Log { 0.5 } else { lo.abs().max(f64::MIN_POSITIVE) * 0.5 };
-    let (y0, y1) = if hi > lo || lo != 0.0 || fig.scale == Scale::Log { (lo - pad, hi + pad) } else { (-1.0, 1.0) };
+    let pad = if hi > lo {
+        0.05 * (hi - lo)
+    } else if fig.scale == Scale::Log {
+        0.5
+    } else {
+        lo.abs().max(f64::MIN_POSITIVE) * 0.5
+    };
+    let (y0, y1) = if hi > lo || lo != 0.0 || fig.scale == Scale::Log {
+        (lo - pad, hi + pad)
+    } else {
+        (-1.0, 1.0)
+    };
     let (w, h) = (SIZE.0 as usize, SIZE.1 as usize);
     let mut buf = vec![255u8; 3 * w * h];
     let (plot, legend) = frame(&mut buf, fig, (x0, x1, y0, y1))?;
-    let mut canvas = Canvas { buf: &mut buf, width: w };
+    let mut canvas = Canvas {
+        buf: &mut buf,
+        width: w,
+    };
     let map = |(x, y): (f64, f64)| {
         let px = plot.x0 as f64 + (x - x0) / (x1 - x0) * (plot.x1 - plot.x0) as f64;
         let py = plot.y1 as f64 - (y - y0) / (y1 - y0) * (plot.y1 - plot.y0) as f64;
         (px, py)
     };
     // Inside the frame line, so a curve at the edge does not paint over it.
-    let inner = Rect { x0: plot.x0 + 1, y0: plot.y0 + 1, x1: plot.x1 - 1, y1: plot.y1 - 1 };
+    let inner = Rect {
+        x0: plot.x0 + 1,
+        y0: plot.y0 + 1,
+        x1: plot.x1 - 1,
+        y1: plot.y1 - 1,
+    };
     for c in &fig.curves {
         let pts: Vec<(f64, f64)> = c.points.iter().map(|&p| map(p)).collect();
         if c.dashed {
             for piece in dashes(&pts) {
-                polyline(&mut canvas, inner, &piece, c.line.color, c.line.width as f64);
+                polyline(
+                    &mut canvas,
+                    inner,
+                    &piece,
+                    c.line.color,
+                    c.line.width as f64,
+                );
             }
         } else {
             polyline(&mut canvas, inner, &pts, c.line.color, c.line.width as f64);
         }
     }
-    let legend_clip = Rect { x0: SIZE.0 as i32 - LEGEND_W as i32, y0: 0, x1: SIZE.0 as i32 - 1, y1: SIZE.1 as i32 - 1 };
+    let legend_clip = Rect {
+        x0: SIZE.0 as i32 - LEGEND_W as i32,
+        y0: 0,
+        x1: SIZE.0 as i32 - 1,
+        y1: SIZE.1 as i32 - 1,
+    };
     for (c, (x, y)) in fig.curves.iter().zip(legend) {
         let (x, y) = (x as f64, y as f64);
-        let sample = if c.dashed { vec![vec![(x, y), (x + 11.0, y)], vec![(x + 19.0, y), (x + 30.0, y)]] } else { vec![vec![(x, y), (x + 30.0, y)]] };
+        let sample = if c.dashed {
+            vec![
+                vec![(x, y), (x + 11.0, y)],
+                vec![(x + 19.0, y), (x + 30.0, y)],
+            ]
+        } else {
+            vec![vec![(x, y), (x + 30.0, y)]]
+        };
         for piece in sample {
-            polyline(&mut canvas, legend_clip, &piece, c.line.color, c.line.width as f64 + 0.5);
+            polyline(
+                &mut canvas,
+                legend_clip,
+                &piece,
+                c.line.color,
+                c.line.width as f64 + 0.5,
+            );
         }
     }
     // Encoded here and written staged (`outputs`): plotters' file backend would create the path
     // itself, through any link planted there.
     outputs::write(path, |w| {
         use image::ImageEncoder;
-        image::codecs::png::PngEncoder::new(w).write_image(&buf, SIZE.0, SIZE.1, image::ColorType::Rgb8).map_err(|e| e.to_string())
+        image::codecs::png::PngEncoder::new(w)
+            .write_image(&buf, SIZE.0, SIZE.1, image::ColorType::Rgb8)
+            .map_err(|e| e.to_string())
     })?;
     Ok(true)
 }
 
 /// Title, grid, ticks, frame and legend text; returns the plot rectangle and where each
 /// legend sample line starts.
-fn frame(buf: &mut [u8], fig: &Figure, (x0, x1, y0, y1): (f64, f64, f64, f64)) -> Result<(Rect, Vec<(i32, i32)>), String> {
+fn frame(
+    buf: &mut [u8],
+    fig: &Figure,
+    (x0, x1, y0, y1): (f64, f64, f64, f64),
+) -> Result<(Rect, Vec<(i32, i32)>), String> {
     let root = BitMapBackend::with_buffer(buf, SIZE).into_drawing_area();
     let (left, right) = root.split_horizontally(SIZE.0 - LEGEND_W);
     let (xstep, ystep) = (tick_step(x0, x1, X_LABELS), tick_step(y0, y1, Y_LABELS));
@@ -199,7 +259,8 @@ fn frame(buf: &mut [u8], fig: &Figure, (x0, x1, y0, y1): (f64, f64, f64, f64)) -
         .margin(14)
         .x_label_area_size(52)
         .y_label_area_size(96)
-        .build_cartesian_2d(x0..x1, y0..y1).map_err(|e| e.to_string())?;
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(|e| e.to_string())?;
     let ylab = |v: &f64| match fig.scale {
         Scale::Linear => linear_label(*v, ystep, max_abs),
         Scale::Log => log_label(*v, ystep),
@@ -217,16 +278,32 @@ fn frame(buf: &mut [u8], fig: &Figure, (x0, x1, y0, y1): (f64, f64, f64, f64)) -
         .axis_style(BLACK)
         .x_label_formatter(&|v| linear_label(*v, xstep, x_max))
         .y_label_formatter(&ylab)
-        .draw().map_err(|e| e.to_string())?;
+        .draw()
+        .map_err(|e| e.to_string())?;
     let (xr, yr) = chart.plotting_area().get_pixel_range();
-    let plot = Rect { x0: xr.start, y0: yr.start, x1: xr.end - 1, y1: yr.end - 1 };
-    root.draw(&Rectangle::new([(plot.x0, plot.y0), (plot.x1, plot.y1)], BLACK.stroke_width(1))).map_err(|e| e.to_string())?;
+    let plot = Rect {
+        x0: xr.start,
+        y0: yr.start,
+        x1: xr.end - 1,
+        y1: yr.end - 1,
+    };
+    root.draw(&Rectangle::new(
+        [(plot.x0, plot.y0), (plot.x1, plot.y1)],
+        BLACK.stroke_width(1),
+    ))
+    .map_err(|e| e.to_string())?;
     let mut samples = Vec::new();
     let (lx, _) = right.get_pixel_range();
     let mut y = plot.y0 + 12;
     for c in &fig.curves {
         // `right` has its own origin at its top-left corner; the samples are in image pixels.
-        right.draw(&Text::new(c.label.clone(), (46, y - 9), ("sans-serif", 15).into_font().color(&BLACK))).map_err(|e| e.to_string())?;
+        right
+            .draw(&Text::new(
+                c.label.clone(),
+                (46, y - 9),
+                ("sans-serif", 15).into_font().color(&BLACK),
+            ))
+            .map_err(|e| e.to_string())?;
         samples.push((lx.start + 8, y));
         y += 24;
     }

@@ -31,7 +31,10 @@ pub struct Rect {
 /// with `width` pixels in `color`, touching only pixels inside `clip`. Overlapping segments of
 /// one line do not darken each other: each pixel takes the line's largest coverage once.
 pub fn polyline(canvas: &mut Canvas, clip: Rect, points: &[(f64, f64)], color: Rgb, width: f64) {
-    let (w, h) = ((clip.x1 - clip.x0 + 1).max(0) as usize, (clip.y1 - clip.y0 + 1).max(0) as usize);
+    let (w, h) = (
+        (clip.x1 - clip.x0 + 1).max(0) as usize,
+        (clip.y1 - clip.y0 + 1).max(0) as usize,
+    );
     if w == 0 || h == 0 {
         return;
     }
@@ -40,23 +43,40 @@ pub fn polyline(canvas: &mut Canvas, clip: Rect, points: &[(f64, f64)], color: R
     // Segments are first cut to the clip rectangle grown by the line's half width, so a far
     // outlier (1e300 pixels away) leaves finite, short segments.
     let grow = r + 2.0;
-    let bounds = (clip.x0 as f64 - grow, clip.y0 as f64 - grow, clip.x1 as f64 + grow, clip.y1 as f64 + grow);
+    let bounds = (
+        clip.x0 as f64 - grow,
+        clip.y0 as f64 - grow,
+        clip.x1 as f64 + grow,
+        clip.y1 as f64 + grow,
+    );
     for pair in points.windows(2) {
         let (a, b) = (pair[0], pair[1]);
         if !(a.0.is_finite() && a.1.is_finite() && b.0.is_finite() && b.1.is_finite()) {
             continue;
         }
-        let Some((a, b)) = cut(a, b, bounds) else { continue };
+        let Some((a, b)) = cut(a, b, bounds) else {
+            continue;
+        };
         let (lx, hx) = (a.0.min(b.0) - r - 1.0, a.0.max(b.0) + r + 1.0);
         let (ly, hy) = (a.1.min(b.1) - r - 1.0, a.1.max(b.1) + r + 1.0);
-        let (px0, px1) = ((lx.floor() as i32).max(clip.x0), (hx.ceil() as i32).min(clip.x1));
-        let (py0, py1) = ((ly.floor() as i32).max(clip.y0), (hy.ceil() as i32).min(clip.y1));
+        let (px0, px1) = (
+            (lx.floor() as i32).max(clip.x0),
+            (hx.ceil() as i32).min(clip.x1),
+        );
+        let (py0, py1) = (
+            (ly.floor() as i32).max(clip.y0),
+            (hy.ceil() as i32).min(clip.y1),
+        );
         let (dx, dy) = (b.0 - a.0, b.1 - a.1);
         let len2 = dx * dx + dy * dy;
         for py in py0..=py1 {
             for px in px0..=px1 {
                 let (qx, qy) = (px as f64 - a.0, py as f64 - a.1);
-                let t = if len2 > 0.0 { ((qx * dx + qy * dy) / len2).clamp(0.0, 1.0) } else { 0.0 };
+                let t = if len2 > 0.0 {
+                    ((qx * dx + qy * dy) / len2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
                 let (ex, ey) = (qx - t * dx, qy - t * dy);
                 let d = (ex * ex + ey * ey).sqrt();
                 let c = (r + 0.5 - d).clamp(0.0, 1.0) as f32;
@@ -83,10 +103,19 @@ pub fn polyline(canvas: &mut Canvas, clip: Rect, points: &[(f64, f64)], color: R
 }
 
 /// The part of segment a–b inside `(x0, y0, x1, y1)` (Liang–Barsky), if any.
-fn cut(a: (f64, f64), b: (f64, f64), (x0, y0, x1, y1): (f64, f64, f64, f64)) -> Option<((f64, f64), (f64, f64))> {
+fn cut(
+    a: (f64, f64),
+    b: (f64, f64),
+    (x0, y0, x1, y1): (f64, f64, f64, f64),
+) -> Option<((f64, f64), (f64, f64))> {
     let (dx, dy) = (b.0 - a.0, b.1 - a.1);
     let (mut t0, mut t1) = (0.0f64, 1.0f64);
-    for (p, q) in [(-dx, a.0 - x0), (dx, x1 - a.0), (-dy, a.1 - y0), (dy, y1 - a.1)] {
+    for (p, q) in [
+        (-dx, a.0 - x0),
+        (dx, x1 - a.0),
+        (-dy, a.1 - y0),
+        (dy, y1 - a.1),
+    ] {
         if p == 0.0 {
             if q < 0.0 {
                 return None;
@@ -100,7 +129,10 @@ fn cut(a: (f64, f64), b: (f64, f64), (x0, y0, x1, y1): (f64, f64, f64, f64)) -> 
             }
         }
     }
-    (t0 <= t1).then_some(((a.0 + t0 * dx, a.1 + t0 * dy), (a.0 + t1 * dx, a.1 + t1 * dy)))
+    (t0 <= t1).then_some((
+        (a.0 + t0 * dx, a.1 + t0 * dy),
+        (a.0 + t1 * dx, a.1 + t1 * dy),
+    ))
 }
 
 #[cfg(test)]
@@ -110,10 +142,31 @@ mod tests {
     #[test]
     fn nothing_is_drawn_outside_the_clip_rectangle() {
         let mut buf = vec![255u8; 3 * 100 * 100];
-        let clip = Rect { x0: 20, y0: 20, x1: 79, y1: 79 };
+        let clip = Rect {
+            x0: 20,
+            y0: 20,
+            x1: 79,
+            y1: 79,
+        };
         // A spike far above the rectangle and a zigzag across it.
-        let points = [(0.0, 50.0), (50.0, -1e300), (60.0, 50.0), (61.0, 99.0), (62.0, 10.0), (99.0, 50.0)];
-        polyline(&mut Canvas { buf: &mut buf, width: 100 }, clip, &points, [200, 0, 0], 3.0);
+        let points = [
+            (0.0, 50.0),
+            (50.0, -1e300),
+            (60.0, 50.0),
+            (61.0, 99.0),
+            (62.0, 10.0),
+            (99.0, 50.0),
+        ];
+        polyline(
+            &mut Canvas {
+                buf: &mut buf,
+                width: 100,
+            },
+            clip,
+            &points,
+            [200, 0, 0],
+            3.0,
+        );
         let mut inside = 0;
         for y in 0..100 {
             for x in 0..100 {
@@ -130,7 +183,21 @@ mod tests {
     #[test]
     fn edges_are_blended() {
         let mut buf = vec![255u8; 3 * 40 * 40];
-        polyline(&mut Canvas { buf: &mut buf, width: 40 }, Rect { x0: 0, y0: 0, x1: 39, y1: 39 }, &[(2.0, 3.0), (37.0, 30.0)], [0, 0, 0], 2.0);
+        polyline(
+            &mut Canvas {
+                buf: &mut buf,
+                width: 40,
+            },
+            Rect {
+                x0: 0,
+                y0: 0,
+                x1: 39,
+                y1: 39,
+            },
+            &[(2.0, 3.0), (37.0, 30.0)],
+            [0, 0, 0],
+            2.0,
+        );
         let partial = buf.chunks(3).filter(|p| p[0] > 0 && p[0] < 255).count();
         assert!(partial > 20, "{partial} partly covered pixels");
     }

@@ -37,8 +37,16 @@ impl PlotSelection {
             return Err(format!("--from {a} must be before --to {b}"));
         }
         // The rules of `launcher run --record`: `*` stops at '/', a leading '/' is implied.
-        let globs = if self.signals.is_empty() { None } else { Some(Globs::new(&self.signals).map_err(|e| format!("--signals {e}"))?) };
-        Ok(Matcher { globs, from: self.from, to: self.to })
+        let globs = if self.signals.is_empty() {
+            None
+        } else {
+            Some(Globs::new(&self.signals).map_err(|e| format!("--signals {e}"))?)
+        };
+        Ok(Matcher {
+            globs,
+            from: self.from,
+            to: self.to,
+        })
     }
 }
 
@@ -67,7 +75,15 @@ mod tests {
 
     #[test]
     fn globs_match_by_segment() {
-        let m = |g: &str| PlotSelection { signals: vec![g.to_string()], from: None, to: None }.matcher().unwrap();
+        let m = |g: &str| {
+            PlotSelection {
+                signals: vec![g.to_string()],
+                from: None,
+                to: None,
+            }
+            .matcher()
+            .unwrap()
+        };
         assert!(m("/observer/uio/**").entity("/observer/uio/xhat/1"));
         assert!(m("/observer/uio/**").entity("/observer/uio/log10_max_abs_error"));
         assert!(!m("/observer/uio/**").entity("/observer/luenberger/xhat/1"));
@@ -76,12 +92,28 @@ mod tests {
         assert!(!m("/plant/*").entity("/plant/x/1"));
         assert!(m("plant/x/?").entity("/plant/x/1"));
         assert!(m("/plant/x/1").entity("/plant/x/1") && !m("/plant/x/1").entity("/plant/x/10"));
-        assert!(PlotSelection { signals: vec!["/plant/[x".into()], from: None, to: None }.validate().unwrap_err().starts_with("--signals '/plant/[x': "));
+        assert!(
+            PlotSelection {
+                signals: vec!["/plant/[x".into()],
+                from: None,
+                to: None
+            }
+            .validate()
+            .unwrap_err()
+            .starts_with("--signals '/plant/[x': ")
+        );
     }
 
     #[test]
     fn a_window_must_be_finite_and_ordered() {
-        let w = |from, to| PlotSelection { signals: vec![], from, to }.validate();
+        let w = |from, to| {
+            PlotSelection {
+                signals: vec![],
+                from,
+                to,
+            }
+            .validate()
+        };
         assert!(w(Some(1.0), Some(2.0)).is_ok());
         assert!(w(Some(2.0), Some(1.0)).unwrap_err().contains("--from 2"));
         assert!(w(Some(1.0), Some(1.0)).is_err());

@@ -54,7 +54,15 @@ pub struct Frames<R> {
 impl<R: Read> Frames<R> {
     /// Frames of `reader`, which holds `len` bytes.
     pub fn new(reader: R, len: u64) -> Self {
-        Frames { reader, len, pos: 0, version: None, in_stream: false, footer_ok: false, closing: false }
+        Frames {
+            reader,
+            len,
+            pos: 0,
+            version: None,
+            in_stream: false,
+            footer_ok: false,
+            closing: false,
+        }
     }
 
     /// The Rerun version that wrote the current stream.
@@ -92,11 +100,17 @@ impl<R: Read> Frames<R> {
                 1 => MessageKind::SetStoreInfo,
                 2 => MessageKind::ArrowMsg,
                 3 => MessageKind::BlueprintActivationCommand,
-                k => return Err(Fault::Bad(format!("the message header at byte {at} has kind {k}, which is none of Rerun's"))),
+                k => {
+                    return Err(Fault::Bad(format!(
+                        "the message header at byte {at} has kind {k}, which is none of Rerun's"
+                    )));
+                }
             };
             let remaining = self.len - self.pos;
             if size > remaining {
-                return Err(Fault::Cut(format!("the message at byte {at} claims {size} bytes, but the file holds {remaining} more")));
+                return Err(Fault::Cut(format!(
+                    "the message at byte {at} claims {size} bytes, but the file holds {remaining} more"
+                )));
             }
             let payload = self.exactly(size, "a message")?;
             if kind == MessageKind::End {
@@ -121,7 +135,9 @@ impl<R: Read> Frames<R> {
                 Ok(())
             }
             Err(e) if at == 0 => Err(Fault::NotRrd(e.to_string())),
-            Err(e) => Err(Fault::Bad(format!("the bytes after the stream footer at byte {at} are no stream header ({e})"))),
+            Err(e) => Err(Fault::Bad(format!(
+                "the bytes after the stream footer at byte {at} are no stream header ({e})"
+            ))),
         }
     }
 
@@ -144,13 +160,21 @@ impl<R: Read> Frames<R> {
             return bad("lacks its RRF2FOOT marker".into());
         }
         if count != 1 {
-            return bad(format!("claims {count} entries where a Rerun writer writes 1"));
+            return bad(format!(
+                "claims {count} entries where a Rerun writer writes 1"
+            ));
         }
         if start != payload_at || size != payload.len() as u64 {
-            return bad(format!("points at {size} bytes at byte {start}, not at the footer's {} bytes at byte {payload_at}", payload.len()));
+            return bad(format!(
+                "points at {size} bytes at byte {start}, not at the footer's {} bytes at byte {payload_at}",
+                payload.len()
+            ));
         }
         if StreamFooter::compute_crc(payload) != crc {
-            return bad(format!("does not match its checksum over the {} bytes of the footer (the chunk manifest)", payload.len()));
+            return bad(format!(
+                "does not match its checksum over the {} bytes of the footer (the chunk manifest)",
+                payload.len()
+            ));
         }
         self.in_stream = false;
         self.footer_ok = true;
@@ -161,10 +185,15 @@ impl<R: Read> Frames<R> {
     fn exactly(&mut self, n: u64, what: &str) -> Result<Vec<u8>, Fault> {
         let remaining = self.len - self.pos;
         if n > remaining {
-            return Err(Fault::Cut(format!("the file ends {remaining} bytes into {what} at byte {}", self.pos)));
+            return Err(Fault::Cut(format!(
+                "the file ends {remaining} bytes into {what} at byte {}",
+                self.pos
+            )));
         }
         let mut buf = vec![0; n as usize];
-        self.reader.read_exact(&mut buf).map_err(|e| Fault::Cut(format!("cannot read {what} at byte {}: {e}", self.pos)))?;
+        self.reader
+            .read_exact(&mut buf)
+            .map_err(|e| Fault::Cut(format!("cannot read {what} at byte {}: {e}", self.pos)))?;
         self.pos += n;
         Ok(buf)
     }
@@ -224,17 +253,26 @@ mod tests {
             let mut b = good.clone();
             b[i] ^= 0xff;
             let (_, fault, ok) = all(&b);
-            assert!(matches!(fault, Some(Fault::Bad(_))) && !ok, "byte {i}: {fault:?}");
+            assert!(
+                matches!(fault, Some(Fault::Bad(_))) && !ok,
+                "byte {i}: {fault:?}"
+            );
         }
         // A kind no writer writes.
         let mut b = good.clone();
         b[12] = 9;
         assert!(matches!(all(&b).1, Some(Fault::Bad(_))));
         // Not a stream at all.
-        assert!(matches!(all(b"hello world, this is text").1, Some(Fault::NotRrd(_))));
+        assert!(matches!(
+            all(b"hello world, this is text").1,
+            Some(Fault::NotRrd(_))
+        ));
         // Cut anywhere: a killed writer's file.
         for cut in [5, 20, 30, good.len() - 3] {
-            assert!(matches!(all(&good[..cut]).1, Some(Fault::Cut(_))), "cut at {cut}");
+            assert!(
+                matches!(all(&good[..cut]).1, Some(Fault::Cut(_))),
+                "cut at {cut}"
+            );
         }
     }
 }

@@ -26,10 +26,18 @@ pub fn check(msg: &ArrowMsg) -> Result<(), String> {
         Compression::None | Compression::Unspecified => Cow::Borrowed(&msg.payload[..]),
         Compression::Lz4 => {
             let size = msg.uncompressed_size;
-            if size > (msg.payload.len() as u64).saturating_mul(LZ4_MAX_RATIO) + 64 || size > LZ4_MAX_BYTES {
-                return Err(format!("it claims {size} bytes once uncompressed from {}, more than LZ4 can give", msg.payload.len()));
+            if size > (msg.payload.len() as u64).saturating_mul(LZ4_MAX_RATIO) + 64
+                || size > LZ4_MAX_BYTES
+            {
+                return Err(format!(
+                    "it claims {size} bytes once uncompressed from {}, more than LZ4 can give",
+                    msg.payload.len()
+                ));
             }
-            Cow::Owned(lz4_flex::block::decompress(&msg.payload, size as usize).map_err(|e| format!("its LZ4 data is damaged ({e})"))?)
+            Cow::Owned(
+                lz4_flex::block::decompress(&msg.payload, size as usize)
+                    .map_err(|e| format!("its LZ4 data is damaged ({e})"))?,
+            )
         }
     };
     ipc_lengths(&data)
@@ -39,7 +47,10 @@ pub fn check(msg: &ArrowMsg) -> Result<(), String> {
 /// marker, an i32 metadata length, the flatbuffer `Message`, its body), checking each length.
 fn ipc_lengths(data: &[u8]) -> Result<(), String> {
     let mut pos = 0usize;
-    let word = |at: usize| data.get(at..at + 4).map(|w| <[u8; 4]>::try_from(w).expect("4 bytes"));
+    let word = |at: usize| {
+        data.get(at..at + 4)
+            .map(|w| <[u8; 4]>::try_from(w).expect("4 bytes"))
+    };
     while let Some(mut w) = word(pos) {
         pos += 4;
         if w == [0xff; 4] {
@@ -51,12 +62,23 @@ fn ipc_lengths(data: &[u8]) -> Result<(), String> {
             return Ok(());
         }
         let remaining = data.len() - pos;
-        let meta = usize::try_from(meta).ok().filter(|&m| m <= remaining).ok_or_else(|| format!("an Arrow message claims {meta} bytes of metadata, with {remaining} left"))?;
-        let message = root_as_message(&data[pos..pos + meta]).map_err(|e| format!("an Arrow message's metadata is damaged ({e})"))?;
+        let meta = usize::try_from(meta)
+            .ok()
+            .filter(|&m| m <= remaining)
+            .ok_or_else(|| {
+                format!("an Arrow message claims {meta} bytes of metadata, with {remaining} left")
+            })?;
+        let message = root_as_message(&data[pos..pos + meta])
+            .map_err(|e| format!("an Arrow message's metadata is damaged ({e})"))?;
         pos += meta;
         let remaining = data.len() - pos;
         let body = message.bodyLength();
-        let body = usize::try_from(body).ok().filter(|&b| b <= remaining).ok_or_else(|| format!("an Arrow message claims a body of {body} bytes, with {remaining} left"))?;
+        let body = usize::try_from(body)
+            .ok()
+            .filter(|&b| b <= remaining)
+            .ok_or_else(|| {
+                format!("an Arrow message claims a body of {body} bytes, with {remaining} left")
+            })?;
         pos += body;
     }
     Ok(())

@@ -7,8 +7,8 @@
 //! holds the loop back instead of growing without bound.
 
 use std::collections::BTreeMap;
-use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
 use std::sync::Arc;
+use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::thread::JoinHandle;
 
 use rerun::external::arrow::array::{Float64Array, ListArray};
@@ -48,8 +48,14 @@ impl Columns {
     /// Starts the thread writing `entities` to `rec`.
     pub fn start(rec: RecordingStream, entities: Vec<Entity>) -> Result<Self, String> {
         let (tx, rx) = sync_channel(DEPTH);
-        let thread = std::thread::Builder::new().name("uio-recorder".into()).spawn(move || write_all(&rec, &entities, rx)).map_err(|e| format!("cannot start the recorder's thread: {e}"))?;
-        Ok(Columns { tx: Some(tx), thread: Some(thread) })
+        let thread = std::thread::Builder::new()
+            .name("uio-recorder".into())
+            .spawn(move || write_all(&rec, &entities, rx))
+            .map_err(|e| format!("cannot start the recorder's thread: {e}"))?;
+        Ok(Columns {
+            tx: Some(tx),
+            thread: Some(thread),
+        })
     }
 
     /// Hands a batch over (waits while [`DEPTH`] are in flight); fails with the thread's error
@@ -61,7 +67,8 @@ impl Columns {
             return Ok(());
         }
         // The thread has gone: its own error says why.
-        self.finish().and(Err("the recorder's thread has stopped".into()))
+        self.finish()
+            .and(Err("the recorder's thread has stopped".into()))
     }
 
     /// Waits for every batch to be written; returns each signal's digest.
@@ -75,29 +82,69 @@ impl Columns {
     }
 }
 
-fn write_all(rec: &RecordingStream, entities: &[Entity], rx: Receiver<Batch>) -> Result<BTreeMap<String, Running>, String> {
+fn write_all(
+    rec: &RecordingStream,
+    entities: &[Entity],
+    rx: Receiver<Batch>,
+) -> Result<BTreeMap<String, Running>, String> {
     let inner: FieldRef = Arc::new(Field::new("item", DataType::Float64, true));
     let outer: FieldRef = Arc::new(Field::new("item", DataType::List(inner.clone()), true));
     let mut digests: BTreeMap<String, Running> = BTreeMap::new();
     for batch in rx {
         let rows = batch.steps.len();
-        let (step_values, time_values) = (ScalarBuffer::from(batch.steps), ScalarBuffer::from(batch.times_ns));
-        let steps = TimeColumn::new(Some(true), Timeline::new_sequence("step"), step_values.clone());
-        let times = TimeColumn::new(Some(true), Timeline::new_duration("sim_time"), time_values.clone());
+        let (step_values, time_values) = (
+            ScalarBuffer::from(batch.steps),
+            ScalarBuffer::from(batch.times_ns),
+        );
+        let steps = TimeColumn::new(
+            Some(true),
+            Timeline::new_sequence("step"),
+            step_values.clone(),
+        );
+        let times = TimeColumn::new(
+            Some(true),
+            Timeline::new_duration("sim_time"),
+            time_values.clone(),
+        );
         let mut digest_rows = Rows::new(&step_values, Some(&time_values));
         for (e, values) in batch.values {
             let entity = &entities[e];
             let width = entity.signals.len();
             if values.len() != rows * width {
-                return Err(format!("{}: {} values for {rows} rows of {width}", entity.path, values.len()));
+                return Err(format!(
+                    "{}: {} values for {rows} rows of {width}",
+                    entity.path,
+                    values.len()
+                ));
             }
             for (j, signal) in entity.signals.iter().enumerate() {
-                digests.entry(signal.clone()).or_default().update_rows(&mut digest_rows, values.iter().skip(j).step_by(width).copied());
+                digests.entry(signal.clone()).or_default().update_rows(
+                    &mut digest_rows,
+                    values.iter().skip(j).step_by(width).copied(),
+                );
             }
-            let lists = ListArray::new(inner.clone(), OffsetBuffer::<i32>::from_lengths(std::iter::repeat_n(width, rows)), Arc::new(Float64Array::from(values)), None);
-            let column = ListArray::new(outer.clone(), OffsetBuffer::<i32>::from_lengths(std::iter::repeat_n(1, rows)), Arc::new(lists), None);
-            let column = SerializedComponentColumn::new(column, ComponentDescriptor::partial(VALUES_COMPONENT));
-            rec.send_columns(entity.path.as_str(), [steps.clone(), times.clone()], [column]).map_err(|e| e.to_string())?;
+            let lists = ListArray::new(
+                inner.clone(),
+                OffsetBuffer::<i32>::from_lengths(std::iter::repeat_n(width, rows)),
+                Arc::new(Float64Array::from(values)),
+                None,
+            );
+            let column = ListArray::new(
+                outer.clone(),
+                OffsetBuffer::<i32>::from_lengths(std::iter::repeat_n(1, rows)),
+                Arc::new(lists),
+                None,
+            );
+            let column = SerializedComponentColumn::new(
+                column,
+                ComponentDescriptor::partial(VALUES_COMPONENT),
+            );
+            rec.send_columns(
+                entity.path.as_str(),
+                [steps.clone(), times.clone()],
+                [column],
+            )
+            .map_err(|e| e.to_string())?;
         }
     }
     Ok(digests)

@@ -12,7 +12,7 @@ use std::path::Path;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use re_log_encoding::{EncodingOptions, Encoder};
+use re_log_encoding::{Encoder, EncodingOptions};
 use rerun::external::re_log_types::LogMsg;
 use rerun::sink::{LogSink, SinkFlushError};
 
@@ -34,11 +34,23 @@ impl UncompressedFileSink {
 
     /// The same, its chunks LZ4-compressed as Rerun's own sink writes them when `lz4`.
     pub fn create_with(path: &Path, lz4: bool) -> Result<Self, String> {
-        let file = outputs::create_new(path).map_err(|e| format!("{}: cannot create: {e}", path.display()))?;
-        let options = if lz4 { EncodingOptions::PROTOBUF_COMPRESSED } else { EncodingOptions::PROTOBUF_UNCOMPRESSED };
-        let encoder = Encoder::new_eager(re_build_info::CrateVersion::LOCAL, options, BufWriter::with_capacity(1 << 20, file))
-            .map_err(|e| format!("{}: {e}", path.display()))?;
-        Ok(Self { encoder: Mutex::new(Some(encoder)), error: Arc::new(Mutex::new(None)) })
+        let file = outputs::create_new(path)
+            .map_err(|e| format!("{}: cannot create: {e}", path.display()))?;
+        let options = if lz4 {
+            EncodingOptions::PROTOBUF_COMPRESSED
+        } else {
+            EncodingOptions::PROTOBUF_UNCOMPRESSED
+        };
+        let encoder = Encoder::new_eager(
+            re_build_info::CrateVersion::LOCAL,
+            options,
+            BufWriter::with_capacity(1 << 20, file),
+        )
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+        Ok(Self {
+            encoder: Mutex::new(Some(encoder)),
+            error: Arc::new(Mutex::new(None)),
+        })
     }
 
     /// Where the first write error is kept: Rerun calls `send` on its own thread and cannot
@@ -67,7 +79,8 @@ impl LogSink for UncompressedFileSink {
     fn flush_blocking(&self, _timeout: Duration) -> Result<(), SinkFlushError> {
         let mut guard = self.encoder.lock().expect("encoder lock");
         if let Some(enc) = guard.as_mut() {
-            enc.flush_blocking().map_err(|e| SinkFlushError::failed(e.to_string()))?;
+            enc.flush_blocking()
+                .map_err(|e| SinkFlushError::failed(e.to_string()))?;
         }
         match self.error.lock().ok().and_then(|e| e.clone()) {
             Some(e) => Err(SinkFlushError::failed(e)),

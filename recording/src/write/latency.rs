@@ -43,7 +43,11 @@ impl Latency {
     /// For these hops.
     pub fn new(hops: Vec<String>) -> Self {
         let hist = hops.iter().map(|_| histogram()).collect();
-        Latency { hops, hist, step: histogram() }
+        Latency {
+            hops,
+            hist,
+            step: histogram(),
+        }
     }
 
     /// Records one hop's latency.
@@ -82,6 +86,11 @@ impl Latency {
 
     /// Each measured hop's percentiles (none in-process, where there are no hops).
     pub fn hop_percentiles(&self) -> Vec<(String, Percentiles)> {
-        self.hops.iter().zip(&self.hist).filter(|(_, h)| !h.is_empty()).map(|(n, h)| (n.clone(), Self::percentiles(h))).collect()
+        self.hops
+            .iter()
+            .zip(&self.hist)
+            .filter(|(_, h)| !h.is_empty())
+            .map(|(n, h)| (n.clone(), Self::percentiles(h)))
+            .collect()
     }
 }

@@ -3,12 +3,12 @@
 //! and between observers the largest difference of their estimates at any step.
 
 use lockstep::PlantLayout;
-use lti::kernel::mul_into;
 use lti::Mat;
+use lti::kernel::mul_into;
 
-use super::tail::{tail_start, BlockMax};
-use super::what::InputEstimate;
 use super::StepRow;
+use super::tail::{BlockMax, tail_start};
+use super::what::InputEstimate;
 
 /// The figures of one observer.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -96,7 +96,9 @@ impl Metrics {
             planned: steps,
             planned_tail: steps - steps / 4,
             exact: vec![[0.0; 2]; observers],
-            blocks: (0..observers).map(|_| [BlockMax::new(steps), BlockMax::new(steps)]).collect(),
+            blocks: (0..observers)
+                .map(|_| [BlockMax::new(steps), BlockMax::new(steps)])
+                .collect(),
             observers: vec![ObserverFigures::default(); observers],
             differences,
             steps: 0,
@@ -118,13 +120,31 @@ impl Metrics {
     /// The run's first fault acts from step `first` (of period dt): figures are kept for the
     /// steps before it too.
     pub fn fault_free_until(&mut self, first: u64, dt: f64) {
-        self.fault_free = Some((first, first as f64 * dt, vec![[0.0; 3]; self.observers.len()]));
+        self.fault_free = Some((
+            first,
+            first as f64 * dt,
+            vec![[0.0; 3]; self.observers.len()],
+        ));
     }
 
     /// Observer `o` estimates the unknown inputs: ŵ_k = W y_{k+1} − (WCΦ) x̂_k − (WCΓ_B) u_k
     /// (+ c at an operating point, `offset`).
-    pub fn estimate_inputs(&mut self, o: usize, w: Mat, w_c_phi: &Mat, w_c_gamma_b: &Mat, offset: Option<Vec<f64>>) {
-        self.what[o] = Some(InputEstimate::new(w, w_c_phi, w_c_gamma_b, offset, self.planned, self.planned_tail));
+    pub fn estimate_inputs(
+        &mut self,
+        o: usize,
+        w: Mat,
+        w_c_phi: &Mat,
+        w_c_gamma_b: &Mat,
+        offset: Option<Vec<f64>>,
+    ) {
+        self.what[o] = Some(InputEstimate::new(
+            w,
+            w_c_phi,
+            w_c_gamma_b,
+            offset,
+            self.planned,
+            self.planned_tail,
+        ));
     }
 
     /// The first step of the tail of the steps completed so far.
@@ -137,17 +157,31 @@ impl Metrics {
     pub fn finish(&mut self) {
         let start = self.tail_start();
         let completed = self.steps >= self.planned;
-        for (((f, [e, r]), exact), what) in self.observers.iter_mut().zip(&self.blocks).zip(&self.exact).zip(&self.what) {
+        for (((f, [e, r]), exact), what) in self
+            .observers
+            .iter_mut()
+            .zip(&self.blocks)
+            .zip(&self.exact)
+            .zip(&self.what)
+        {
             f.tail_max_abs_error = start.map(|s| if completed { exact[0] } else { e.max_from(s) });
-            f.tail_max_abs_residual = start.map(|s| if completed { exact[1] } else { r.max_from(s) });
-            f.tail_max_abs_input_error = what.as_ref().and_then(|w| start.map(|s| w.tail_max_abs_error(s, completed)));
+            f.tail_max_abs_residual =
+                start.map(|s| if completed { exact[1] } else { r.max_from(s) });
+            f.tail_max_abs_input_error = what
+                .as_ref()
+                .and_then(|w| start.map(|s| w.tail_max_abs_error(s, completed)));
         }
         if let Some((first, until, ff)) = &self.fault_free
             && *first / 4 > 0
             && self.steps >= *first
         {
             for (f, m) in self.observers.iter_mut().zip(ff) {
-                f.fault_free = Some(FaultFree { until: *until, tail_max_abs_error: m[0], tail_max_abs_residual: m[1], max_abs_error: m[2] });
+                f.fault_free = Some(FaultFree {
+                    until: *until,
+                    tail_max_abs_error: m[0],
+                    tail_max_abs_residual: m[1],
+                    max_abs_error: m[2],
+                });
             }
         }
     }
@@ -164,7 +198,15 @@ impl Metrics {
             Some((first, _, ff)) if k < *first => Some((k >= *first - *first / 4, ff.iter_mut())),
             _ => None,
         };
-        let per_observer = row.xhat.iter().zip(&mut self.error).zip(&mut self.residual).zip(&mut self.what).zip(&mut self.observers).zip(&mut self.blocks).zip(&mut self.exact);
+        let per_observer = row
+            .xhat
+            .iter()
+            .zip(&mut self.error)
+            .zip(&mut self.residual)
+            .zip(&mut self.what)
+            .zip(&mut self.observers)
+            .zip(&mut self.blocks)
+            .zip(&mut self.exact);
         for ((((((xhat, error), res), what), f), [be, br]), exact) in per_observer {
             let mut emax: f64 = 0.0;
             for ((e, &xi), &xh) in error.iter_mut().zip(x).zip(xhat) {
@@ -213,7 +255,10 @@ impl Metrics {
     /// max |x̂_a − x̂_b| for observers a and b.
     pub fn difference(&self, a: usize, b: usize) -> Option<f64> {
         let key = (a.min(b), a.max(b));
-        self.differences.iter().find(|(p, _)| *p == key).map(|(_, d)| *d)
+        self.differences
+            .iter()
+            .find(|(p, _)| *p == key)
+            .map(|(_, d)| *d)
     }
 }
 
@@ -226,9 +271,21 @@ mod tests {
     fn a_residual_at_an_operating_point_is_formed_in_deviations() {
         // n = 1, p = 1: y = 2.5 at x = 1 where C = 2 gives 2, so c_r = y_op − C x_op = 0.5 for a
         // point (x_op, y_op) = (1, 2.5); x̂ = 1 at y = 2.5 is then no residual at all.
-        let layout = PlantLayout { n: 1, p: 1, q: 0, r: 0, l: 0, f: 0 };
+        let layout = PlantLayout {
+            n: 1,
+            p: 1,
+            q: 0,
+            r: 0,
+            l: 0,
+            f: 0,
+        };
         let c = Mat::from_element(1, 1, 2.0);
-        let op = lti::OperatingPoint { x: vec![1.0], u: vec![], w: vec![], y: vec![2.5] };
+        let op = lti::OperatingPoint {
+            x: vec![1.0],
+            u: vec![],
+            w: vec![],
+            y: vec![2.5],
+        };
         let mut row = StepRow::new(layout, 1, false);
         row.plant[layout.x()][0] = 1.0;
         row.plant[layout.y()][0] = 2.5;

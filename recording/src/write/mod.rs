@@ -15,10 +15,10 @@ mod what;
 
 pub use blueprint::blueprint;
 pub use file_sink::UncompressedFileSink;
-pub use latency::{histogram, Latency, Percentiles};
-pub use metrics::{nan_max, FaultFree, Metrics, ObserverFigures};
-pub use layout::{Layout, Line, LAYOUT, SERIES_COMPONENT, VALUES_COMPONENT};
-pub use rrd::{RrdSink, SeriesId, FLUSH_STEPS, FLUSH_VALUES};
+pub use latency::{Latency, Percentiles, histogram};
+pub use layout::{LAYOUT, Layout, Line, SERIES_COMPONENT, VALUES_COMPONENT};
+pub use metrics::{FaultFree, Metrics, ObserverFigures, nan_max};
+pub use rrd::{FLUSH_STEPS, FLUSH_VALUES, RrdSink, SeriesId};
 pub use select::Selection;
 pub use what::InputEstimate;
 
@@ -52,7 +52,11 @@ impl StepRow {
             plant: vec![0.0; layout.len()],
             xhat: vec![vec![0.0; layout.n]; observers],
             xhat_hdr: vec![Header::default(); observers],
-            u: if controller { vec![0.0; layout.l] } else { Vec::new() },
+            u: if controller {
+                vec![0.0; layout.l]
+            } else {
+                Vec::new()
+            },
             ..Default::default()
         }
     }

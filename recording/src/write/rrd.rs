@@ -25,11 +25,14 @@ use std::sync::{Arc, Mutex};
 
 use rerun::blueprint::{Blueprint, BlueprintActivation};
 use rerun::external::arrow::array::{ArrayRef, StringArray};
-use rerun::{AsComponents as _, Color, ComponentDescriptor, RecordingStream, RecordingStreamBuilder, SerializedComponentBatch, SeriesLines, TextDocument};
+use rerun::{
+    AsComponents as _, Color, ComponentDescriptor, RecordingStream, RecordingStreamBuilder,
+    SerializedComponentBatch, SeriesLines, TextDocument,
+};
 
 use super::columns::{self, Batch, Columns};
 use super::file_sink::UncompressedFileSink;
-use super::layout::{Layout, Line, LAYOUT, SERIES_COMPONENT};
+use super::layout::{LAYOUT, Layout, Line, SERIES_COMPONENT};
 use super::select::Selection;
 use crate::digest;
 use crate::palette::Rgb;
@@ -117,7 +120,13 @@ impl RrdSink {
     /// Opens `path` for writing, with the scenario text as a document and the layout version
     /// as a property; `blueprint` is made and sent when the layout is known (the first send).
     /// `select` says what is written, and whether compressed.
-    pub fn create(path: &Path, name: &str, blueprint: impl FnOnce(&Layout) -> Blueprint + Send + 'static, scenario_toml: &str, select: Selection) -> Result<Self, String> {
+    pub fn create(
+        path: &Path,
+        name: &str,
+        blueprint: impl FnOnce(&Layout) -> Blueprint + Send + 'static,
+        scenario_toml: &str,
+        select: Selection,
+    ) -> Result<Self, String> {
         let sink = UncompressedFileSink::create_with(path, select.compress())?;
         let error = sink.error_slot();
         let rec = RecordingStreamBuilder::new("uio-observers")
@@ -125,10 +134,12 @@ impl RrdSink {
             .buffered()
             .map_err(|e| format!("{}: cannot record: {e}", path.display()))?;
         rec.set_sink(Box::new(sink));
-        rec.send_property("layout", &TextDocument::new(LAYOUT.to_string())).map_err(|e| e.to_string())?;
+        rec.send_property("layout", &TextDocument::new(LAYOUT.to_string()))
+            .map_err(|e| e.to_string())?;
         let scenario_text = format!("```toml\n{scenario_toml}\n```");
         let scenario_digest = digest::of_text(&scenario_text);
-        rec.log_static("scenario", &TextDocument::from_markdown(scenario_text)).map_err(|e| e.to_string())?;
+        rec.log_static("scenario", &TextDocument::from_markdown(scenario_text))
+            .map_err(|e| e.to_string())?;
         Ok(RrdSink {
             rec,
             groups: Vec::new(),
@@ -147,24 +158,48 @@ impl RrdSink {
     /// entities where their component already has one in an earlier group
     /// (`/observer/uio/what` beside `/observer/uio`).
     pub fn group(&mut self, label: &str) -> usize {
-        self.groups.push(Group { label: label.to_string(), steps: Vec::new(), times_ns: Vec::new(), entities: Vec::new(), width: 0, skip: false });
+        self.groups.push(Group {
+            label: label.to_string(),
+            steps: Vec::new(),
+            times_ns: Vec::new(),
+            entities: Vec::new(),
+            width: 0,
+            skip: false,
+        });
         self.groups.len() - 1
     }
 
     /// Registers signal `path` in `group` with its legend name, colour and line width (points).
     /// Every signal is registered before the first row: an entity's rows hold them all.
-    pub fn series(&mut self, group: usize, path: &str, legend: &str, color: Rgb, width: f32) -> SeriesId {
+    pub fn series(
+        &mut self,
+        group: usize,
+        path: &str,
+        legend: &str,
+        color: Rgb,
+        width: f32,
+    ) -> SeriesId {
         let live = self.select.entity(path);
         let id = self.signals.len();
         let (mut entity, mut slot) = (usize::MAX, 0);
         if live {
             let owner = signals::entity_of(path);
             let labelled = format!("{owner}/{}", self.groups[group].label);
-            entity = match self.entities.iter().position(|e| e.group == group && (e.path == owner || e.path == labelled)) {
+            entity = match self
+                .entities
+                .iter()
+                .position(|e| e.group == group && (e.path == owner || e.path == labelled))
+            {
                 Some(e) => e,
                 None => {
                     let taken = self.entities.iter().any(|e| e.path == owner);
-                    self.entities.push(Entity { path: if taken { labelled } else { owner }, group, series: Vec::new(), values: Vec::new(), announced: false });
+                    self.entities.push(Entity {
+                        path: if taken { labelled } else { owner },
+                        group,
+                        series: Vec::new(),
+                        values: Vec::new(),
+                        announced: false,
+                    });
                     self.groups[group].entities.push(self.entities.len() - 1);
                     self.entities.len() - 1
                 }
@@ -173,7 +208,16 @@ impl RrdSink {
             self.entities[entity].series.push(id);
             self.groups[group].width += 1;
         }
-        self.signals.push(Signal { path: path.to_string(), legend: legend.to_string(), color, width, group, live, entity, slot });
+        self.signals.push(Signal {
+            path: path.to_string(),
+            legend: legend.to_string(),
+            color,
+            width,
+            group,
+            live,
+            entity,
+            slot,
+        });
         SeriesId(id)
     }
 
@@ -228,15 +272,35 @@ impl RrdSink {
 
     /// The layout (every entity and its signals), sent once as the blueprint.
     fn send_blueprint(&mut self) -> Result<(), String> {
-        let Some(make) = self.blueprint.take() else { return Ok(()) };
+        let Some(make) = self.blueprint.take() else {
+            return Ok(());
+        };
         let mut layout = Layout::default();
         for e in &self.entities {
-            layout.entity(&e.path, e.series.iter().map(|&s| {
-                let sig = &self.signals[s];
-                (sig.path.clone(), Line { legend: sig.legend.clone(), color: sig.color, width: sig.width })
-            }));
+            layout.entity(
+                &e.path,
+                e.series.iter().map(|&s| {
+                    let sig = &self.signals[s];
+                    (
+                        sig.path.clone(),
+                        Line {
+                            legend: sig.legend.clone(),
+                            color: sig.color,
+                            width: sig.width,
+                        },
+                    )
+                }),
+            );
         }
-        make(&layout).send(&self.rec, BlueprintActivation { make_active: true, make_default: true }).map_err(|e| e.to_string())
+        make(&layout)
+            .send(
+                &self.rec,
+                BlueprintActivation {
+                    make_active: true,
+                    make_default: true,
+                },
+            )
+            .map_err(|e| e.to_string())
     }
 
     /// Logs entity `e`'s statics: the signal behind each element, and its line.
@@ -245,12 +309,28 @@ impl RrdSink {
         let sig = |s: &usize| &self.signals[*s];
         let lines = SeriesLines::new()
             .with_names(entity.series.iter().map(|s| sig(s).legend.clone()))
-            .with_colors(entity.series.iter().map(|s| Color::from_rgb(sig(s).color[0], sig(s).color[1], sig(s).color[2])))
+            .with_colors(
+                entity
+                    .series
+                    .iter()
+                    .map(|s| Color::from_rgb(sig(s).color[0], sig(s).color[1], sig(s).color[2])),
+            )
             .with_widths(entity.series.iter().map(|s| sig(s).width));
-        let names: ArrayRef = Arc::new(StringArray::from_iter_values(entity.series.iter().map(|s| sig(s).path.as_str())));
+        let names: ArrayRef = Arc::new(StringArray::from_iter_values(
+            entity.series.iter().map(|s| sig(s).path.as_str()),
+        ));
         let mut batches = lines.as_serialized_batches();
-        batches.push(SerializedComponentBatch::new(names, ComponentDescriptor { archetype: None, component: SERIES_COMPONENT.into(), component_type: None }));
-        self.rec.log_serialized_batches(entity.path.as_str(), true, batches).map_err(|e| e.to_string())?;
+        batches.push(SerializedComponentBatch::new(
+            names,
+            ComponentDescriptor {
+                archetype: None,
+                component: SERIES_COMPONENT.into(),
+                component_type: None,
+            },
+        ));
+        self.rec
+            .log_serialized_batches(entity.path.as_str(), true, batches)
+            .map_err(|e| e.to_string())?;
         self.entities[e].announced = true;
         Ok(())
     }
@@ -260,17 +340,35 @@ impl RrdSink {
             return Ok(());
         }
         self.send_blueprint()?;
-        let fresh: Vec<usize> = self.groups[i].entities.iter().copied().filter(|&e| !self.entities[e].announced).collect();
+        let fresh: Vec<usize> = self.groups[i]
+            .entities
+            .iter()
+            .copied()
+            .filter(|&e| !self.entities[e].announced)
+            .collect();
         for &e in &fresh {
             self.announce(e)?;
         }
         if !fresh.is_empty() {
             // Logged rows wait in Rerun's batcher while sent columns go straight through: the
             // readers need these statics before the entity's first rows.
-            self.rec.flush_blocking().map_err(|e| format!("{}: cannot write: {e}", self.path.display()))?;
+            self.rec
+                .flush_blocking()
+                .map_err(|e| format!("{}: cannot write: {e}", self.path.display()))?;
         }
         if self.columns.is_none() {
-            let entities = self.entities.iter().map(|e| columns::Entity { path: e.path.clone(), signals: e.series.iter().map(|&s| self.signals[s].path.clone()).collect() }).collect();
+            let entities = self
+                .entities
+                .iter()
+                .map(|e| columns::Entity {
+                    path: e.path.clone(),
+                    signals: e
+                        .series
+                        .iter()
+                        .map(|&s| self.signals[s].path.clone())
+                        .collect(),
+                })
+                .collect();
             self.columns = Some(Columns::start(self.rec.clone(), entities)?);
         }
         let g = &mut self.groups[i];
@@ -284,7 +382,13 @@ impl RrdSink {
                 .iter()
                 .map(|&e| {
                     let e_ = &mut self.entities[e];
-                    (e, std::mem::replace(&mut e_.values, Vec::with_capacity(rows * e_.series.len())))
+                    (
+                        e,
+                        std::mem::replace(
+                            &mut e_.values,
+                            Vec::with_capacity(rows * e_.series.len()),
+                        ),
+                    )
                 })
                 .collect(),
         };
@@ -303,10 +407,15 @@ impl RrdSink {
             Some(mut c) => c.finish()?,
             None => BTreeMap::new(),
         };
-        self.rec.send_property("steps", &TextDocument::new(steps_completed.to_string())).map_err(|e| e.to_string())?;
-        let mut digests: BTreeMap<String, String> = written.iter().map(|(k, d)| (k.clone(), d.hex())).collect();
+        self.rec
+            .send_property("steps", &TextDocument::new(steps_completed.to_string()))
+            .map_err(|e| e.to_string())?;
+        let mut digests: BTreeMap<String, String> =
+            written.iter().map(|(k, d)| (k.clone(), d.hex())).collect();
         digests.insert(digest::SCENARIO_KEY.into(), self.scenario_digest.clone());
-        self.rec.send_property("digest", &TextDocument::new(digest::to_json(&digests))).map_err(|e| e.to_string())?;
+        self.rec
+            .send_property("digest", &TextDocument::new(digest::to_json(&digests)))
+            .map_err(|e| e.to_string())?;
         let flushed = self.rec.flush_blocking();
         self.write_error()?;
         flushed.map_err(|e| format!("{}: cannot write: {e}", self.path.display()))?;

@@ -15,7 +15,11 @@ pub struct Selection {
 
 impl Default for Selection {
     fn default() -> Self {
-        Selection { every: 1, globs: None, compress: false }
+        Selection {
+            every: 1,
+            globs: None,
+            compress: false,
+        }
     }
 }
 
@@ -29,10 +33,18 @@ impl Selection {
             return Err("--record-every must be at least 1".into());
         }
         if patterns.is_empty() {
-            return Ok(Selection { every, globs: None, compress: false });
+            return Ok(Selection {
+                every,
+                globs: None,
+                compress: false,
+            });
         }
         let globs = Globs::new(patterns).map_err(|e| format!("--record {e}"))?;
-        Ok(Selection { every, globs: Some(globs), compress: false })
+        Ok(Selection {
+            every,
+            globs: Some(globs),
+            compress: false,
+        })
     }
 
     /// The same, written with Rerun's LZ4 chunk compression (`--compress`): about 0.64 × the
@@ -59,7 +71,9 @@ impl Selection {
 
     /// The `--record` patterns that select none of `paths`.
     pub fn unmatched<'a>(&self, paths: impl IntoIterator<Item = &'a str>) -> Vec<String> {
-        self.globs.as_ref().map_or_else(Vec::new, |g| g.unmatched(paths))
+        self.globs
+            .as_ref()
+            .map_or_else(Vec::new, |g| g.unmatched(paths))
     }
 
     /// Whether entity `path` is recorded.
@@ -75,10 +89,22 @@ mod tests {
     #[test]
     fn globs_match_by_segment() {
         let s = Selection::new(1, &["/plant/x/*".into(), "observer/uio/**".into()]).unwrap();
-        assert!(s.entity("/plant/x/1") && s.entity("/observer/uio/xhat/2") && s.entity("/observer/uio/error/1"));
-        assert!(!s.entity("/plant/y/1") && !s.entity("/plant/x") && !s.entity("/observer/luenberger/xhat/1"));
+        assert!(
+            s.entity("/plant/x/1")
+                && s.entity("/observer/uio/xhat/2")
+                && s.entity("/observer/uio/error/1")
+        );
+        assert!(
+            !s.entity("/plant/y/1")
+                && !s.entity("/plant/x")
+                && !s.entity("/observer/luenberger/xhat/1")
+        );
         assert!(Selection::new(1, &[]).unwrap().entity("/anything"));
-        assert!(Selection::new(1, &["/plant/[x".into()]).unwrap_err().starts_with("--record '/plant/[x': "));
+        assert!(
+            Selection::new(1, &["/plant/[x".into()])
+                .unwrap_err()
+                .starts_with("--record '/plant/[x': ")
+        );
         assert!(Selection::new(0, &[]).is_err());
         let thin = Selection::new(10, &[]).unwrap();
         assert!(thin.step(0) && thin.step(20) && !thin.step(5));

@@ -27,7 +27,11 @@ pub fn tail_start(completed: u64, planned: u64) -> Option<u64> {
         return None;
     }
     let start = completed - quarter;
-    if completed >= planned { Some(start) } else { Some(start - start % block_len(planned)) }
+    if completed >= planned {
+        Some(start)
+    } else {
+        Some(start - start % block_len(planned))
+    }
 }
 
 /// Maxima of one figure per block of steps, allocated once for the whole run.
@@ -42,7 +46,10 @@ impl BlockMax {
     /// For a run of `planned` steps.
     pub fn new(planned: u64) -> Self {
         let len = block_len(planned);
-        BlockMax { shift: len.trailing_zeros(), blocks: vec![0.0; planned.div_ceil(len).max(1) as usize] }
+        BlockMax {
+            shift: len.trailing_zeros(),
+            blocks: vec![0.0; planned.div_ceil(len).max(1) as usize],
+        }
     }
 
     /// Takes the value of step `k` into its block (steps beyond the plan are ignored).
@@ -55,7 +62,10 @@ impl BlockMax {
 
     /// The largest value from step `start` (a block boundary) on.
     pub fn max_from(&self, start: u64) -> f64 {
-        self.blocks.iter().skip((start >> self.shift) as usize).fold(0.0, |m, &v| nan_max(m, v))
+        self.blocks
+            .iter()
+            .skip((start >> self.shift) as usize)
+            .fold(0.0, |m, &v| nan_max(m, v))
     }
 }
 

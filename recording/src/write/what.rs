@@ -8,8 +8,8 @@
 //! recorded at t_k, beside the w_k it estimates; its error is w_k − ŵ_k with w_k the plant's
 //! recorded w(t_k) — the value held over the step for steps and piecewise inputs.
 
-use lti::input_estimate::InputEstimateStep;
 use lti::Mat;
+use lti::input_estimate::InputEstimateStep;
 
 use super::metrics::nan_max;
 use super::tail::BlockMax;
@@ -30,14 +30,28 @@ pub struct InputEstimate {
 impl InputEstimate {
     /// From W, WCΦ, WCΓ_B (and the constant c at an operating point), for a run of `steps`
     /// steps whose tail starts at `planned_tail`.
-    pub fn new(w: Mat, w_c_phi: &Mat, w_c_gamma_b: &Mat, offset: Option<Vec<f64>>, steps: u64, planned_tail: u64) -> Self {
+    pub fn new(
+        w: Mat,
+        w_c_phi: &Mat,
+        w_c_gamma_b: &Mat,
+        offset: Option<Vec<f64>>,
+        steps: u64,
+        planned_tail: u64,
+    ) -> Self {
         let q = w.nrows();
         let step = InputEstimateStep::new(w, w_c_phi, w_c_gamma_b);
         let step = match offset {
             Some(c) => step.with_offset(c),
             None => step,
         };
-        InputEstimate { step, prev_w: vec![0.0; q], ready: false, errors: BlockMax::new(steps), exact_tail: 0.0, planned_tail }
+        InputEstimate {
+            step,
+            prev_w: vec![0.0; q],
+            ready: false,
+            errors: BlockMax::new(steps),
+            exact_tail: 0.0,
+            planned_tail,
+        }
     }
 
     /// ŵ_{k−1}, completed by the last row (valid when `ready`).
@@ -49,7 +63,12 @@ impl InputEstimate {
     pub fn push(&mut self, k: u64, y: &[f64], u_prev: &[f64], w: &[f64], xhat: &[f64]) {
         self.ready = self.step.push(y, u_prev, xhat);
         if self.ready {
-            let err = self.step.value.iter().zip(&self.prev_w).fold(0.0, |m, (a, b)| nan_max(m, (a - b).abs()));
+            let err = self
+                .step
+                .value
+                .iter()
+                .zip(&self.prev_w)
+                .fold(0.0, |m, (a, b)| nan_max(m, (a - b).abs()));
             self.errors.push(k - 1, err);
             if k > self.planned_tail {
                 self.exact_tail = nan_max(self.exact_tail, err);
@@ -59,6 +78,10 @@ impl InputEstimate {
     }
     /// max |w − ŵ| over the tail [start, …) of the estimates completed; exact for a completed run.
     pub fn tail_max_abs_error(&self, start: u64, completed: bool) -> f64 {
-        if completed { self.exact_tail } else { self.errors.max_from(start) }
+        if completed {
+            self.exact_tail
+        } else {
+            self.errors.max_from(start)
+        }
     }
 }

@@ -41,17 +41,41 @@ pub fn jacobian(f: &mut OneSample, z: &[f64]) -> Result<Jacobian, String> {
     for (j, &h) in steps.iter().enumerate() {
         let d1 = column(f, z, j, h)?;
         let d2 = column(f, z, j, h / 2.0)?;
-        cols.push(d2.iter().zip(&d1).map(|(b, a)| b + (b - a) / 3.0).collect::<Vec<f64>>());
-        errs.push(d2.iter().zip(&d1).map(|(b, a)| (b - a).abs() / 3.0).collect::<Vec<f64>>());
+        cols.push(
+            d2.iter()
+                .zip(&d1)
+                .map(|(b, a)| b + (b - a) / 3.0)
+                .collect::<Vec<f64>>(),
+        );
+        errs.push(
+            d2.iter()
+                .zip(&d1)
+                .map(|(b, a)| (b - a).abs() / 3.0)
+                .collect::<Vec<f64>>(),
+        );
     }
     let rows = cols.first().map_or(0, Vec::len);
-    let t = |c: &Vec<Vec<f64>>| (0..rows).map(|i| c.iter().map(|col| col[i]).collect()).collect();
-    Ok(Jacobian { value: t(&cols), error: t(&errs), steps })
+    let t = |c: &Vec<Vec<f64>>| {
+        (0..rows)
+            .map(|i| c.iter().map(|col| col[i]).collect())
+            .collect()
+    };
+    Ok(Jacobian {
+        value: t(&cols),
+        error: t(&errs),
+        steps,
+    })
 }
 
 /// Rows `r`, columns `c` of the Jacobian, with the block's largest error estimate.
 pub fn block(d: &Jacobian, r: std::ops::Range<usize>, c: std::ops::Range<usize>) -> Block {
-    let rows = d.value[r.clone()].iter().map(|row| row[c.clone()].to_vec()).collect();
-    let error = d.error[r].iter().flat_map(|row| row[c.clone()].iter().copied()).fold(0.0, f64::max);
+    let rows = d.value[r.clone()]
+        .iter()
+        .map(|row| row[c.clone()].to_vec())
+        .collect();
+    let error = d.error[r]
+        .iter()
+        .flat_map(|row| row[c.clone()].iter().copied())
+        .fold(0.0, f64::max);
     Block { rows, error }
 }

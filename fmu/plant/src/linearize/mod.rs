@@ -30,7 +30,7 @@ mod trim;
 
 use serde::{Deserialize, Serialize};
 
-use crate::check::{resolve, Map, Start};
+use crate::check::{Map, Start, resolve};
 use crate::params::Params;
 use crate::slave::Archive;
 
@@ -107,17 +107,38 @@ impl OneSample<'_> {
             .parameters
             .iter()
             .cloned()
-            .chain(self.map.inputs.iter().zip(&z[n..n + l]).map(|(&vr, &v)| (vr, Start::Real(v))))
-            .chain(self.map.disturbances.iter().zip(&z[n + l..]).map(|(&vr, &v)| (vr, Start::Real(v))))
+            .chain(
+                self.map
+                    .inputs
+                    .iter()
+                    .zip(&z[n..n + l])
+                    .map(|(&vr, &v)| (vr, Start::Real(v))),
+            )
+            .chain(
+                self.map
+                    .disturbances
+                    .iter()
+                    .zip(&z[n + l..])
+                    .map(|(&vr, &v)| (vr, Start::Real(v))),
+            )
             .collect();
-        let x0: Vec<(u32, f64)> = self.map.states.iter().zip(&z[..n]).map(|(&vr, &v)| (vr, v)).collect();
+        let x0: Vec<(u32, f64)> = self
+            .map
+            .states
+            .iter()
+            .zip(&z[..n])
+            .map(|(&vr, &v)| (vr, v))
+            .collect();
         self.instances += 1;
         let mut s = self.archive.start("linearize", &starts, &x0)?;
         let (mut x, mut y) = (vec![0.0; n], vec![0.0; self.map.outputs.len()]);
         s.get(&self.map.outputs, &mut y, 0.0)?;
         s.get(&self.map.states, &mut x, 0.0)?;
         if let Some(i) = (0..n).find(|&i| x[i] != z[i]) {
-            return Err(format!("the state '{}' reads {} after initialisation where its start value was {}: the FMU does not start where it is set", self.p.states[i], x[i], z[i]));
+            return Err(format!(
+                "the state '{}' reads {} after initialisation where its start value was {}: the FMU does not start where it is set",
+                self.p.states[i], x[i], z[i]
+            ));
         }
         let h = self.dt / self.p.substeps.max(1) as f64;
         for j in 0..self.p.substeps.max(1) {
@@ -129,20 +150,36 @@ impl OneSample<'_> {
 }
 
 fn run(req: &Request) -> Result<Answer, String> {
-    let (n, l, q) = (req.params.states.len(), req.params.inputs.len(), req.params.disturbances.len());
+    let (n, l, q) = (
+        req.params.states.len(),
+        req.params.inputs.len(),
+        req.params.disturbances.len(),
+    );
     if req.u.len() != l || req.w.len() != q {
-        return Err(format!("operating point: {} u and {} w given for {l} inputs and {q} disturbances", req.u.len(), req.w.len()));
+        return Err(format!(
+            "operating point: {} u and {} w given for {l} inputs and {q} disturbances",
+            req.u.len(),
+            req.w.len()
+        ));
     }
     if !(req.dt > 0.0 && req.dt.is_finite()) {
         return Err(format!("dt = {}: must be finite and > 0", req.dt));
     }
     let params = &req.params;
     let Some(x_start) = params.x0.clone() else {
-        return Err("x_op: the launcher gives the operating point's x (or the trim's first guess)".into());
+        return Err(
+            "x_op: the launcher gives the operating point's x (or the trim's first guess)".into(),
+        );
     };
     let (fmu, map) = resolve(params)?;
     let archive = Archive::open(&params.path, fmu.version, map.python.as_ref())?;
-    let mut f = OneSample { p: params, map: &map, archive, dt: req.dt, instances: 0 };
+    let mut f = OneSample {
+        p: params,
+        map: &map,
+        archive,
+        dt: req.dt,
+        instances: 0,
+    };
     let (x, trim) = if req.trim {
         let t = trim::newton(&mut f, &x_start, &req.u, &req.w)?;
         (t.0, Some(t.1))
@@ -174,5 +211,7 @@ fn run(req: &Request) -> Result<Answer, String> {
 /// line for a request the FMU cannot answer.
 pub fn main() -> std::process::ExitCode {
     let answer = crate::request::read::<Request>("request").and_then(|r| run(&r));
-    crate::request::answer(answer.map(|a| Some(serde_json::to_string(&a).expect("numbers serialise"))))
+    crate::request::answer(
+        answer.map(|a| Some(serde_json::to_string(&a).expect("numbers serialise"))),
+    )
 }

@@ -5,8 +5,8 @@
 //! state the equilibrium does not fix (a free integrator such as a shaft angle): reported,
 //! left where it was, and what residual stays there is said, not hidden.
 
-use lti::linalg::svd::Svd;
 use lti::DMatrix;
+use lti::linalg::svd::Svd;
 
 use super::difference::{column, step};
 use super::{OneSample, Trim};
@@ -16,7 +16,12 @@ pub const MAX_ITERATIONS: usize = 30;
 /// Singular values of Φ − I at or below this fraction of the largest are a free direction.
 pub const FREE: f64 = 1e-8;
 
-pub fn newton(f: &mut OneSample, x_start: &[f64], u: &[f64], w: &[f64]) -> Result<(Vec<f64>, Trim), String> {
+pub fn newton(
+    f: &mut OneSample,
+    x_start: &[f64],
+    u: &[f64],
+    w: &[f64],
+) -> Result<(Vec<f64>, Trim), String> {
     let n = x_start.len();
     let mut x = x_start.to_vec();
     let z = |x: &[f64]| x.iter().chain(u).chain(w).copied().collect::<Vec<f64>>();
@@ -36,7 +41,8 @@ pub fn newton(f: &mut OneSample, x_start: &[f64], u: &[f64], w: &[f64]) -> Resul
                 j[(r, c)] = col[r] - if r == c { 1.0 } else { 0.0 };
             }
         }
-        let free = free.get_or_insert_with(|| null_states(&j, (0..n).collect()).unwrap_or_default());
+        let free =
+            free.get_or_insert_with(|| null_states(&j, (0..n).collect()).unwrap_or_default());
         let active: Vec<usize> = (0..n).filter(|k| !free.contains(k)).collect();
         let m = active.len();
         let ja = DMatrix::from_fn(m, m, |r, c| j[(active[r], active[c])]);
@@ -64,17 +70,29 @@ pub fn newton(f: &mut OneSample, x_start: &[f64], u: &[f64], w: &[f64]) -> Resul
         // Converged: what a step could still remove is at rounding level, or stopped shrinking.
         if reducible <= 1e-13 * scale || (it > 3 && reducible >= 0.5 * last_norm) {
             let residual = g.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            return Ok((x, Trim { iterations: it, residual, step_residual: g, free: free.clone() }));
+            return Ok((
+                x,
+                Trim {
+                    iterations: it,
+                    residual,
+                    step_residual: g,
+                    free: free.clone(),
+                },
+            ));
         }
         last_norm = reducible;
         for (&k, d) in active.iter().zip(&delta) {
             x[k] += d;
         }
         if x.iter().any(|v| !v.is_finite()) {
-            return Err(format!("trim: Newton's step left the finite numbers at iteration {it}"));
+            return Err(format!(
+                "trim: Newton's step left the finite numbers at iteration {it}"
+            ));
         }
     }
-    Err(format!("trim: no equilibrium within {MAX_ITERATIONS} Newton iterations from x = {x_start:?}"))
+    Err(format!(
+        "trim: no equilibrium within {MAX_ITERATIONS} Newton iterations from x = {x_start:?}"
+    ))
 }
 
 /// The states (of `index`, the rows and columns of `j`) in a null direction of `j`: entries
@@ -82,7 +100,12 @@ pub fn newton(f: &mut OneSample, x_start: &[f64], u: &[f64], w: &[f64]) -> Resul
 fn null_states(j: &DMatrix<f64>, index: Vec<usize>) -> Option<Vec<usize>> {
     let svd = Svd::new(j)?;
     let s1 = svd.s.first().copied().unwrap_or(0.0);
-    let null: Vec<usize> = (0..svd.s.len()).filter(|&i| svd.s[i] <= FREE * s1).collect();
-    let states: Vec<usize> = (0..index.len()).filter(|&k| null.iter().any(|&i| svd.v[(k, i)].abs() > 0.1)).map(|k| index[k]).collect();
+    let null: Vec<usize> = (0..svd.s.len())
+        .filter(|&i| svd.s[i] <= FREE * s1)
+        .collect();
+    let states: Vec<usize> = (0..index.len())
+        .filter(|&k| null.iter().any(|&i| svd.v[(k, i)].abs() > 0.1))
+        .map(|k| index[k])
+        .collect();
     (!states.is_empty()).then_some(states)
 }

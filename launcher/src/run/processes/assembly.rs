@@ -3,7 +3,7 @@
 
 use std::collections::VecDeque;
 
-use lockstep::{Header, Reader, WireHeader, PROTOCOL_VERSION};
+use lockstep::{Header, PROTOCOL_VERSION, Reader, WireHeader};
 
 use super::super::envelope::Launchable;
 use super::super::session::Session;
@@ -31,7 +31,14 @@ impl Queue {
             super::super::envelope::Program::Remote(_, r) => Some(r.host.clone()),
             _ => None,
         };
-        Queue { label: c.label.clone(), names: c.config.publishes.names.clone(), items: VecDeque::new(), free: Vec::new(), last: None, host }
+        Queue {
+            label: c.label.clone(),
+            names: c.config.publishes.names.clone(),
+            items: VecDeque::new(),
+            free: Vec::new(),
+            last: None,
+            host,
+        }
     }
 
     pub(super) fn is_empty(&self) -> bool {
@@ -76,15 +83,28 @@ impl Queue {
     /// because of another's sample, the launcher names the one that broke the protocol.
     fn violation(&self, width: usize) -> Option<LaunchError> {
         self.items.iter().find_map(|(h, values)| {
-            let broken = |why: String| Some(LaunchError::Component(format!("{} broke the protocol at step {}: {why}", self.label, h.step)));
+            let broken = |why: String| {
+                Some(LaunchError::Component(format!(
+                    "{} broke the protocol at step {}: {why}",
+                    self.label, h.step
+                )))
+            };
             if h.protocol != PROTOCOL_VERSION {
-                return broken(format!("its sample says protocol version {}, the run speaks {PROTOCOL_VERSION}", h.protocol));
+                return broken(format!(
+                    "its sample says protocol version {}, the run speaks {PROTOCOL_VERSION}",
+                    h.protocol
+                ));
             }
             if values.len() != width {
-                return broken(format!("its sample has {} values, the run's configuration says {width}", values.len()));
+                return broken(format!(
+                    "its sample has {} values, the run's configuration says {width}",
+                    values.len()
+                ));
             }
             let i = values.iter().position(|v| !v.is_finite())?;
-            let name = self.names.get(i).map_or(String::new(), |n| format!(" ({})", scenario::untrusted::quoted(n)));
+            let name = self.names.get(i).map_or(String::new(), |n| {
+                format!(" ({})", scenario::untrusted::quoted(n))
+            });
             broken(format!("value {}{name} is {}", i + 1, values[i]))
         })
     }
@@ -94,9 +114,17 @@ impl Queue {
     /// sent), the number of values, and that each is finite.
     pub(super) fn take(&mut self, k: u64, out: &mut [f64]) -> Result<Header, LaunchError> {
         let (h, values) = self.items.pop_front().expect("non-empty");
-        let broken = |why: String| LaunchError::Component(format!("{} broke the protocol at step {k}: {why}", self.label));
+        let broken = |why: String| {
+            LaunchError::Component(format!(
+                "{} broke the protocol at step {k}: {why}",
+                self.label
+            ))
+        };
         if h.protocol != PROTOCOL_VERSION {
-            return Err(broken(format!("its sample says protocol version {}, the run speaks {PROTOCOL_VERSION}", h.protocol)));
+            return Err(broken(format!(
+                "its sample says protocol version {}, the run speaks {PROTOCOL_VERSION}",
+                h.protocol
+            )));
         }
         if h.step != k {
             return Err(broken(format!("its sample is of step {}", h.step)));
@@ -105,10 +133,16 @@ impl Queue {
             return Err(broken(why));
         }
         if values.len() != out.len() {
-            return Err(broken(format!("its sample has {} values, the run's configuration says {}", values.len(), out.len())));
+            return Err(broken(format!(
+                "its sample has {} values, the run's configuration says {}",
+                values.len(),
+                out.len()
+            )));
         }
         if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-            let name = self.names.get(i).map_or(String::new(), |n| format!(" ({})", scenario::untrusted::quoted(n)));
+            let name = self.names.get(i).map_or(String::new(), |n| {
+                format!(" ({})", scenario::untrusted::quoted(n))
+            });
             return Err(broken(format!("value {}{name} is {}", i + 1, values[i])));
         }
         out.copy_from_slice(&values);
@@ -120,7 +154,14 @@ impl Queue {
     /// its input (`taken_ns`) before that input was sent. A component that publishes without
     /// reading would otherwise go unnoticed until its full subscriber buffer blocks the plant.
     /// Two hosts' CLOCK_MONOTONIC have unrelated origins, so a hop between hosts is not checked.
-    pub(super) fn made_after(&self, k: u64, own: &Header, input: &Header, input_label: &str, input_host: &Option<String>) -> Result<(), LaunchError> {
+    pub(super) fn made_after(
+        &self,
+        k: u64,
+        own: &Header,
+        input: &Header,
+        input_label: &str,
+        input_host: &Option<String>,
+    ) -> Result<(), LaunchError> {
         if self.host == *input_host && own.taken_ns < input.sent_ns {
             return Err(LaunchError::Component(format!(
                 "{} broke the protocol at step {k}: it published the step before {input_label}'s sample {k} was sent (it does not read its input)",
@@ -153,10 +194,24 @@ pub(super) struct Assembly {
 impl Assembly {
     /// The queues of `components` (plant, observer processes, controller), as the launcher
     /// spawns them.
-    pub(super) fn new(components: &[Launchable], cfg: &super::super::configs::Configs, steps: u64, dt: f64, controller_observer: Option<usize>) -> Self {
+    pub(super) fn new(
+        components: &[Launchable],
+        cfg: &super::super::configs::Configs,
+        steps: u64,
+        dt: f64,
+        controller_observer: Option<usize>,
+    ) -> Self {
         let nproc = cfg.processes.len();
         let members: Vec<Vec<usize>> = cfg.processes.iter().map(|p| p.observers.clone()).collect();
-        let controller_observer = controller_observer.map(|c| (c, members.iter().position(|m| m.contains(&c)).expect("every observer has a process")));
+        let controller_observer = controller_observer.map(|c| {
+            (
+                c,
+                members
+                    .iter()
+                    .position(|m| m.contains(&c))
+                    .expect("every observer has a process"),
+            )
+        });
         Assembly {
             plant: Queue::new(&components[0]),
             observers: components[1..1 + nproc].iter().map(Queue::new).collect(),
@@ -165,7 +220,16 @@ impl Assembly {
             steps,
             dt,
             controller_observer,
-            scratch: members.iter().map(|m| if m.len() > 1 { vec![0.0; m.len() * cfg.layout.n] } else { Vec::new() }).collect(),
+            scratch: members
+                .iter()
+                .map(|m| {
+                    if m.len() > 1 {
+                        vec![0.0; m.len() * cfg.layout.n]
+                    } else {
+                        Vec::new()
+                    }
+                })
+                .collect(),
             members,
         }
     }
@@ -180,7 +244,10 @@ impl Assembly {
         if let Some(i) = self.observers.iter().position(|q| q.is_empty()) {
             return Some(1 + i);
         }
-        self.controller.as_ref().filter(|q| q.is_empty()).map(|_| 1 + self.observers.len())
+        self.controller
+            .as_ref()
+            .filter(|q| q.is_empty())
+            .map(|_| 1 + self.observers.len())
     }
 
     /// A queued sample that breaks the protocol (see [`Queue::violation`]), with the widths of
@@ -188,18 +255,33 @@ impl Assembly {
     pub(super) fn queued_violation(&self, row: &StepRow) -> Option<LaunchError> {
         self.plant
             .violation(row.plant.len())
-            .or_else(|| self.observers.iter().zip(&self.members).find_map(|(q, m)| q.violation(m.len() * row.xhat.first().map_or(0, Vec::len))))
-            .or_else(|| self.controller.as_ref().and_then(|q| q.violation(row.u.len())))
+            .or_else(|| {
+                self.observers
+                    .iter()
+                    .zip(&self.members)
+                    .find_map(|(q, m)| q.violation(m.len() * row.xhat.first().map_or(0, Vec::len)))
+            })
+            .or_else(|| {
+                self.controller
+                    .as_ref()
+                    .and_then(|q| q.violation(row.u.len()))
+            })
     }
 
     /// Moves every complete step into the session.
-    pub(super) fn assemble(&mut self, row: &mut StepRow, session: &mut Session) -> Result<usize, LaunchError> {
+    pub(super) fn assemble(
+        &mut self,
+        row: &mut StepRow,
+        session: &mut Session,
+    ) -> Result<usize, LaunchError> {
         let mut done = 0;
         loop {
             if self.next >= self.steps {
                 return Ok(done);
             }
-            let ready = !self.plant.is_empty() && self.observers.iter().all(|q| !q.is_empty()) && self.controller.as_ref().is_none_or(|q| !q.is_empty());
+            let ready = !self.plant.is_empty()
+                && self.observers.iter().all(|q| !q.is_empty())
+                && self.controller.as_ref().is_none_or(|q| !q.is_empty());
             if !ready {
                 return Ok(done);
             }
@@ -207,16 +289,30 @@ impl Assembly {
             row.plant_hdr = self.plant.take(k, &mut row.plant)?;
             row.k = k;
             row.t = k as f64 * self.dt;
-            for ((q, members), buf) in self.observers.iter_mut().zip(&self.members).zip(&mut self.scratch) {
+            for ((q, members), buf) in self
+                .observers
+                .iter_mut()
+                .zip(&self.members)
+                .zip(&mut self.scratch)
+            {
                 if let [i] = members[..] {
                     row.xhat_hdr[i] = q.take(k, &mut row.xhat[i])?;
-                    q.made_after(k, &row.xhat_hdr[i], &row.plant_hdr, "the plant", &self.plant.host)?;
+                    q.made_after(
+                        k,
+                        &row.xhat_hdr[i],
+                        &row.plant_hdr,
+                        "the plant",
+                        &self.plant.host,
+                    )?;
                     continue;
                 }
                 // A bank's process: its members' x̂ side by side.
                 let h = q.take(k, buf)?;
                 q.made_after(k, &h, &row.plant_hdr, "the plant", &self.plant.host)?;
-                for (&i, x) in members.iter().zip(buf.chunks_exact(row.xhat[members[0]].len())) {
+                for (&i, x) in members
+                    .iter()
+                    .zip(buf.chunks_exact(row.xhat[members[0]].len()))
+                {
                     row.xhat[i].copy_from_slice(x);
                     row.xhat_hdr[i] = h;
                 }
@@ -249,7 +345,10 @@ impl Assembly {
         let (q, last) = match i {
             0 => (&self.plant, self.steps),
             i if i <= nobs => (&self.observers[i - 1], self.steps.saturating_sub(1)),
-            _ => (self.controller.as_ref().expect("a controller"), self.steps.saturating_sub(1)),
+            _ => (
+                self.controller.as_ref().expect("a controller"),
+                self.steps.saturating_sub(1),
+            ),
         };
         q.last.is_some_and(|l| l >= last)
     }
@@ -289,4 +388,3 @@ impl Readers<'_> {
         Ok(got)
     }
 }
-

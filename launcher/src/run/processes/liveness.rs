@@ -29,15 +29,25 @@ pub struct Look {
 
 /// What the group looks like now, or `None` when it is gone.
 pub fn look(pgid: u32) -> Option<Look> {
-    let mut out = Look { stopped: false, runnable: false, ticks: 0 };
+    let mut out = Look {
+        stopped: false,
+        runnable: false,
+        ticks: 0,
+    };
     let mut found = false;
     for entry in std::fs::read_dir("/proc").ok()?.flatten() {
         let name = entry.file_name();
-        let Some(pid) = name.to_str().and_then(|n| n.parse::<u32>().ok()) else { continue };
-        let Ok(stat) = std::fs::read_to_string(format!("/proc/{pid}/stat")) else { continue };
+        let Some(pid) = name.to_str().and_then(|n| n.parse::<u32>().ok()) else {
+            continue;
+        };
+        let Ok(stat) = std::fs::read_to_string(format!("/proc/{pid}/stat")) else {
+            continue;
+        };
         // "pid (comm) S ppid pgrp session tty tpgid flags minflt cminflt majflt cmajflt utime stime …":
         // the fields after the last ')' (comm may hold anything).
-        let Some((_, rest)) = stat.rsplit_once(')') else { continue };
+        let Some((_, rest)) = stat.rsplit_once(')') else {
+            continue;
+        };
         let f: Vec<&str> = rest.split_whitespace().collect();
         if f.len() < 13 || f[2].parse::<u32>().ok() != Some(pgid) {
             continue;
@@ -74,7 +84,10 @@ pub struct Watch {
 impl Watch {
     /// A first look at every group.
     pub fn new(pgids: &[u32]) -> Self {
-        Watch { at: Instant::now(), last: pgids.iter().map(|&p| look(p)).collect() }
+        Watch {
+            at: Instant::now(),
+            last: pgids.iter().map(|&p| look(p)).collect(),
+        }
     }
 
     /// Every [`LOOK_EVERY`]: the verdict on group `i` against the previous look, and a new look
@@ -104,7 +117,13 @@ mod tests {
     #[test]
     fn the_kernel_tells_busy_blocked_and_stopped_apart() {
         use std::os::unix::process::CommandExt;
-        let spawn = |script: &str| std::process::Command::new("sh").args(["-c", script]).process_group(0).spawn().unwrap();
+        let spawn = |script: &str| {
+            std::process::Command::new("sh")
+                .args(["-c", script])
+                .process_group(0)
+                .spawn()
+                .unwrap()
+        };
         let mut spin = spawn("while :; do :; done");
         let mut sleep = spawn("sleep 30");
         let mut stop = spawn("sleep 30");

@@ -16,16 +16,16 @@ use std::path::Path;
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-use lockstep::{cleanup_dead_runs, Bus, Reader, RunSpace, Wait};
+use lockstep::{Bus, Reader, RunSpace, Wait, cleanup_dead_runs};
 use scenario::Scenario;
 
 use self::assembly::{Assembly, Readers};
 use self::placement::placement;
-use self::proc::{spawn, stop_all, Proc};
+use self::proc::{Proc, spawn, stop_all};
 use super::configs::Configs;
 use super::envelope::envelopes;
 use super::session::Session;
-use super::{interrupt, Stop};
+use super::{Stop, interrupt};
 use crate::error::LaunchError;
 use recording::write::StepRow;
 
@@ -43,7 +43,13 @@ const POLL: Duration = Duration::from_millis(5);
 const CHUNK: usize = 16;
 
 /// Runs the scenario across processes.
-pub fn run(s: &Scenario, cfg: &Configs, session: &mut Session, wait: Wait, pin: bool) -> Result<Stop, LaunchError> {
+pub fn run(
+    s: &Scenario,
+    cfg: &Configs,
+    session: &mut Session,
+    wait: Wait,
+    pin: bool,
+) -> Result<Stop, LaunchError> {
     cleanup_dead_runs();
     let space = RunSpace::create().map_err(|e| LaunchError::Component(e.to_string()))?;
     let result = run_in(s, &space, cfg, session, wait, pin);
@@ -51,26 +57,46 @@ pub fn run(s: &Scenario, cfg: &Configs, session: &mut Session, wait: Wait, pin: 
     result
 }
 
-fn run_in(s: &Scenario, space: &RunSpace, cfg: &Configs, session: &mut Session, wait: Wait, pin: bool) -> Result<Stop, LaunchError> {
+fn run_in(
+    s: &Scenario,
+    space: &RunSpace,
+    cfg: &Configs,
+    session: &mut Session,
+    wait: Wait,
+    pin: bool,
+) -> Result<Stop, LaunchError> {
     let ipc = |e: lockstep::LockstepError| LaunchError::Component(e.to_string());
     let components = envelopes(s, cfg, space, wait);
     for c in &components {
-        space.write_config(&c.file(), &to_json(&c.config)).map_err(ipc)?;
+        space
+            .write_config(&c.file(), &to_json(&c.config))
+            .map_err(ipc)?;
     }
 
     // The recorder's subscribers exist before any component can publish: they create every
     // service of the run (PROTOCOL.md §4).
     let bus = Bus::join(space, "launcher", Wait::Yield).map_err(ipc)?;
     space.restrict_shm().map_err(ipc)?;
-    let readers: Vec<Reader> = components.iter().map(|c| bus.reader(&c.config.publishes.service)).collect::<Result<_, _>>().map_err(ipc)?;
+    let readers: Vec<Reader> = components
+        .iter()
+        .map(|c| bus.reader(&c.config.publishes.service))
+        .collect::<Result<_, _>>()
+        .map_err(ipc)?;
     // Observer processes: one per observer, one per bank (its members together).
     let nobs = cfg.processes.len();
 
     let (tx, rx) = mpsc::channel();
     let mut procs: Vec<Proc> = Vec::new();
     let (plant_cpu, observer_cpus, controller_cpu) = placement(cfg, pin);
-    let cpus: Vec<Option<usize>> = std::iter::once(plant_cpu).chain(observer_cpus).chain(s.controller.as_ref().map(|_| controller_cpu)).collect();
-    let workdir = s.path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let cpus: Vec<Option<usize>> = std::iter::once(plant_cpu)
+        .chain(observer_cpus)
+        .chain(s.controller.as_ref().map(|_| controller_cpu))
+        .collect();
+    let workdir = s
+        .path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     let workdir = &std::path::absolute(workdir).unwrap_or_else(|_| workdir.to_path_buf());
     let result = (|| {
         for (i, (c, &cpu)) in components.iter().zip(&cpus).enumerate() {
@@ -78,8 +104,20 @@ fn run_in(s: &Scenario, space: &RunSpace, cfg: &Configs, session: &mut Session, 
         }
         let stall = Duration::from_secs_f64(s.stall_timeout);
         handshake(&mut procs, &rx, stall)?;
-        let r = Readers { plant: &readers[0], observers: &readers[1..1 + nobs], controller: readers.get(1 + nobs) };
-        let mut asm = Assembly::new(&components, cfg, s.steps, s.dt, s.controller.as_ref().and_then(|c| s.observers.iter().position(|o| o.name == c.observer)));
+        let r = Readers {
+            plant: &readers[0],
+            observers: &readers[1..1 + nobs],
+            controller: readers.get(1 + nobs),
+        };
+        let mut asm = Assembly::new(
+            &components,
+            cfg,
+            s.steps,
+            s.dt,
+            s.controller
+                .as_ref()
+                .and_then(|c| s.observers.iter().position(|o| o.name == c.observer)),
+        );
         supervise(cfg, session, &mut procs, &r, &mut asm, stall)
     })();
     stop_all(&mut procs);
@@ -96,7 +134,11 @@ const EXIT_GRACE: Duration = Duration::from_millis(100);
 /// after [`READY_TIMEOUT`] is waited for up to the stall limit while it runs or waits for a core
 /// (an interpreter importing its libraries on a loaded machine), and named once blocked; one the
 /// kernel has stopped (SIGSTOP, a debugger) is named after [`STALL_BLOCKED`].
-fn handshake(procs: &mut [Proc], rx: &mpsc::Receiver<(usize, Option<String>)>, stall: Duration) -> Result<(), LaunchError> {
+fn handshake(
+    procs: &mut [Proc],
+    rx: &mpsc::Receiver<(usize, Option<String>)>,
+    stall: Duration,
+) -> Result<(), LaunchError> {
     let start = Instant::now();
     let pgids: Vec<u32> = procs.iter().map(|p| p.child.id()).collect();
     let mut watch: Option<liveness::Watch> = None;
@@ -104,7 +146,9 @@ fn handshake(procs: &mut [Proc], rx: &mpsc::Receiver<(usize, Option<String>)>, s
     let mut ready = vec![false; procs.len()];
     while !ready.iter().all(|&r| r) {
         if let Some(sig) = interrupt::received() {
-            return Err(LaunchError::Interrupted(format!("{sig} received while the components started")));
+            return Err(LaunchError::Interrupted(format!(
+                "{sig} received while the components started"
+            )));
         }
         for p in procs.iter_mut() {
             if p.status.is_none()
@@ -113,7 +157,10 @@ fn handshake(procs: &mut [Proc], rx: &mpsc::Receiver<(usize, Option<String>)>, s
                 p.status = Some(st);
                 // Give its stderr reader a moment to collect the message.
                 std::thread::sleep(Duration::from_millis(20));
-                return Err(LaunchError::Component(format!("{} before the run began", p.describe_exit())));
+                return Err(LaunchError::Component(format!(
+                    "{} before the run began",
+                    p.describe_exit()
+                )));
             }
         }
         match rx.recv_timeout(Duration::from_millis(20)) {
@@ -135,14 +182,26 @@ fn handshake(procs: &mut [Proc], rx: &mpsc::Receiver<(usize, Option<String>)>, s
                 looks += 1;
                 let waited = start.elapsed();
                 named = match v {
-                    liveness::Verdict::Stopped => Some(format!("{} did not report ready within {} s and is stopped", procs[i].describe_stall(), waited.as_secs())),
-                    liveness::Verdict::Blocked if waited > READY_TIMEOUT => Some(format!("{} did not report ready within {} s and is asleep, using no CPU", procs[i].describe_stall(), READY_TIMEOUT.as_secs())),
+                    liveness::Verdict::Stopped => Some(format!(
+                        "{} did not report ready within {} s and is stopped",
+                        procs[i].describe_stall(),
+                        waited.as_secs()
+                    )),
+                    liveness::Verdict::Blocked if waited > READY_TIMEOUT => Some(format!(
+                        "{} did not report ready within {} s and is asleep, using no CPU",
+                        procs[i].describe_stall(),
+                        READY_TIMEOUT.as_secs()
+                    )),
                     _ => None,
                 };
             }
             if named.is_none() && start.elapsed() > stall.max(READY_TIMEOUT) {
                 let labels: Vec<&str> = slow.iter().map(|&i| procs[i].label.as_str()).collect();
-                named = Some(format!("{} did not report ready within {} s (the stall limit: stall_timeout in the scenario, --stall-timeout)", labels.join(", "), lti::eig::sig(stall.max(READY_TIMEOUT).as_secs_f64())));
+                named = Some(format!(
+                    "{} did not report ready within {} s (the stall limit: stall_timeout in the scenario, --stall-timeout)",
+                    labels.join(", "),
+                    lti::eig::sig(stall.max(READY_TIMEOUT).as_secs_f64())
+                ));
             }
             if let Some(why) = named {
                 return Err(LaunchError::Component(why));
@@ -151,7 +210,10 @@ fn handshake(procs: &mut [Proc], rx: &mpsc::Receiver<(usize, Option<String>)>, s
     }
     for p in procs.iter_mut() {
         let mut stdin = p.child.stdin.take().expect("piped");
-        stdin.write_all(b"go\n").and_then(|_| stdin.flush()).map_err(|e| LaunchError::Component(format!("{}: {e}", p.label)))?;
+        stdin
+            .write_all(b"go\n")
+            .and_then(|_| stdin.flush())
+            .map_err(|e| LaunchError::Component(format!("{}: {e}", p.label)))?;
     }
     Ok(())
 }
@@ -169,12 +231,27 @@ fn closed_before_ready(p: &mut Proc) -> LaunchError {
         }
         std::thread::sleep(Duration::from_millis(5));
     }
-    LaunchError::Component(format!("{} (pid {}) closed its stdout before it reported ready: it failed to start", p.label, p.child.id()))
+    LaunchError::Component(format!(
+        "{} (pid {}) closed its stdout before it reported ready: it failed to start",
+        p.label,
+        p.child.id()
+    ))
 }
 
-fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: &Readers, asm: &mut Assembly, stall: Duration) -> Result<Stop, LaunchError> {
+fn supervise(
+    cfg: &Configs,
+    session: &mut Session,
+    procs: &mut [Proc],
+    readers: &Readers,
+    asm: &mut Assembly,
+    stall: Duration,
+) -> Result<Stop, LaunchError> {
     let steps = cfg.plant.steps;
-    let mut row = StepRow::new(cfg.layout, cfg.observers.len(), readers.controller.is_some());
+    let mut row = StepRow::new(
+        cfg.layout,
+        cfg.observers.len(),
+        readers.controller.is_some(),
+    );
     let mut last_progress = Instant::now();
     let pgids: Vec<u32> = procs.iter().map(|p| p.child.id()).collect();
     let mut watch: Option<liveness::Watch> = None;
@@ -217,7 +294,9 @@ fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: 
             if procs[i].status.is_some() {
                 continue;
             }
-            let Ok(Some(st)) = procs[i].child.try_wait() else { continue };
+            let Ok(Some(st)) = procs[i].child.try_wait() else {
+                continue;
+            };
             procs[i].status = Some(st);
             // Status 0 is the end of its part only when it published all of it; collect what it
             // published before it went (its last samples may still be on their way).
@@ -240,26 +319,42 @@ fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: 
             }
             let mut what = procs[i].describe_exit();
             if st.success() {
-                let last = asm.queue(i).last.map_or("none".to_string(), |l| format!("of step {l}"));
+                let last = asm
+                    .queue(i)
+                    .last
+                    .map_or("none".to_string(), |l| format!("of step {l}"));
                 what += &format!(" before the end of the run (its last sample: {last})");
             }
-            let last = if asm.next == 0 { "no step completed".to_string() } else { format!("last completed step {}", asm.next - 1) };
+            let last = if asm.next == 0 {
+                "no step completed".to_string()
+            } else {
+                format!("last completed step {}", asm.next - 1)
+            };
             if i == 0 && st.code() == Some(plant::shell::EXIT_DIVERGED) {
                 return Ok(Stop::Diverged(format!("{what} ({last})")));
             }
             return Ok(Stop::Failed(format!("{what}; {last}")));
         }
         if procs.iter().all(|p| p.status.is_some()) && got == 0 {
-            return Ok(Stop::Failed(format!("every component finished but only {} of {steps} steps arrived", asm.next)));
+            return Ok(Stop::Failed(format!(
+                "every component finished but only {} of {steps} steps arrived",
+                asm.next
+            )));
         }
         let quiet = last_progress.elapsed();
         if quiet <= STALL_BLOCKED {
             watch = None;
         } else {
             let missing = asm.missing();
-            let last = if asm.next == 0 { "no step completed".to_string() } else { format!("last completed step {}", asm.next - 1) };
+            let last = if asm.next == 0 {
+                "no step completed".to_string()
+            } else {
+                format!("last completed step {}", asm.next - 1)
+            };
             let verdict = match missing {
-                Some(i) => watch.get_or_insert_with(|| liveness::Watch::new(&pgids)).judge(&pgids, i),
+                Some(i) => watch
+                    .get_or_insert_with(|| liveness::Watch::new(&pgids))
+                    .judge(&pgids, i),
                 None => Some(liveness::Verdict::Blocked),
             };
             let why = match verdict {
@@ -271,13 +366,26 @@ fn supervise(cfg: &Configs, session: &mut Session, procs: &mut [Proc], readers: 
                     lti::eig::sig(stall.as_secs_f64())
                 )),
                 Some(v) => {
-                    let state = if v == liveness::Verdict::Stopped { "it is stopped" } else { "it is asleep and used no CPU for the last second" };
-                    let hint = if missing == Some(0) { " (a plant blocked publishing to a component that stopped reading its samples shows as this too)" } else { "" };
-                    Some(format!("published no sample for step {} within {} s and {state}; {last}{hint}", asm.next, STALL_BLOCKED.as_secs()))
+                    let state = if v == liveness::Verdict::Stopped {
+                        "it is stopped"
+                    } else {
+                        "it is asleep and used no CPU for the last second"
+                    };
+                    let hint = if missing == Some(0) {
+                        " (a plant blocked publishing to a component that stopped reading its samples shows as this too)"
+                    } else {
+                        ""
+                    };
+                    Some(format!(
+                        "published no sample for step {} within {} s and {state}; {last}{hint}",
+                        asm.next,
+                        STALL_BLOCKED.as_secs()
+                    ))
                 }
             };
             if let Some(why) = why {
-                let who = missing.map_or_else(|| "a component".to_string(), |i| procs[i].describe_stall());
+                let who = missing
+                    .map_or_else(|| "a component".to_string(), |i| procs[i].describe_stall());
                 stop_all(procs);
                 return Ok(Stop::Failed(format!("{who} {why}")));
             }

@@ -10,7 +10,9 @@ fn allowed_cpus() -> Vec<usize> {
         if libc::sched_getaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &mut set) != 0 {
             return Vec::new();
         }
-        (0..libc::CPU_SETSIZE as usize).filter(|&c| libc::CPU_ISSET(c, &set)).collect()
+        (0..libc::CPU_SETSIZE as usize)
+            .filter(|&c| libc::CPU_ISSET(c, &set))
+            .collect()
     }
 }
 
@@ -34,14 +36,28 @@ pub(crate) fn pin_self(cpu: usize) {
 /// shares the other: only one process switch then lies on each step's critical path (a switch
 /// between processes costs ~2.5 µs on the 2-vCPU machines this was measured on). In between,
 /// the plant keeps the first CPU and the rest of the ring takes the others in turn.
-pub(super) fn placement(cfg: &Configs, pin: bool) -> (Option<usize>, Vec<Option<usize>>, Option<usize>) {
+pub(super) fn placement(
+    cfg: &Configs,
+    pin: bool,
+) -> (Option<usize>, Vec<Option<usize>>, Option<usize>) {
     // Per observer process: in the ring unless every observer it steps is a follower.
-    let ring_observers: Vec<bool> = cfg.processes.iter().map(|p| p.observers.iter().any(|&i| !cfg.followers[i])).collect();
+    let ring_observers: Vec<bool> = cfg
+        .processes
+        .iter()
+        .map(|p| p.observers.iter().any(|&i| !cfg.followers[i]))
+        .collect();
     let ring = 1 + ring_observers.iter().filter(|&&r| r).count() + usize::from(cfg.closed_loop);
     let mut cpus = ring_cpus(ring, pin).into_iter();
     let plant = cpus.next().flatten();
-    let observers = ring_observers.iter().map(|&r| if r { cpus.next().flatten() } else { None }).collect();
-    let controller = if cfg.closed_loop { cpus.next().flatten() } else { None };
+    let observers = ring_observers
+        .iter()
+        .map(|&r| if r { cpus.next().flatten() } else { None })
+        .collect();
+    let controller = if cfg.closed_loop {
+        cpus.next().flatten()
+    } else {
+        None
+    };
     (plant, observers, controller)
 }
 
@@ -62,4 +78,3 @@ pub(crate) fn ring_cpus(ring: usize, pin: bool) -> Vec<Option<usize>> {
         })
         .collect()
 }
-

@@ -33,8 +33,16 @@ impl Proc {
             (None, Some(sig)) => format!("was killed by signal {sig} ({})", signal_name(sig)),
             _ => "ended".into(),
         };
-        let err = self.stderr.lock().map(|s| s.trim().lines().last().unwrap_or("").to_string()).unwrap_or_default();
-        if err.is_empty() { format!("{} (pid {}) {how}", self.label, self.child.id()) } else { format!("{} (pid {}) {how}: {err}", self.label, self.child.id()) }
+        let err = self
+            .stderr
+            .lock()
+            .map(|s| s.trim().lines().last().unwrap_or("").to_string())
+            .unwrap_or_default();
+        if err.is_empty() {
+            format!("{} (pid {}) {how}", self.label, self.child.id())
+        } else {
+            format!("{} (pid {}) {how}: {err}", self.label, self.child.id())
+        }
     }
 
     /// "observer 'uio' (pid N, stopped)": the process named with the state the kernel reports.
@@ -43,7 +51,10 @@ impl Proc {
         // /proc/<pid>/stat: "pid (comm) S ..."; the state letter follows the last ')'.
         let state = std::fs::read_to_string(format!("/proc/{pid}/stat"))
             .ok()
-            .and_then(|s| s.rsplit_once(')').and_then(|(_, rest)| rest.trim_start().chars().next()));
+            .and_then(|s| {
+                s.rsplit_once(')')
+                    .and_then(|(_, rest)| rest.trim_start().chars().next())
+            });
         let state = match state {
             Some('T') | Some('t') => ", stopped",
             Some('D') => ", in uninterruptible sleep",
@@ -119,15 +130,28 @@ fn program_path(program: &str, workdir: &Path) -> std::path::PathBuf {
     workdir.join(program)
 }
 
-
 /// Starts a component (PROTOCOL.md §1): our binary, or the scenario's command in the scenario
 /// file's folder; either way with the protocol's environment, in its own process group.
-pub(super) fn spawn(c: &Launchable, workdir: &Path, space: &RunSpace, cpu: Option<usize>, tx: &mpsc::Sender<(usize, Option<String>)>, index: usize) -> Result<Proc, LaunchError> {
+pub(super) fn spawn(
+    c: &Launchable,
+    workdir: &Path,
+    space: &RunSpace,
+    cpu: Option<usize>,
+    tx: &mpsc::Sender<(usize, Option<String>)>,
+    index: usize,
+) -> Result<Proc, LaunchError> {
     let label = c.label.clone();
     let mut cmd = match &c.program {
         Program::Builtin(kind) => {
             let mut cmd = component_command(kind);
-            cmd.args(["--run", space.id(), "--name", &c.config.name, "--wait", &c.config.wait]);
+            cmd.args([
+                "--run",
+                space.id(),
+                "--name",
+                &c.config.name,
+                "--wait",
+                &c.config.wait,
+            ]);
             cmd
         }
         Program::External(p) => {
@@ -137,7 +161,15 @@ pub(super) fn spawn(c: &Launchable, workdir: &Path, space: &RunSpace, cpu: Optio
         }
         Program::Remote(kind, r) => {
             let mut cmd = Command::new(crate::run::bridge_path());
-            cmd.args(["remote", "--host", &r.host, "--connect", &r.endpoint, "--builtin", kind]);
+            cmd.args([
+                "remote",
+                "--host",
+                &r.host,
+                "--connect",
+                &r.endpoint,
+                "--builtin",
+                kind,
+            ]);
             cmd
         }
     };
@@ -205,6 +237,10 @@ pub(super) fn spawn(c: &Launchable, workdir: &Path, space: &RunSpace, cpu: Optio
             }
         }
     });
-    Ok(Proc { label, child, stderr, status: None })
+    Ok(Proc {
+        label,
+        child,
+        stderr,
+        status: None,
+    })
 }
-
