@@ -131,8 +131,9 @@ fn a_run_killed_with_sigkill_leaves_no_shared_memory_on_the_machine() {
     // As root the run's /dev/shm is a tmpfs of its own mount namespace: it goes with the last
     // process in it. Elsewhere the run uses the machine's and the next test's cleanup applies.
     if unsafe { libc::geteuid() } != 0 {
-        eprintln!(
-            "SKIPPED a_run_killed_with_sigkill_leaves_no_shared_memory_on_the_machine: needs root (a private /dev/shm)"
+        tests::skip(
+            "a_run_killed_with_sigkill_leaves_no_shared_memory_on_the_machine",
+            "needs root (a private /dev/shm)",
         );
         return;
     }
@@ -335,7 +336,10 @@ fn fill(dir: &std::path::Path, leave: u64) {
 fn a_full_disk_stops_the_run_and_says_what_was_kept() {
     // Mounting needs root; as root a mount that fails is a failure of the test, not a skip.
     if unsafe { libc::geteuid() } != 0 {
-        eprintln!("skipped: mounting a tmpfs needs root");
+        tests::skip(
+            "a_full_disk_stops_the_run_and_says_what_was_kept",
+            "mounting a tmpfs needs root",
+        );
         return;
     }
     // The run's recording must fit the disk when it starts (the launcher refuses one that

@@ -21,8 +21,9 @@ fn root_or_skip(test: &str) -> bool {
     // SAFETY: geteuid cannot fail.
     let root = unsafe { libc::geteuid() } == 0;
     if !root {
-        eprintln!(
-            "skipped {test}: needs root (it plants files owned by another user and runs the launcher as root)"
+        tests::skip(
+            test,
+            "needs root (it plants files owned by another user and runs the launcher as root)",
         );
     }
     root

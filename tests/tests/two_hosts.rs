@@ -23,7 +23,7 @@ use std::process::Command;
 use tests::*;
 
 /// Runs one case of the script: Ok with what it printed, Err with why it failed.
-fn attempt(name: &str) -> Result<String, String> {
+fn attempt(name: &str) -> Result<Option<String>, String> {
     let out = Command::new(repo().join("scripts/two-hosts.sh"))
         .arg(name)
         .env(
@@ -37,10 +37,11 @@ fn attempt(name: &str) -> Result<String, String> {
         String::from_utf8_lossy(&out.stderr),
     );
     if out.status.code() == Some(77) {
-        return Ok(format!("{name}: {stdout}"));
+        tests::skip("two_hosts", &format!("{name}: {}", stdout.trim()));
+        return Ok(None);
     }
     if out.status.success() && stdout.contains(&format!("ok {name}:")) {
-        Ok(stdout.into_owned())
+        Ok(Some(stdout.into_owned()))
     } else {
         Err(format!("two-hosts.sh {name}: {stdout}{stderr}"))
     }
@@ -51,13 +52,18 @@ fn attempt(name: &str) -> Result<String, String> {
 /// load a lease can lapse once (seen: the attacked run losing its agent during the 200 MB
 /// query, a cut link taking 2.05 s to stop), while a broken case fails both times. The first
 /// failure is printed.
-fn case(name: &str) {
+/// Whether the case ran (false: this machine cannot make the namespaces, reported as skipped).
+fn case(name: &str) -> bool {
     let outcome = attempt(name).or_else(|first| {
         eprintln!("{name} failed once; run again. The failure:\n{first}");
         attempt(name)
     });
     match outcome {
-        Ok(out) => eprintln!("{out}"),
+        Ok(Some(out)) => {
+            eprintln!("{out}");
+            true
+        }
+        Ok(None) => false,
         Err(why) => panic!("{why}"),
     }
 }
@@ -77,6 +83,8 @@ fn two_hosts() {
         "concurrent",
         "insecure",
     ] {
-        case(c);
+        if !case(c) {
+            return;
+        }
     }
 }
