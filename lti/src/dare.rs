@@ -58,6 +58,7 @@
 //! cause (uncontrollable modes not inside the unit circle, unobservable modes on it) when the
 //! staircase forms find one, else by the closed-loop spectral radius.
 
+pub use crate::linalg::norm::one_norm;
 use nalgebra::DMatrix;
 
 use crate::dd::DdMatrix;
@@ -589,13 +590,6 @@ fn not_definite(name: &str, s: &Mat, what: &str) -> LtiError {
 
 pub(crate) fn sym(m: &Mat) -> Mat {
     (m + m.transpose()) * 0.5
-}
-
-/// ‖M‖₁, the largest column sum of |mᵢⱼ|.
-pub fn one_norm(m: &Mat) -> f64 {
-    m.column_iter()
-        .map(|c| c.iter().map(|x| x.abs()).sum::<f64>())
-        .fold(0.0, f64::max)
 }
 
 #[cfg(test)]

@@ -9,52 +9,10 @@
 use nalgebra::{Complex, DMatrix};
 
 use crate::error::Result;
+pub use crate::linalg::balance::balance;
 
 /// A complex number in double precision.
 pub type C64 = Complex<f64>;
-
-/// D⁻¹ A D with D a diagonal of powers of two (Parlett–Reinsch balancing).
-pub fn balance(a: &DMatrix<f64>) -> DMatrix<f64> {
-    let n = a.nrows();
-    let mut b = a.clone();
-    let mut converged = false;
-    while !converged {
-        converged = true;
-        for i in 0..n {
-            let mut c = 0.0;
-            let mut r = 0.0;
-            for j in 0..n {
-                if j != i {
-                    c += b[(j, i)].abs();
-                    r += b[(i, j)].abs();
-                }
-            }
-            if c == 0.0 || r == 0.0 {
-                continue;
-            }
-            let s = c + r;
-            let mut f = 1.0;
-            let mut g = r / 2.0;
-            while c < g {
-                f *= 2.0;
-                c *= 4.0;
-            }
-            g = r * 2.0;
-            while c >= g {
-                f /= 2.0;
-                c /= 4.0;
-            }
-            if (c + r) / f < 0.95 * s {
-                converged = false;
-                for j in 0..n {
-                    b[(j, i)] *= f;
-                    b[(i, j)] /= f;
-                }
-            }
-        }
-    }
-    b
-}
 
 /// Eigenvalues of a real square matrix, sorted by (real part, imaginary part).
 pub fn eigenvalues(a: &DMatrix<f64>) -> Result<Vec<C64>> {
@@ -228,7 +186,7 @@ mod tests {
         assert_eq!(format_list(&v), "-84.2607 ± j127.959, -1");
     }
 
-    /// Issue 10 item 14: a zero computed as −2.2e-16 is a zero, not an unstable or stable one.
+    /// A zero computed as −2.2e-16 is a zero, not an unstable or stable one.
     #[test]
     fn rounding_noise_around_zero_prints_as_zero() {
         assert_eq!(format_list(&[C64::new(-2.220446049250313e-16, 0.0)]), "0");

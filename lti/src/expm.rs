@@ -59,6 +59,7 @@
 use nalgebra::DMatrix;
 
 use crate::dd::{Dd, two_prod};
+use crate::linalg::norm::one_norm;
 
 /// Unit roundoff of IEEE double precision, the u of the paper's θ_m.
 const U: f64 = 1.1102230246251565e-16;
@@ -163,12 +164,6 @@ fn ell(a: &DMatrix<f64>, m: usize) -> usize {
         return 0;
     }
     ((alpha / U).log2() / (2 * m) as f64).ceil().max(0.0) as usize
-}
-
-fn one_norm(a: &DMatrix<f64>) -> f64 {
-    a.column_iter()
-        .map(|c| c.iter().map(|x| x.abs()).sum::<f64>())
-        .fold(0.0, f64::max)
 }
 
 /// b_j = (2m − j)! / (j! (m − j)!), j = 0 … m: integers (exact in u128 and in double-double).

@@ -15,9 +15,9 @@
 
 use nalgebra::DMatrix;
 
-use crate::dare::one_norm;
 use crate::eig::{C64, eigenvalues};
 use crate::error::Result;
+use crate::linalg::norm::one_norm;
 use crate::subspace::orthogonal_complement;
 
 /// The controllable / uncontrollable split of (A, B).

@@ -129,7 +129,7 @@ mod tests {
         assert_eq!(l, want);
     }
 
-    /// Issue 30: the smallest general C on which the greedy column picking gave 2 columns.
+    /// The smallest general C on which the greedy column picking gave 2 columns.
     #[test]
     fn the_kernel_basis_of_a_general_c_has_n_minus_p_orthonormal_columns() {
         let c = DMatrix::from_row_slice(2, 3, &[0.45, -1.8, 1.0, 1.05, -2.2, 1.0]);

@@ -39,9 +39,10 @@
 
 use nalgebra::DMatrix;
 
-use crate::dare::{Definite, finite, one_norm, sym, symmetric};
+use crate::dare::{Definite, finite, sym, symmetric};
 use crate::error::{LtiError, Result};
 use crate::expm::expm;
+use crate::linalg::norm::one_norm;
 
 type Mat = DMatrix<f64>;
 

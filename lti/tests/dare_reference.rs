@@ -48,7 +48,7 @@ fn fixture() -> Value {
     reader::load("../fixtures/dare-reference.json")
 }
 
-/// The issue's bar (issue 12, "DARE/Kalman gains equal scipy's to 1e-9"). scipy itself is off the
+/// The bar: DARE and Kalman gains equal scipy's to 1e-9. scipy itself is off the
 /// exact solution by up to 3.8e-10 here (fixture `_meta.max_rel_errors`; 1.4e-11 on the seeds),
 /// and by up to 2e-7 on badly scaled random systems outside the fixture, where this solver still
 /// lands on the exact solution: past ~1e-9 the comparison measures scipy.

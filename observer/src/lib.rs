@@ -2,7 +2,6 @@
 //! process shell that runs it in lockstep with the plant.
 
 pub mod design;
-#[cfg(feature = "lmi")]
 mod lmi;
 pub mod runtime;
 pub mod shell;

@@ -22,7 +22,7 @@ fn images(s: &[C64], dt: f64) -> Vec<C64> {
     s.iter().map(|z| (z * dt).exp()).collect()
 }
 
-/// The DC motor of issue 10: x = [i, ω, θ], the load torque w enters ω, y = [ω, θ]. The
+/// The DC motor: x = [i, ω, θ], the load torque w enters ω, y = [ω, θ]. The
 /// current i reaches the outputs only through ω, where w enters too: s = −2 is an invariant
 /// zero of (A, E, C), and (T_dA_d, C) of the exact sampling has none.
 fn dc_motor() -> Model {

@@ -9,6 +9,7 @@ pub mod digest;
 pub mod export;
 mod globs;
 pub mod inspect;
+mod nan;
 pub mod palette;
 pub mod plot;
 pub mod read;

@@ -1,4 +1,4 @@
-//! Issue 24: the recording layout. Layout 2 stores a component's signals as the elements of
+//! The recording layout. Layout 2 stores a component's signals as the elements of
 //! one entity's rows and reads back signal by signal, bit for bit (LZ4-compressed too); a layout-1 recording (a signal per
 //! entity, no `layout` property) still reads; a layout this reader does not know is refused by
 //! its number; a recording costs at most twice the bytes of the values it holds.

@@ -16,12 +16,7 @@ use fmi::schema::minimal::MinModelDescription;
 use fmi::schema::traits::FmiModelDescription;
 use scenario::untrusted::quoted;
 
-/// FMI 2.0 or 3.0.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Version {
-    Two,
-    Three,
-}
+pub use crate::version::Version;
 
 /// What a variable is for, in the words both standards share.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -9,7 +9,7 @@
 
 use object::{Architecture, Object as _, ObjectKind, ObjectSymbol as _};
 
-use crate::archive::Version;
+use crate::version::Version;
 
 /// The FMI 2.0 co-simulation functions the host calls (FMI 2.0 §2.1, §4.2: every one of them
 /// a co-simulation FMU exports).

@@ -8,6 +8,7 @@
 
 mod archive;
 mod check;
+mod exit;
 mod fmi2;
 mod library;
 mod linearize;
@@ -17,6 +18,9 @@ mod plant;
 mod python;
 mod request;
 mod slave;
+mod version;
+
+use exit::end;
 
 fn main() -> std::process::ExitCode {
     match std::env::args().nth(1).as_deref() {
@@ -27,19 +31,4 @@ fn main() -> std::process::ExitCode {
     let code =
         lockstep::component::exit_status::<plant::FmuPlant>("fmu_plant", std::env::args().skip(1));
     end(code)
-}
-
-/// Ends the process with `code`. After an FMU that embeds Python or returned fmi2Fatal, the
-/// libraries it loaded do not run their exit handlers (`_exit`): numpy's bundled libgfortran
-/// freed corrupted memory at exit after pythonfmu instances were freed or failed (glibc's
-/// "free(): corrupted unsorted chunks", SIGABRT, after an otherwise finished run).
-pub fn end(code: i32) -> std::process::ExitCode {
-    if fmi2::fatal() || python::loaded() {
-        use std::io::Write as _;
-        let _ = std::io::stdout().flush();
-        let _ = std::io::stderr().flush();
-        // SAFETY: ends the process at once; what is ours is flushed, the run left behind.
-        unsafe { libc::_exit(code) };
-    }
-    std::process::ExitCode::from(code as u8)
 }

@@ -19,11 +19,11 @@ pub fn answer(outcome: Result<Option<String>, String>) -> std::process::ExitCode
             if let Some(text) = text {
                 println!("{text}");
             }
-            crate::end(0)
+            crate::exit::end(0)
         }
         Err(e) => {
             eprintln!("{e}");
-            crate::end(2)
+            crate::exit::end(2)
         }
     }
 }

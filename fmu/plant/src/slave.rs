@@ -9,10 +9,10 @@ use fmi::fmi3::import::Fmi3Import;
 use fmi::fmi3::instance::InstanceCS as Cs3;
 use fmi::fmi3::{CoSimulation as _, Common as _, Fmi3Model as _, GetSet as _};
 
-use crate::archive::Version;
 use crate::check::Start;
 use crate::fmi2::Cs2;
 use crate::log_capture;
+use crate::version::Version;
 
 /// An extracted FMU, its library ready to instantiate: extracted once however many instances
 /// are made of it (`launcher linearize` makes dozens).

@@ -356,7 +356,7 @@ pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> V
             // launcher cannot see that host's kernel, names a stall there after 5 s, and a
             // component left waiting there (its run gone) would spin the default 10 s only.
             c.config.inlet_timeout_s =
-                Some(s.stall_timeout + super::processes::STALL_BLOCKED.as_secs_f64());
+                Some(s.stall_timeout + super::stall::STALL_BLOCKED.as_secs_f64());
         }
     }
     out

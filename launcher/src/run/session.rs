@@ -96,7 +96,7 @@ pub struct Session {
 
 /// An observer whose error left the plant's state bound (or is not finite) at this row, in
 /// words. An observer designed wrongly diverges while every condition it printed read "ok"
-/// (issue 30: a rank-deficient reduced basis reached an error of 1.8e12 and the run exited 0):
+/// (a rank-deficient reduced basis reached an error of 1.8e12 and the run exited 0):
 /// its error x̂ᵢ − xᵢ is held to the rule the plant's state is, |·| ≤ `state_bound` (default
 /// 1e9). The error, not the estimate: an observer that follows a diverging plant is not the one
 /// to name, the plant's own check stops that run.

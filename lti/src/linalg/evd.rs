@@ -10,8 +10,8 @@ use faer::Mat as FMat;
 use nalgebra::{Complex, DMatrix};
 
 use super::view;
-use crate::eig::balance;
 use crate::error::{LtiError, Result};
+use crate::linalg::balance::balance;
 
 /// Eigenvalues of A (unsorted; conjugate pairs exact, the standardized 2×2 Schur blocks').
 pub fn eigenvalues(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>> {

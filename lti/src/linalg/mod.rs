@@ -19,7 +19,9 @@
 //! * [`qr`] — QR with column pivoting (rank-revealing);
 //! * [`product`] — blocked matrix products and LU solves for large matrices.
 
+pub mod balance;
 pub mod evd;
+pub mod norm;
 pub mod product;
 pub mod qr;
 pub mod svd;

@@ -81,7 +81,7 @@ mod tests {
         }
     }
 
-    /// Issue 30: seed 003's closed loop at dt = 1 ms (poles −4 … −7) with Ackermann's formula,
+    /// Seed 003's closed loop at dt = 1 ms (poles −4 … −7) with Ackermann's formula,
     /// refused in z ("placement missed … 1.306e-5"), placed in δ to the continuous accuracy.
     #[test]
     fn ackermann_places_poles_crowded_at_z_1_through_the_delta_domain() {

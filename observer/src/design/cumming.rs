@@ -21,7 +21,7 @@ use super::{
     require_stable, sampled_report,
 };
 use crate::runtime::LinearObserver;
-use lti::dare::one_norm as norm1;
+use lti::linalg::norm::one_norm as norm1;
 use lti::subspace::kernel_basis;
 
 const KIND: &str = "cumming";

@@ -37,7 +37,7 @@ use super::{
     sampled_report,
 };
 use crate::runtime::LinearObserver;
-use lti::dare::one_norm as norm1;
+use lti::linalg::norm::one_norm as norm1;
 
 /// How K is chosen.
 #[derive(Debug, Clone)]

@@ -33,6 +33,7 @@ use super::{
     Checks, DesignError, Designed, Domain, Gain, Pair, Report, eig, eq_detail, free_gain,
     require_stable, sampled_report,
 };
+use crate::lmi::LmiSolution;
 use crate::runtime::LinearObserver;
 
 const KIND: &str = "hui-zak-uio";
@@ -49,15 +50,6 @@ pub enum Path {
 /// Whether this build can solve the LMI.
 pub fn lmi_available() -> bool {
     cfg!(feature = "lmi")
-}
-
-/// The LMI's solution.
-#[derive(Debug, Clone)]
-pub struct LmiSolution {
-    /// P = Pᵀ ⪰ 0.01 I.
-    pub p: Mat,
-    /// Y with YD = 0.
-    pub y: Mat,
 }
 
 struct Core {

@@ -9,6 +9,7 @@ use lti::kernel::mul_into;
 use super::StepRow;
 use super::tail::{BlockMax, tail_start};
 use super::what::InputEstimate;
+use crate::nan::nan_max;
 
 /// The figures of one observer.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -40,14 +41,6 @@ pub struct FaultFree {
     pub tail_max_abs_residual: f64,
     /// max |x − x̂| over the stretch.
     pub max_abs_error: f64,
-}
-
-/// max(a, b) that propagates NaN (`f64::max` ignores it): a non-finite estimate must not score
-/// as a perfect one.
-#[inline]
-pub fn nan_max(a: f64, b: f64) -> f64 {
-    // a when it is NaN or larger; else b, NaN when b is.
-    if a > b || a.is_nan() { a } else { b }
 }
 
 /// Accumulates [`ObserverFigures`] and pairwise differences.

@@ -13,11 +13,12 @@ mod select;
 pub mod tail;
 mod what;
 
+pub use crate::nan::nan_max;
 pub use blueprint::blueprint;
 pub use file_sink::UncompressedFileSink;
 pub use latency::{Latency, Percentiles, histogram};
 pub use layout::{LAYOUT, Layout, Line, SERIES_COMPONENT, VALUES_COMPONENT};
-pub use metrics::{FaultFree, Metrics, ObserverFigures, nan_max};
+pub use metrics::{FaultFree, Metrics, ObserverFigures};
 pub use rrd::{FLUSH_STEPS, FLUSH_VALUES, RrdSink, SeriesId};
 pub use select::Selection;
 pub use what::InputEstimate;

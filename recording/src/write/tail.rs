@@ -8,7 +8,7 @@
 //! for runs of up to [`MAX_BLOCKS`] planned steps a block is one step and that tail is exact
 //! too. With ⌊K'/4⌋ = 0 (fewer than 4 steps) there is no tail.
 
-use super::nan_max;
+use crate::nan::nan_max;
 
 /// Most blocks kept per figure (512 KiB each).
 pub const MAX_BLOCKS: u64 = 1 << 16;

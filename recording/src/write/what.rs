@@ -1,4 +1,4 @@
-//! The unknown-input estimate ŵ of an observer, formed from the recorded samples (issue 20):
+//! The unknown-input estimate ŵ of an observer, formed from the recorded samples:
 //!
 //! ```text
 //! ŵ_k = W y_{k+1} − (WCΦ) x̂_k − (WCΓ_B) u_k
@@ -11,8 +11,8 @@
 use lti::Mat;
 use lti::input_estimate::InputEstimateStep;
 
-use super::metrics::nan_max;
 use super::tail::BlockMax;
+use crate::nan::nan_max;
 
 /// One observer's ŵ, step by step, and its error against the recorded w.
 #[derive(Debug, Clone)]

@@ -1,7 +1,8 @@
 //! Central differences of the one-sample map with Richardson's extrapolation (module docs of
 //! [`super`]): column j from F(z ± h_j e_j) and F(z ± h_j/2 e_j).
 
-use super::{Block, OneSample};
+use super::one_sample::OneSample;
+use super::wire::Block;
 
 /// ∛ε: the central difference's step relative to max(|z_j|, 1).
 pub const RELATIVE_STEP: f64 = 6.06e-6;

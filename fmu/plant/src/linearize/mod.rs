@@ -26,128 +26,14 @@
 //! with the states involved, and what residual stays in them.
 
 mod difference;
+mod one_sample;
 mod trim;
+mod wire;
 
-use serde::{Deserialize, Serialize};
-
-use crate::check::{Map, Start, resolve};
-use crate::params::Params;
+use crate::check::resolve;
 use crate::slave::Archive;
-
-/// What the launcher asks for, on stdin.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Request {
-    /// The plant's map (`[plant.fmu]`); its `x0` is x_op (or the trim's first guess).
-    pub params: Params,
-    pub u: Vec<f64>,
-    pub w: Vec<f64>,
-    pub dt: f64,
-    #[serde(default)]
-    pub trim: bool,
-}
-
-/// A Jacobian block and its estimated error (max |D(h/2) − D(h)| / 3 over the block).
-#[derive(Debug, Serialize)]
-pub struct Block {
-    pub rows: Vec<Vec<f64>>,
-    pub error: f64,
-}
-
-/// The trim's outcome.
-#[derive(Debug, Serialize)]
-pub struct Trim {
-    pub iterations: usize,
-    /// max |x⁺ − x| at the end, over all states.
-    pub residual: f64,
-    /// x⁺ − x at the end.
-    pub step_residual: Vec<f64>,
-    /// States (0-based) in a direction along which Φ − I is singular.
-    pub free: Vec<usize>,
-}
-
-/// The answer, on stdout.
-#[derive(Debug, Serialize)]
-pub struct Answer {
-    pub x: Vec<f64>,
-    pub y: Vec<f64>,
-    #[serde(rename = "Phi")]
-    pub phi: Block,
-    #[serde(rename = "Gamma_B")]
-    pub gamma_b: Block,
-    #[serde(rename = "Gamma_E")]
-    pub gamma_e: Block,
-    #[serde(rename = "C")]
-    pub c: Block,
-    /// ∂y₀/∂u and ∂y₀/∂w: a direct feedthrough the sampled model has no place for.
-    pub d_u: Block,
-    pub d_w: Block,
-    /// The steps h_j of x, u, w.
-    pub steps: Vec<f64>,
-    pub trim: Option<Trim>,
-    /// FMU instances made.
-    pub instances: usize,
-}
-
-/// One FMU, extracted once; a fresh instance per evaluation of F.
-pub struct OneSample<'a> {
-    p: &'a Params,
-    map: &'a Map,
-    archive: Archive,
-    dt: f64,
-    pub instances: usize,
-}
-
-impl OneSample<'_> {
-    /// F(z) = (x⁺, y₀) for z = (x, u, w), from a fresh instance.
-    pub fn eval(&mut self, z: &[f64]) -> Result<(Vec<f64>, Vec<f64>), String> {
-        let (n, l) = (self.map.states.len(), self.map.inputs.len());
-        let starts: Vec<(u32, Start)> = self
-            .map
-            .parameters
-            .iter()
-            .cloned()
-            .chain(
-                self.map
-                    .inputs
-                    .iter()
-                    .zip(&z[n..n + l])
-                    .map(|(&vr, &v)| (vr, Start::Real(v))),
-            )
-            .chain(
-                self.map
-                    .disturbances
-                    .iter()
-                    .zip(&z[n + l..])
-                    .map(|(&vr, &v)| (vr, Start::Real(v))),
-            )
-            .collect();
-        let x0: Vec<(u32, f64)> = self
-            .map
-            .states
-            .iter()
-            .zip(&z[..n])
-            .map(|(&vr, &v)| (vr, v))
-            .collect();
-        self.instances += 1;
-        let mut s = self.archive.start("linearize", &starts, &x0)?;
-        let (mut x, mut y) = (vec![0.0; n], vec![0.0; self.map.outputs.len()]);
-        s.get(&self.map.outputs, &mut y, 0.0)?;
-        s.get(&self.map.states, &mut x, 0.0)?;
-        if let Some(i) = (0..n).find(|&i| x[i] != z[i]) {
-            return Err(format!(
-                "the state '{}' reads {} after initialisation where its start value was {}: the FMU does not start where it is set",
-                self.p.states[i], x[i], z[i]
-            ));
-        }
-        let h = self.dt / self.p.substeps.max(1) as f64;
-        for j in 0..self.p.substeps.max(1) {
-            s.step(j as f64 * h, h)?;
-        }
-        s.get(&self.map.states, &mut x, self.dt)?;
-        Ok((x, y))
-    }
-}
+use one_sample::OneSample;
+use wire::{Answer, Request};
 
 fn run(req: &Request) -> Result<Answer, String> {
     let (n, l, q) = (
@@ -173,13 +59,7 @@ fn run(req: &Request) -> Result<Answer, String> {
     };
     let (fmu, map) = resolve(params)?;
     let archive = Archive::open(&params.path, fmu.version, map.python.as_ref())?;
-    let mut f = OneSample {
-        p: params,
-        map: &map,
-        archive,
-        dt: req.dt,
-        instances: 0,
-    };
+    let mut f = OneSample::new(params, &map, archive, req.dt);
     let (x, trim) = if req.trim {
         let t = trim::newton(&mut f, &x_start, &req.u, &req.w)?;
         (t.0, Some(t.1))

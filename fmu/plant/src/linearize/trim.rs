@@ -9,7 +9,8 @@ use lti::DMatrix;
 use lti::linalg::svd::Svd;
 
 use super::difference::{column, step};
-use super::{OneSample, Trim};
+use super::one_sample::OneSample;
+use super::wire::Trim;
 
 /// Newton iterations at most.
 pub const MAX_ITERATIONS: usize = 30;

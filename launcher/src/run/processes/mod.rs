@@ -25,16 +25,13 @@ use self::proc::{Proc, spawn, stop_all};
 use super::configs::Configs;
 use super::envelope::envelopes;
 use super::session::Session;
+use super::stall::STALL_BLOCKED;
 use super::{Stop, interrupt};
 use crate::error::LaunchError;
 use recording::write::StepRow;
 
 /// How long components may take to report ready.
 const READY_TIMEOUT: Duration = Duration::from_secs(20);
-/// How long the run may make no progress before the component it waits for is looked at: named
-/// at once when the kernel has it stopped or blocked; waited for, up to the scenario's stall
-/// limit, when it runs or waits for a core ([`liveness`]).
-pub const STALL_BLOCKED: Duration = Duration::from_secs(5);
 /// Sleep between drains. The launcher shares the cores with the lockstep ring, and every
 /// wake-up takes a core from it for a moment: drain rarely, in large batches. At the fastest
 /// step rate measured (~250k steps/s) 5 ms is ~1300 samples, well inside the recorder's buffer.

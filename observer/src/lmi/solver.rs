@@ -15,7 +15,7 @@ use clarabel::solver::{
 use lti::Mat;
 use lti::pinv::pinv;
 
-use crate::design::LmiSolution;
+use super::LmiSolution;
 
 /// Upper triangle of a symmetric matrix, column by column, off-diagonals × √2.
 fn svec(m: &Mat) -> Vec<f64> {
