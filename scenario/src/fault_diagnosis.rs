@@ -11,7 +11,7 @@ use plant::fault::{Fault, Kind, Profile, Target};
 use super::limits::{MAX_CALIBRATION_RUNS, MAX_WINDOW};
 use super::raw::{RawDiagnoser, RawFault, RawNoise};
 use super::untrusted::quoted;
-use super::validate::{Bad, bad, check_name, definite, finite, matrix, placement, poles};
+use crate::check::{Bad, bad, check_name, definite, finite, matrix, placement, poles};
 
 /// The run's noise: the per-step covariances the plant draws from and the Kalman filter uses.
 #[derive(Debug, Clone, PartialEq)]

@@ -11,7 +11,7 @@ use serde_json::json;
 use super::ProcessSpec;
 use super::plant_file::{self, Sizes};
 use super::raw::RawFmu;
-use super::validate::{Bad, bad};
+use crate::check::{Bad, bad};
 
 /// The program that runs an FMU plant (a kit component built beside the launcher).
 pub const FMU_PLANT_PROGRAM: &str = "fmu_plant";

@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 
 use super::raw::RawScenario;
 use super::untrusted::quoted;
-use super::validate::{Bad, bad, check_name};
+use crate::check::{Bad, bad, check_name};
 
 /// Where a component runs when not on the launcher's host.
 #[derive(Debug, Clone, PartialEq, Eq)]

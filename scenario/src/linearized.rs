@@ -14,8 +14,8 @@ use serde_json::json;
 
 use super::plant_file::Sizes;
 use super::raw::{RawFmu, RawOperatingPoint};
-use super::validate::{Bad, bad, check_name, finite};
 use super::{MAX_SCENARIO_BYTES, ScenarioError, untrusted};
+use crate::check::{Bad, bad, check_name, finite};
 
 /// What `fmu_plant --linearize` is asked.
 #[derive(Debug, Clone)]
@@ -42,17 +42,16 @@ impl Request {
 
 /// Reads what `launcher linearize` needs from the scenario at `path`.
 pub fn request(path: &Path) -> Result<Request, ScenarioError> {
-    let err = |(field, reason): Bad| ScenarioError {
+    let err = |Bad { field, reason }: Bad| ScenarioError {
         file: path.to_path_buf(),
         at: None,
         field,
         reason,
     };
-    let text =
-        untrusted::read_bounded(path, MAX_SCENARIO_BYTES).map_err(|r| err((String::new(), r)))?;
+    let text = untrusted::read_bounded(path, MAX_SCENARIO_BYTES).map_err(|r| err(bad("", r)))?;
     let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
-        err((
-            String::new(),
+        err(bad(
+            "",
             format!(
                 "malformed TOML: {}",
                 e.message().lines().next().unwrap_or("")

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use super::raw::{RawScenario, Rows};
 use super::untrusted::{open_regular, quoted};
-use super::validate::{Bad, bad};
+use crate::check::{Bad, bad};
 
 /// Largest matrix file read, bytes (1 GiB: n ≈ 11 000 states).
 pub const MAX_MATRIX_FILE_BYTES: u64 = 1 << 30;

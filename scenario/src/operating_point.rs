@@ -1,4 +1,4 @@
-//! `[plant.operating_point]`: the point the design model is linearised at (x, u, w, y; issue 31).
+//! `[plant.operating_point]`: the point the design model is linearised at (x, u, w, y).
 //!
 //! The model is in deviations there; every plant exchanges absolute signals (see
 //! [`lti::operating_point`]). Checked here: one finite value per state, known input, unknown
@@ -12,7 +12,7 @@ use lti::{Mat, Model, OperatingPoint};
 
 use super::SignalNames;
 use super::raw::RawOperatingPoint;
-use super::validate::{Bad, bad, finite};
+use crate::check::{Bad, bad, finite};
 
 /// Rounding of the equilibrium's sums leaves a few ε of their terms; a point off by more than
 /// 1e-9 of them is not the plant's equilibrium (a typo, or a point of another model).

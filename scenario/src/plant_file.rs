@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use super::quoted;
-use super::validate::{Bad, bad};
+use crate::check::{Bad, bad};
 
 /// Sizes of the design model a plant's map must match.
 pub(crate) struct Sizes {

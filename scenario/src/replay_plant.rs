@@ -12,8 +12,8 @@ use serde_json::json;
 
 use super::plant_file::{self, Sizes};
 use super::raw::{RawChannels, RawReplay};
-use super::validate::{Bad, bad};
 use super::{ProcessSpec, quoted};
+use crate::check::{Bad, bad};
 
 /// The program that replays recorded data as the plant (a kit component built beside the launcher).
 pub const REPLAY_PLANT_PROGRAM: &str = "replay_plant";

@@ -11,7 +11,7 @@ pub fn did_you_mean<'a>(word: &str, known: impl IntoIterator<Item = &'a str>) ->
 
 /// Words longer than this get no suggestion, and candidates longer than this are skipped: the
 /// distance table is (|a| + 1)(|b| + 1) cells, and a hostile file's 20 MiB field name must not
-/// cost gigabytes (issue 32).
+/// cost gigabytes.
 pub const MAX_WORD: usize = 64;
 
 /// At most this many candidates are compared.

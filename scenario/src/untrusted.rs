@@ -15,7 +15,7 @@ pub const MAX_SCENARIO_BYTES: u64 = 1 << 20;
 /// Longest untrusted text quoted whole in a message, in characters; longer text is cut.
 const QUOTE_CHARS: usize = 80;
 
-/// Longest list of untrusted names shown in a message, in characters (issue 32: a 20 MiB
+/// Longest list of untrusted names shown in a message, in characters (a 20 MiB
 /// header made a 99 MB message line).
 const LIST_CHARS: usize = 300;
 

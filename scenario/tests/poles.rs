@@ -1,4 +1,4 @@
-//! Issue 10, item 2: where a design takes no free poles, `poles = []` — or no `poles` key for
+//! Where a design takes no free poles, `poles = []` — or no `poles` key for
 //! `das-ghosal-uio` — is accepted (today's "must not be empty" refusal is gone), and the design
 //! itself says how many poles a pair needs.
 
