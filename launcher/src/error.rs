@@ -4,6 +4,8 @@ use thiserror::Error;
 
 use scenario::ScenarioError;
 
+/// Exit code: `compare` found the recordings differ.
+pub const EXIT_DIFFER: i32 = 1;
 /// Exit code: bad input (scenario, unmet condition, refused unstable loop, output in the way).
 pub const EXIT_BAD_INPUT: i32 = 2;
 /// Exit code: a component crashed or the transport failed.

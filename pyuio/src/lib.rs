@@ -39,8 +39,8 @@ fn design(path: &str, text: Option<&str>) -> PyResult<(bool, String, String)> {
     let r = design_report::report(&s);
     Ok((
         r.ok,
-        serde_json::to_string(&r.json).expect("serialises"),
-        r.text,
+        serde_json::to_string(&r.json()).expect("serialises"),
+        r.text(),
     ))
 }
 

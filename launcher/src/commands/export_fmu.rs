@@ -8,10 +8,20 @@
 use std::path::{Path, PathBuf};
 
 use fmu_export::{Description, Fmi, ObserverResource, OperatingPoint, Signal};
-use launcher::{LaunchError, Scenario, plan};
+use launcher::{LaunchError, Scenario, plan, println, shipped};
+use std::process::ExitCode;
+
+use crate::cli::ExportFmuArgs;
 
 /// The observer FMUs' shared library, as cargo names it in target/release.
 pub const LIBRARY: &str = "libuio_observer_fmu.so";
+
+pub fn command(a: ExportFmuArgs) -> Result<ExitCode, LaunchError> {
+    let s = shipped::load(&a.scenario)?;
+    let path = export_fmu(&s, &a.observer, &a.out, Fmi::from(a.fmi))?;
+    println!("{}", path.display());
+    Ok(ExitCode::SUCCESS)
+}
 
 /// Writes DIR/<observer>_fmi<2|3>.fmu; its path.
 pub fn export_fmu(

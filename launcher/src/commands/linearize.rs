@@ -9,7 +9,10 @@
 
 use std::path::{Path, PathBuf};
 
-use launcher::LaunchError;
+use launcher::{LaunchError, println};
+use std::process::ExitCode;
+
+use crate::cli::LinearizeArgs;
 use scenario::linearized::{self, Linearized};
 use serde_json::Value;
 
@@ -44,6 +47,12 @@ fn fmt(v: &[f64]) -> String {
             .collect::<Vec<_>>()
             .join(", ")
     )
+}
+
+pub fn command(a: LinearizeArgs) -> Result<ExitCode, LaunchError> {
+    let path = linearize(&a.scenario, a.trim, &a.out)?;
+    println!("wrote {}", path.display());
+    Ok(ExitCode::SUCCESS)
 }
 
 /// Runs `launcher linearize`; the scenario written.

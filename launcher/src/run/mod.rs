@@ -17,7 +17,6 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-
 pub use configs::{Configs, configs};
 pub use envelope::{Launchable, Program, bridge_path, envelopes};
 pub use options::{Mode, Options, Stop};
