@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Design time of a Chen–Patton UIO on random stiff models, ours beside scipy's (issue 20, item 2).
+"""Design time of a Chen–Patton UIO on random stiff models, ours beside scipy's.
 
 For each n: a random stable model whose eigenvalues spread over three decades (−0.1 … −100, a
 third of them as complex pairs, in a random orthogonal basis), p = n/10 outputs, two unknown
@@ -13,7 +13,7 @@ child process with a time limit; one that runs out is reported as "> limit".
     .venv/bin/python scripts/design-bench.py [--sizes 50,200,500,1000] [--limit 300] [--runs 3] [--gains lqe,place]
     .venv/bin/python scripts/design-bench.py --andes kundur,ieee14,ieee39,npcc,wecc [--dt 0.001] --gains lqe
 
-With `--andes`, the models are the real power-system ones in `fixtures/andes/<case>/` (issue 30:
+With `--andes`, the models are the real power-system ones in `fixtures/andes/<case>/` (their
 design times beside scipy's) instead of random ones; IEEE 39 and WECC are refused by both (an
 unseen mode at s = 0), so their rows time the refusal against scipy's DARE failing.
 

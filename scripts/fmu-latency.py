@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Step latency with an FMU plant beside the built-in plant's, in the same session (BENCHMARKS.md,
-issue 22): seed 002 as the discrete plant of its exact ZOH (scipy), once simulated by the built-in
+"""Step latency with an FMU plant beside the built-in plant's, in the same session (BENCHMARKS.md):
+seed 002 as the discrete plant of its exact ZOH (scipy), once simulated by the built-in
 plant and once by the lti_plant test FMU (FMI 2.0 and 3.0) given the same Φ, Γ_B, Γ_E, across
 processes without recording, interleaved, REPS times each; prints each run's step latency
 percentiles and steps/s and the medians with the FMU/built-in ratios.

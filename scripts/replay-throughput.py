@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Replay throughput (BENCHMARKS.md, issue 23): the 10⁵-row log of python/tests/test_replay.py's
+"""Replay throughput (BENCHMARKS.md): the 10⁵-row log of python/tests/test_replay.py's
 throughput test (two DC motors, every state measured, one Chen–Patton UIO, dt = 1 ms, 100 s)
 replayed from a CSV and from an MCAP log (one JSON message per row, stamped with its time), and
 the same scenario with the built-in plant driven by the same inputs (sines, w = 0) — each timed

@@ -24,11 +24,11 @@ fi
 # changes. Its bin/ goes first on PATH, so the launcher's `python3` is the environment's.
 venv="${UIO_VENV:-$PWD/.venv}"
 stamp="$venv/.uio-installed"
-"$venv/bin/python3" -c 'import fmpy' 2>/dev/null || rm -f "$stamp"  # test FMUs (issue 22): fmpy
-"$venv/bin/python3" -c 'import mcap' 2>/dev/null || rm -f "$stamp"  # export --mcap read back (issue 23)
-"$venv/bin/python3" -c 'import control, maturin' 2>/dev/null || rm -f "$stamp"  # the Python package (issue 23)
-"$venv/bin/python3" -c 'import rerun' 2>/dev/null || rm -f "$stamp"  # `rerun rrd verify` on our recordings (issue 24)
-"$venv/bin/python3" -c 'import pythonfmu' 2>/dev/null || rm -f "$stamp"  # a third-party exporter's FMUs (issue 31)
+"$venv/bin/python3" -c 'import fmpy' 2>/dev/null || rm -f "$stamp"  # test FMUs: fmpy
+"$venv/bin/python3" -c 'import mcap' 2>/dev/null || rm -f "$stamp"  # export --mcap read back
+"$venv/bin/python3" -c 'import control, maturin' 2>/dev/null || rm -f "$stamp"  # the Python package
+"$venv/bin/python3" -c 'import rerun' 2>/dev/null || rm -f "$stamp"  # `rerun rrd verify` on our recordings
+"$venv/bin/python3" -c 'import pythonfmu' 2>/dev/null || rm -f "$stamp"  # a third-party exporter's FMUs
 if [ ! -x "$venv/bin/python3" ] || [ ! -e "$stamp" ] \
    || [ -n "$(find python/pyproject.toml python/uio_component -newer "$stamp" -print -quit)" ]; then
   if ! python3 -c 'import ensurepip, venv' 2>/dev/null; then
@@ -39,13 +39,16 @@ if [ ! -x "$venv/bin/python3" ] || [ ! -e "$stamp" ] \
   fi
   echo "preparing the Python environment $venv"
   [ -x "$venv/bin/python3" ] || python3 -m venv "$venv"
-  "$venv/bin/pip" install -q --disable-pip-version-check ./python pytest scipy fmpy mcap maturin control rerun-sdk==0.36.3 pythonfmu  # pythonfmu: FMUs from a third-party exporter (issue 31); fmpy: test FMUs (issue 22); mcap: export, maturin and control: the Python package (issue 23); rerun-sdk: Rerun's own CLI checks our recordings (issue 24)
+  "$venv/bin/pip" install -q --disable-pip-version-check ./python pytest scipy fmpy mcap maturin control rerun-sdk==0.36.3 pythonfmu  # pythonfmu: FMUs from a third-party exporter; fmpy: test FMUs; mcap: export, maturin and control: the Python package; rerun-sdk: Rerun's own CLI checks our recordings
   touch "$stamp"
 fi
 export PATH="$venv/bin:$PATH"
 
 # One formatting (rustfmt.toml), checked before anything is built: `cargo fmt --all` fixes it.
 cargo fmt --all --check >/dev/null || { echo "cargo fmt --all --check: the sources are not formatted (run cargo fmt --all)"; exit 1; }
+# No import circle between the files of a crate (each file's uses resolved to the file that
+# defines the item).
+python3 scripts/check-imports.py
 
 # The multi-process tests start the component binaries: build them all first.
 cargo build --release --workspace --bins
@@ -61,8 +64,8 @@ cargo test --release --workspace 2>&1 | tee "$log"
 # The same design tests with the LMI solver compiled in.
 cargo test --release -p observer --features lmi 2>&1 | tee -a "$log"
 
-# test FMUs (issue 22): FMI 2.0/3.0 co-simulation FMUs from fmu/testfmus, for test_fmu_testfmus.py,
-# and (issue 31) one made by a third-party exporter from PyPI, pythonfmu
+# test FMUs: FMI 2.0/3.0 co-simulation FMUs from fmu/testfmus, for test_fmu_testfmus.py,
+# and one made by a third-party exporter from PyPI, pythonfmu
 export UIO_TEST_FMUS="${CARGO_TARGET_DIR:-$PWD/target}/testfmus"; fmu/testfmus/build.sh "$UIO_TEST_FMUS"
 
 # The Python kit and components.

@@ -140,7 +140,7 @@ fn seed003_prefilter_makes_the_angle_of_attack_follow_the_reference() {
     assert!(e.contains("singular"), "{e}");
 }
 
-/// Issue 30: Ackermann's formula for the sampled loop at dt = 1 ms, where the poles e^{p·dt}
+/// Ackermann's formula for the sampled loop at dt = 1 ms, where the poles e^{p·dt}
 /// crowd at z = 1 (0.993 … 0.996): refused before ("placement missed … 1.306e-5" in z), placed
 /// now through the δ-domain. A single-input gain is unique, so it must equal Tits–Yang's for the
 /// same sampled poles (an eigenvector method, no characteristic polynomial), and the achieved

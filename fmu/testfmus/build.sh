@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Test FMUs (issue 22): builds OUTDIR/{lti_plant,dc_motor,faulty}_{fmi2,fmi3}.fmu — FMI 2.0 and 3.0
+# Test FMUs: builds OUTDIR/{lti_plant,dc_motor,faulty}_{fmi2,fmi3}.fmu — FMI 2.0 and 3.0
 # co-simulation FMUs for linux x86_64 — from the C sources next to this script, against the
 # FMI headers that FMPy ships, and validates each with FMPy; and OUTDIR/three_tank.fmu, made
 # by pythonfmu (a third-party exporter, PyPI) from python/three_tank.py. Idempotent (each FMU is rebuilt
@@ -55,7 +55,7 @@ for path in sys.argv[1:]:
     fmu = fmpy.instantiate_fmu(unzipdir, md, fmi_type="CoSimulation")
     fmu.freeInstance()
 EOF
-# A third-party exporter's FMU (issue 31): pythonfmu (PyPI) builds python/three_tank.py into an
+# A third-party exporter's FMU: pythonfmu (PyPI) builds python/three_tank.py into an
 # FMI 2.0 co-simulation FMU whose library embeds Python.
 mkdir -p "$tmp/py"
 "$py" -m pythonfmu build -f "$src/python/three_tank.py" -d "$tmp/py" >/dev/null

@@ -1,7 +1,7 @@
 //! A `/dev/shm` of the run's own: the launcher and every process it starts see a fresh tmpfs
 //! there, mode 0700, that no other process on the machine can see, let alone open.
 //!
-//! Why (issue 32, item 4): iceoryx2 0.10 creates its node-counter segment
+//! Why: iceoryx2 0.10 creates its node-counter segment
 //! (`…node.<version>.global_mgmt`) and then sets it to 0666 with an explicit `fchmod`
 //! (`FINAL_PERMISSIONS_GLOBAL_ACCESS`), so no umask and no chmod after the fact closes the
 //! window in which another local user can open it: a watcher as `nobody` broke 20 of 20 runs

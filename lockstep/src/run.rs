@@ -29,7 +29,7 @@ const SHM_DIR: &str = "/dev/shm";
 /// unix sockets of its event services (the `block`, `waitset` and `spin-then-block` waits)
 /// after the root, and a socket's path holds at most 108 bytes. One per user,
 /// `/tmp/uio-iox2-<uid>`: a folder of fixed name belongs to whoever makes it first, and would
-/// lock every other user out (issue 32).
+/// lock every other user out.
 fn short_roots() -> PathBuf {
     PathBuf::from(format!("/tmp/uio-iox2-{}", crate::run_dir::euid()))
 }

@@ -1,4 +1,4 @@
-//! Issue 10, item 10: iceoryx2's warnings — "No config file was loaded", which it prints when
+//! iceoryx2's warnings — "No config file was loaded", which it prints when
 //! it falls back to its global configuration although every run builds its own — do not reach
 //! a process that joined a run's bus.
 

@@ -1,4 +1,4 @@
-//! Issue 19, item 2: a component opening its run (`RunSpace::open`) refuses a runs directory or
+//! A component opening its run (`RunSpace::open`) refuses a runs directory or
 //! run directory that is a symlink, and an `owner.pid` that is not a regular file — a FIFO is
 //! refused without blocking.
 

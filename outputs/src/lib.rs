@@ -1,5 +1,5 @@
 //! Every file the tool writes goes through here, so that no output can be turned into a write
-//! somewhere else (issue 32, item 1):
+//! somewhere else:
 //!
 //! * a file is created only as a **new** regular file, `O_CREAT | O_EXCL | O_NOFOLLOW`: a
 //!   symlink, FIFO, device or any file planted at its name makes the open fail, so nothing is

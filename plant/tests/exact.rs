@@ -181,7 +181,7 @@ fn scalar_step_plant(time: f64) -> (Vec<f64>, Vec<f64>) {
     (x, w)
 }
 
-/// Issue 10 item 13: a switching time 10⁻¹³ s after sample 5000 is not on it. Sample 5000 shows
+/// A switching time 10⁻¹³ s after sample 5000 is not on it. Sample 5000 shows
 /// the old value, and step 5000 integrates the switch inside it: by hand, x(t₅₀₀₁) =
 /// 1 − e^{−(dt − δ)} with δ = 10⁻¹³ (x = 0 up to the switch), which differs from the on-sample
 /// value 1 − e^{−dt} by e^{−dt}·δ ≈ 10⁻¹³, a million times the tolerance.

@@ -1,4 +1,4 @@
-"""Discrete-time plants, `[plant] time = "discrete"` with Phi, Gamma_B, Gamma_E (issue 20, item 4).
+"""Discrete-time plants, `[plant] time = "discrete"` with Phi, Gamma_B, Gamma_E.
 
 * ZOH equivalence: seed 002 with its piecewise unknown input (switching on samples) is run as
   given and as the discrete plant (Φ, Γ_B, Γ_E) that scipy's `expm` of [[A, B, E], [0, 0, 0]]·dt

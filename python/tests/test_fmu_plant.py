@@ -1,4 +1,4 @@
-"""FMUs as the plant of a run (`[plant.fmu]`, issue 22), checked against independent numbers:
+"""FMUs as the plant of a run (`[plant.fmu]`), checked against independent numbers:
 
 * the linear test FMU (lti_plant, the exact ZOH step of seed 002 as parameters) gives a recording
   equal, bit for bit, to the built-in plant's on the same discrete model (`launcher compare`),

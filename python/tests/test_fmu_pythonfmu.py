@@ -1,4 +1,4 @@
-"""FMUs as a third-party exporter makes them (issue 31, item 3): pythonfmu (PyPI) builds
+"""FMUs as a third-party exporter makes them: pythonfmu (PyPI) builds
 fmu/testfmus/python/three_tank.py into an FMI 2.0 co-simulation FMU whose library embeds Python
 and leaves libpython's symbols to its host.
 

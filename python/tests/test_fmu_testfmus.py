@@ -1,4 +1,4 @@
-"""The test FMUs of fmu/testfmus (issue 22, "FMI: plants from FMUs"), run by FMPy — an FMI
+"""The test FMUs of fmu/testfmus, run by FMPy — an FMI
 importer independent of this repository — against references computed here with numpy/scipy.
 
 * lti_plant (FMI 2.0 and 3.0 co-simulation): Φ, Γ_B, Γ_E from one `scipy.linalg.expm` of

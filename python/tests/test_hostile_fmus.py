@@ -1,4 +1,4 @@
-"""FMU archives contained (issue 32, item 3): hostile FMUs made here from this repository's
+"""FMU archives contained: hostile FMUs made here from this repository's
 DC-motor FMU, each refused by the pre-flight check (exit 2, one line naming the entry or the
 identifier) before anything is extracted or loaded:
 

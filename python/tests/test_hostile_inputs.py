@@ -1,4 +1,4 @@
-"""Readers bounded by what they read (issue 32, item 2): hostile logs built here, each refused
+"""Readers bounded by what they read: hostile logs built here, each refused
 with exit 2 and one line, quickly, within a memory bound, and leaving no process behind.
 
 * A 1.7 KB MCAP whose zstd chunk declares 2^62 bytes uncompressed: before, `replay_plant

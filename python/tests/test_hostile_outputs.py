@@ -1,4 +1,4 @@
-"""Outputs that cannot be turned into a write anywhere (issue 32, item 1).
+"""Outputs that cannot be turned into a write anywhere.
 
 Another local user (`nobody`) who can write the output folder plants symbolic links at every
 name a command writes — its temporary names (`<name>.rrd.partial`, `<name>.summary.json.tmp`,
@@ -6,7 +6,7 @@ name a command writes — its temporary names (`<name>.rrd.partial`, `<name>.sum
 `outputs.png`, `uio_fmi3.fmu`, `Phi.npy`, `plant_x.csv`) — pointing at a file only root may
 write. Root then runs `run`, `sweep`, `plot`, `export-fmu`, `linearize` and `export` into that
 folder. The victim must keep its content, and every output be a regular file of root's (the link
-replaced, never written through). Before issue 32, `File::create`/`fs::write` followed the links
+replaced, never written through). Before, `File::create`/`fs::write` followed the links
 and truncated the victim — even a run refused with "already exists" truncated it first.
 
 Runs only as root with `runuser` and a `nobody` account (skipped otherwise, and said so).

@@ -1,4 +1,4 @@
-"""The unknown-input estimate ŵ of a UIO (issue 20, item 5), read back from the recording.
+"""The unknown-input estimate ŵ of a UIO, read back from the recording.
 
 Each run is exported to CSV (`launcher export --csv`); here, independently, scipy samples the
 plant (one `expm` of [[A, B, E], [0, 0, 0]]·dt) and forms ŵ_k = (CΓ_E)⁺(y_{k+1} − CΦx̂_k − CΓ_Bu_k)

@@ -1,4 +1,4 @@
-"""`launcher linearize` (issue 31, item 2): the sampled model of an FMU plant at an operating
+"""`launcher linearize`: the sampled model of an FMU plant at an operating
 point, made from the FMU itself (trim by Newton's method on the one-sample map, central
 differences with Richardson's extrapolation), checked against independent numbers:
 

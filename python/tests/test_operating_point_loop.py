@@ -1,4 +1,4 @@
-"""A closed loop at an operating point (issue 31, item 1): a two-zone building (air and wall
+"""A closed loop at an operating point: a two-zone building (air and wall
 node per zone, heaters Qh1 and Qh2 known and commanded, the outdoor temperature T_out known and
 *measured*, the zones' heat gains unknown) at 20 °C indoors and 5 °C outdoors, under an LQR
 with integral action on the UIO's estimate.

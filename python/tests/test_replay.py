@@ -1,4 +1,4 @@
-"""Observers on recorded data (`[plant.replay]`, `launcher replay`, issue 23):
+"""Observers on recorded data (`[plant.replay]`, `launcher replay`):
 
 * a CSV log of the DC motor with Coulomb friction, simulated here by scipy's solve_ivp (not our
   plant) with an additive actuator fault in it, replayed through a UIO and a bank of UIOs: the
@@ -542,7 +542,7 @@ def test_mcap_missing_hold(motor, tmp_path):
 
 
 def test_a_log_without_input_columns_replays_as_u_zero(motor, tmp_path):
-    """`inputs` is optional (issue 31, item 4): a log of a plant whose known inputs held still
+    """`inputs` is optional: a log of a plant whose known inputs held still
     replays with u = 0 (u_op at an operating point), the same bit for bit as the log with columns
     of zeros mapped to u."""
     folder, (t, u, w, x, y) = motor

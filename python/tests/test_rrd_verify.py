@@ -1,4 +1,4 @@
-"""Issue 24: a recording of layout 2 is a valid Rerun 0.36 file for Rerun's own CLI.
+"""A recording of layout 2 is a valid Rerun 0.36 file for Rerun's own CLI.
 
 `rerun rrd verify` (the rerun-sdk 0.36.3 package's CLI, installed by scripts/test.sh) decodes
 every chunk of the file and checks it against the types it knows, independently of our reader:

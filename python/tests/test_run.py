@@ -235,7 +235,7 @@ def test_a_parent_that_is_not_the_launcher_exits_2(run_space):
 
 
 def test_a_fifo_or_symlink_as_owner_pid_is_refused_without_blocking(run_space):
-    # Issue 19: a planted FIFO made readers hang in open(); a symlink could point anywhere.
+    # A planted FIFO made readers hang in open(); a symlink could point anywhere.
     owner = os.path.join(run_space["dir"], "owner.pid")
     elsewhere = os.path.join(run_space["dir"], "elsewhere")
     with open(elsewhere, "w") as f:

@@ -1,4 +1,4 @@
-"""Shared paths no other user can block (issue 32, item 4).
+"""Shared paths no other user can block.
 
 * Two users side by side: root and `nobody` run at the same time with the default runs and
   iceoryx2 folders (no `UIO_RUNS_DIR`, no `XDG_RUNTIME_DIR`). Before, `/tmp/uio-observers`

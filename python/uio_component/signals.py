@@ -1,6 +1,6 @@
 """The scenario's signals, for plants that generate their own disturbances and inputs.
 
-A signal is the scenario's JSON form (the README's "Scenario files"):
+A signal is the scenario's JSON form (docs/scenario-format.md):
 
 - `{"kind": "constant", "value": v}`
 - `{"kind": "step", "time": T, "before": b, "after": a}` (`before` defaults to 0)

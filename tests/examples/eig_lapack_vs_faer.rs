@@ -1,6 +1,6 @@
 //! Eigenvalues and singular values of the real power-system models, faer's (what `lti` uses)
 //! beside LAPACK's through the system OpenBLAS (`dgeev`, `dgesdd`), in one process, interleaved
-//! (issue 30, item 1: "measure both on the real models and choose").
+//! ("measure both on the real models and choose").
 //!
 //!     cargo run --release -p tests --example eig_lapack_vs_faer [runs]
 //!

@@ -141,7 +141,7 @@ fn check(name: &str) {
                     err < 1e-9,
                     "{name} dt = {dt}: w → e {err:e} of the response"
                 );
-                // Decoupling against a Kalman filter (issue 30): the UIO's tail error under a
+                // Decoupling against a Kalman filter: the UIO's tail error under a
                 // step in w at least 10³ below the Kalman filter's.
                 let (uio, kf) = (
                     tail_error(&d, &model, dt),

@@ -1,4 +1,4 @@
-//! Issue 6: each kind of bad input gets exit code 2, one line naming the file and the field
+//! Each kind of bad input gets exit code 2, one line naming the file and the field
 //! (with line:column where the parser knows it) and the reason, no panic, and no output files.
 
 use std::ffi::OsStr;
@@ -551,7 +551,7 @@ fn only_regular_files_of_bounded_size_are_read() {
     }
 }
 
-/// Issue 21: an unknown key is located at its own line (not its table's header), and an unknown
+/// An unknown key is located at its own line (not its table's header), and an unknown
 /// key, kind or shipped scenario name close to a known one gets "did you mean …".
 #[test]
 fn unknown_keys_point_at_their_line_and_near_misses_are_suggested() {

@@ -1,4 +1,4 @@
-//! Issue 24, item 4: banks of any size. A bank's members share one observer process, so a
+//! Banks of any size. A bank's members share one observer process, so a
 //! dedicated bank of 32 members on a 32-sensor plant runs across processes (it was refused: a
 //! service has 8 subscribers) and in-process, bit-identical, with the decisions of the
 //! structure: a bias on sensor j is found by residual j alone and isolated as channel j.

@@ -1,4 +1,4 @@
-//! Issue 13: `launcher bench` measures its floor — a bare three-process ring over the same
+//! `launcher bench` measures its floor — a bare three-process ring over the same
 //! transport — in the same session, and gives the multi-process figures as ratios to it.
 
 use tests::*;

@@ -1,4 +1,4 @@
-//! Issue 10, items 8 and 10: the command line's rough edges — a closed stdout, scenarios named
+//! The command line's rough edges — a closed stdout, scenarios named
 //! instead of pathed, `list`'s checks, progress on a terminal, and thinned or restricted
 //! recordings.
 

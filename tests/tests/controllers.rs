@@ -1,4 +1,4 @@
-//! Issue 21, item 2: controllers do what was asked — the sampled loop's poles where the file puts
+//! Controllers do what was asked — the sampled loop's poles where the file puts
 //! them, integral action and disturbance cancellation that leave no steady-state error.
 
 use controller::design::{Domain, FeedbackSpec};

@@ -1,4 +1,4 @@
-//! Issue 10, item 20: a recording damaged after it was written is reported as damaged (exit
+//! A recording damaged after it was written is reported as damaged (exit
 //! code 6) by inspect, compare, export and plot, which then write nothing; a clean one passes.
 
 use std::path::{Path, PathBuf};

@@ -1,4 +1,4 @@
-//! Issue 19, item 3: no damage to a recording crashes a reader. Every byte of the first and the
+//! No damage to a recording crashes a reader. Every byte of the first and the
 //! last 8 KiB of a finished recording (and every 37th in between) is flipped in turn and the
 //! file read in process: it must be reported damaged, or read to exactly the clean file's data
 //! (damage outside what the digest covers: row ids, legends, the blueprint) — never read as

@@ -1,4 +1,4 @@
-//! Issue 3: `launcher design` reports conditions, matrices and poles (text and JSON), and a model
+//! `launcher design` reports conditions, matrices and poles (text and JSON), and a model
 //! without an unknown-input observer is refused with the condition named, exit 2, by both
 //! `launcher design` and `launcher run`.
 
@@ -141,7 +141,7 @@ fn models_without_an_unknown_input_observer_are_refused_by_design_and_run() {
     }
 }
 
-/// Issue 10, item 11: `design --json` gives the sampled observer that runs. Replaying its
+/// `design --json` gives the sampled observer that runs. Replaying its
 /// F, G, K, P, Q on a run's recorded y and u reproduces the recorded estimates.
 #[test]
 fn design_json_sampled_matrices_reproduce_the_recorded_estimates() {
@@ -262,7 +262,7 @@ fn design_exits_non_zero_when_an_observer_fails() {
     assert_eq!(out.status.code(), Some(0));
 }
 
-/// Issue 30, item 7: a discrete-time plant (`time = "discrete"`, seed 002's exact sampling at
+/// A discrete-time plant (`time = "discrete"`, seed 002's exact sampling at
 /// 10 ms) designed by every family shows the sampled names only — (Φ, Γ_E, C), TΦ − K1C,
 /// Φ − KCΦ, HΦF − KCΦF, LᵍΦL — and every pole list says s or z.
 #[test]

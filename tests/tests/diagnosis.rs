@@ -1,4 +1,4 @@
-//! Issue 12: faults, noise, banks of residual generators, decisions and Monte Carlo — checked
+//! Faults, noise, banks of residual generators, decisions and Monte Carlo — checked
 //! against independent numbers (exact solutions, the χ² law, the banks' own decoupling).
 
 use std::path::PathBuf;
@@ -507,7 +507,7 @@ fn a_sweep_keeps_its_worst_realisations_as_recordings() {
     assert_eq!(bad.status.code(), Some(2), "{:?}", text(&bad));
 }
 
-/// Issue 20, item 7(b): a sensor bank of Luenberger members on a plant whose unknown input is
+/// A sensor bank of Luenberger members on a plant whose unknown input is
 /// not zero is warned about at design time (its members do not decouple w), and the run's
 /// summary carries the warning; the same bank without E is not.
 #[test]
@@ -558,7 +558,7 @@ fn non_decoupling_bank_under_a_disturbance_is_warned() {
     );
 }
 
-/// Issue 21: isolation over the whole fault. The camera-offset bias through a bank of UIOs is
+/// Isolation over the whole fault. The camera-offset bias through a bank of UIOs is
 /// isolated at its first alarm, then its residual 2 returns to zero and the pattern matches no
 /// channel: `launcher design` warns that y1 (and y2) are isolable only during transients, and
 /// the summary's shares of the fault's time — isolated correctly, as another channel, unknown, no

@@ -1,4 +1,4 @@
-//! Issue 10, item 3: a run that stops early reports the figures of the steps it completed and
+//! A run that stops early reports the figures of the steps it completed and
 //! claims no expectation; a hung component is named.
 
 use std::process::Stdio;

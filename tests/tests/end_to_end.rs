@@ -1,4 +1,4 @@
-//! Issue 2: the seed-002 scenarios run as separate processes and in one process, give
+//! The seed-002 scenarios run as separate processes and in one process, give
 //! bit-identical trajectories, decode with the rerun crate, and leave nothing behind.
 
 use std::process::Command;
@@ -92,7 +92,7 @@ fn check_scenario(name: &str) {
         );
     }
     // The latency series are there too, one per step: the last step's too, closed by the
-    // plant's end sample (issue 10, item 15).
+    // plant's end sample.
     for hop in ["/latency/step", "/latency/controller_to_plant"] {
         let l = &rp.series[hop];
         assert_eq!(l.steps, (0..steps as i64).collect::<Vec<_>>(), "{hop}");

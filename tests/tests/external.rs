@@ -1,4 +1,4 @@
-//! Issue 11: components we did not write join a run through PROTOCOL.md — and one that breaks
+//! Components we did not write join a run through PROTOCOL.md — and one that breaks
 //! it is named, stops the run quickly, and leaves nothing behind.
 
 use std::process::Stdio;
@@ -314,7 +314,7 @@ fn params_must_be_representable_in_json() {
     );
 }
 
-/// Issue 19: stamps a component could forge are checked too — a `taken_ns` of u64::MAX (later
+/// Stamps a component could forge are checked too — a `taken_ns` of u64::MAX (later
 /// than it sent the sample, later than the launcher received it) hides that it did not read its
 /// input, and a `sim_time` that is not a number is no time at all.
 #[test]
@@ -343,7 +343,7 @@ fn forged_stamps_break_the_protocol() {
     }
 }
 
-/// Issue 19: a component that closes its stdout before `ready` (and lives on) cannot report
+/// A component that closes its stdout before `ready` (and lives on) cannot report
 /// ready: it is named at once, not after the 20 s the launcher waits for `ready`.
 #[test]
 fn a_component_that_closes_its_stdout_before_ready_is_named_at_once() {

@@ -1,4 +1,4 @@
-//! Issue 6: a crashed component, an interrupted launcher, a stale run, parallel runs, and
+//! A crashed component, an interrupted launcher, a stale run, parallel runs, and
 //! components started by hand — with real processes, checked from outside.
 
 use std::path::PathBuf;
@@ -284,7 +284,7 @@ fn sigint_and_sigterm_stop_the_run_cleanly() {
     a_signal_stops_the_run_cleanly(libc::SIGTERM, "SIGTERM", 130);
 }
 
-/// Issue 10, item 16: a closed terminal (SIGHUP) or Ctrl-\ (SIGQUIT) stops the run like
+/// A closed terminal (SIGHUP) or Ctrl-\ (SIGQUIT) stops the run like
 /// SIGTERM, with exit code 128 + the signal's number.
 #[test]
 fn sighup_and_sigquit_stop_the_run_cleanly() {
@@ -330,7 +330,7 @@ fn fill(dir: &std::path::Path, leave: u64) {
     );
 }
 
-/// Issue 10, item 21: a full disk stops the run cleanly, naming the file and saying what of
+/// A full disk stops the run cleanly, naming the file and saying what of
 /// the recording was kept.
 #[test]
 fn a_full_disk_stops_the_run_and_says_what_was_kept() {

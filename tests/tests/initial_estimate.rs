@@ -1,4 +1,4 @@
-//! Issue 20, item 6: `xhat0` sets an observer's first estimate, in both run modes alike.
+//! `xhat0` sets an observer's first estimate, in both run modes alike.
 
 use tests::*;
 

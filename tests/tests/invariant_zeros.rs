@@ -1,4 +1,4 @@
-//! Issue 10, item 1: plants whose (A, E, C) has invariant zeros that sampling removes design and
+//! Plants whose (A, E, C) has invariant zeros that sampling removes design and
 //! run in both modes, bit-identically, with the UIO error converging at the fixed modes' rate.
 
 use lti::Model;

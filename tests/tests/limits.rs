@@ -1,5 +1,5 @@
-//! Issue 19: every count and size from the user is checked before anything starts — against a
-//! documented limit (README "Failure behaviour and security", **Limits**) or the machine's disk
+//! Every count and size from the user is checked before anything starts — against a
+//! documented limit (docs/security.md, **Limits**) or the machine's disk
 //! and memory — and refused as bad input: exit 2, one line naming the flag or the field, no
 //! panic, no output.
 

@@ -1,4 +1,4 @@
-//! Issue 5: after start-up, neither the step functions nor the process loops allocate.
+//! After start-up, neither the step functions nor the process loops allocate.
 //! A counting global allocator counts the allocations made by this thread while enabled.
 
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -221,7 +221,7 @@ fn process_loop(s: &Scenario) {
     }
 }
 
-/// Issue 24: the recording writer allocates nothing per step. Between two sends of a group, a
+/// The recording writer allocates nothing per step. Between two sends of a group, a
 /// row and its values go into buffers sized for a whole batch (`FLUSH_STEPS` rows).
 #[test]
 fn the_recording_writer_allocates_nothing_between_sends() {

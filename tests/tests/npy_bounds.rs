@@ -1,4 +1,4 @@
-//! Issue 19, item 3: a `.npy` matrix file whose header claims more than the file holds is
+//! A `.npy` matrix file whose header claims more than the file holds is
 //! refused from its header, before its values are read: a sparse 1 GiB file claiming
 //! 11585×11585 was read whole first (2.1 GB of memory, 9.8 s). Alone in its test binary so
 //! that the children's peak memory (RUSAGE_CHILDREN) is the launcher's of this test.

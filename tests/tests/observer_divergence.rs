@@ -1,4 +1,4 @@
-//! Issue 30 item 5: an observer whose error leaves the plant's state bound stops the run as a
+//! An observer whose error leaves the plant's state bound stops the run as a
 //! diverging plant does — exit 4, the observer named, the recording and summary finalised,
 //! nothing left behind — instead of a run that exits 0 with a figure of 1e12. Here the error
 //! starts beyond the bound (x̂₀ is 50 off, the bound is 10): the check is the same at any step.

@@ -1,4 +1,4 @@
-//! Issue 31, item 1: a plant at an operating point. The design model is in deviations there,
+//! A plant at an operating point. The design model is in deviations there,
 //! the plant speaks absolute units, and the observers and the controller add the point's offsets.
 //! The check is the definition: on seeded random plants at random equilibria, a scenario written
 //! in absolute units with `[plant.operating_point]` and the same scenario written by hand in

@@ -1,4 +1,4 @@
-//! Issue 10, items 4–7: `launcher plot` stays inside its axes, draws one colour per observer,
+//! `launcher plot` stays inside its axes, draws one colour per observer,
 //! an |e| view on a log axis, and what `--signals`, `--from` and `--to` select; every signal is
 //! numbered from 1 and named with its unit in plots and CSV headers.
 
@@ -393,7 +393,7 @@ fn names_and_units_label_plots_and_csv_headers() {
     );
 }
 
-/// Issue 21: the diagnosis view draws J on a log axis (its values log10, 0 at the floor), and
+/// The diagnosis view draws J on a log axis (its values log10, 0 at the floor), and
 /// each threshold dashed in the colour of the evaluation it bounds.
 #[test]
 fn the_diagnosis_view_has_j_on_a_log_axis_and_dashed_thresholds_in_their_colours() {

@@ -1,5 +1,5 @@
-//! Issue 10, item 9: every TOML example in the README parses — uncommented, as a user would
-//! copy it — and a complete scenario among them validates as one.
+//! Every TOML example in the README and in docs/ parses — uncommented, as a user would copy
+//! it — and a complete scenario among them validates as one.
 
 use std::path::Path;
 
@@ -35,14 +35,33 @@ fn uncomment(line: &str) -> Option<String> {
 
 #[test]
 fn every_toml_example_parses_and_scenarios_validate() {
-    let text = std::fs::read_to_string(repo().join("README.md")).unwrap();
-    let blocks = toml_blocks(&text);
-    assert!(!blocks.is_empty(), "the README has TOML examples");
-    for (line, body) in &blocks {
-        toml::from_str::<toml::Table>(body).unwrap_or_else(|e| panic!("README.md:{line}: {e}"));
+    let mut pages = vec![repo().join("README.md")];
+    let mut docs: Vec<_> = std::fs::read_dir(repo().join("docs"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "md"))
+        .collect();
+    docs.sort();
+    pages.extend(docs);
+    let mut count = 0;
+    for page in &pages {
+        let name = page.strip_prefix(repo()).unwrap().display().to_string();
+        let text = std::fs::read_to_string(page).unwrap();
+        let blocks = toml_blocks(&text);
+        count += blocks.len();
+        check(&name, &blocks);
+    }
+    assert!(count > 0, "the README and docs/ have no TOML example");
+}
+
+/// Each block parses as TOML, a block with `[plant]` validates as a scenario, and each of its
+/// commented settings, uncommented on its own, is TOML too.
+fn check(page: &str, blocks: &[(usize, String)]) {
+    for (line, body) in blocks {
+        toml::from_str::<toml::Table>(body).unwrap_or_else(|e| panic!("{page}:{line}: {e}"));
         if body.contains("[plant]") {
-            scenario::Scenario::parse(Path::new("README.md"), body)
-                .unwrap_or_else(|e| panic!("README.md:{line}: {e}"));
+            scenario::Scenario::parse(Path::new(page), body)
+                .unwrap_or_else(|e| panic!("{page}:{line}: {e}"));
         }
         // Each commented setting, uncommented on its own, is valid TOML too.
         for (j, l) in body.lines().enumerate() {
@@ -52,7 +71,7 @@ fn every_toml_example_parses_and_scenarios_validate() {
                 }
                 toml::from_str::<toml::Table>(&setting).unwrap_or_else(|e| {
                     panic!(
-                        "README.md:{}: commented example `{setting}` is not TOML: {e}",
+                        "{page}:{}: commented example `{setting}` is not TOML: {e}",
                         line + j
                     )
                 });

@@ -1,4 +1,4 @@
-//! Issue 13, item 5: `--realtime [--speed X]` paces a run — step k starts at k·dt/X of wall
+//! `--realtime [--speed X]` paces a run — step k starts at k·dt/X of wall
 //! time — with waits that sleep, and counts and records the steps that end late.
 
 use std::time::{Duration, Instant};

@@ -1,4 +1,4 @@
-//! Issue 19, item 2: run directories that cannot be turned against their owner. As root, with
+//! Run directories that cannot be turned against their owner. As root, with
 //! what another user (`nobody`) planted — a symlink as the runs directory, a FIFO as a dead
 //! run's `owner.pid`, a symlink as a run — the real launcher neither deletes, blocks on nor
 //! removes anything that is not provably a dead run of its own. Each test runs in its own

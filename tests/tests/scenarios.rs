@@ -1,4 +1,4 @@
-//! Issue 4: every shipped scenario runs in both modes, gives bit-identical trajectories, meets
+//! Every shipped scenario runs in both modes, gives bit-identical trajectories, meets
 //! its [expect] table, and leaves nothing behind; the seed-specific claims hold.
 
 use std::path::PathBuf;

@@ -1,4 +1,4 @@
-//! Issue 21, item 3: supervision that does not stop healthy runs. A component that publishes
+//! Supervision that does not stop healthy runs. A component that publishes
 //! nothing is judged by what the kernel says of it: stopped or blocked, it is named after 5 s;
 //! running, or waiting for a core, it is waited for up to the stall limit (`stall_timeout`,
 //! `--stall-timeout`), and the message says which limit was hit.

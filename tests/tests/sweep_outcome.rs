@@ -1,4 +1,4 @@
-//! Issue 19: a sweep's realisations that fail are counted as failed (not in the statistics) and
+//! A sweep's realisations that fail are counted as failed (not in the statistics) and
 //! make the sweep fail; an interrupted sweep writes the statistics of what it finished, marked
 //! partial.
 

@@ -1,4 +1,4 @@
-//! Issue 7: inspect, compare, export and plot recordings — complete ones and one whose writer
+//! Inspect, compare, export and plot recordings — complete ones and one whose writer
 //! was killed.
 
 use std::process::Stdio;

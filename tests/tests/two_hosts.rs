@@ -1,4 +1,4 @@
-//! Issue 14: a run with components on another host, over Zenoh, tested on one machine as two
+//! A run with components on another host, over Zenoh, tested on one machine as two
 //! hosts (network namespaces joined by a veth pair, scripts/two-hosts.sh). The script checks each
 //! case itself and this test runs it and reads its verdict:
 //! - the recording against a single-host run, bit for bit;

@@ -1,4 +1,4 @@
-"""Test FMU three_tank (issue 31): a third-party exporter's FMU (pythonfmu, FMI 2.0 CS) of a
+"""Test FMU three_tank: a third-party exporter's FMU (pythonfmu, FMI 2.0 CS) of a
 nonlinear plant in absolute units, at a non-zero operating point.
 
 Three tanks in series (the DTS200 arrangement): pump 1 fills tank 1, pump 2 fills tank 2,
