@@ -54,6 +54,9 @@ python3 scripts/check-imports.py
 cargo build --release --workspace --bins
 # The observer FMUs' library (a cdylib, which --bins does not build), for `launcher export-fmu`.
 cargo build --release -p fmu-observer
+# Lints on every target of the workspace (and the LMI design path), warnings as errors.
+cargo clippy --release --workspace --all-targets -- -D warnings
+cargo clippy --release -p observer --all-targets --features lmi -- -D warnings
 # The Python package on the design library (pyuio/, PyO3): maturin builds it with cargo, in
 # this target directory, and installs it in the environment; unchanged sources rebuild nothing.
 "$venv/bin/pip" install -q --disable-pip-version-check --no-build-isolation ./pyuio

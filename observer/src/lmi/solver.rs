@@ -65,6 +65,8 @@ pub fn solve(a1: &Mat, c: &Mat, d: &Mat, decay: f64) -> Result<LmiSolution, Stri
     };
     let rows = 2 * np + n * r;
     let mut dense = vec![vec![0.0; nvar]; rows];
+    // v indexes a column of every row, not an element of one: no iterator replaces it.
+    #[allow(clippy::needless_range_loop)]
     for v in 0..nvar {
         let (pm, ym) = basis(v);
         for (i, x) in svec(&lmi(&pm, &ym)).into_iter().enumerate() {

@@ -99,7 +99,7 @@ pub(super) fn bank_members(
     observers: &mut Vec<ObserverEntry>,
 ) {
     for (di, d) in diagnosers.iter().enumerate() {
-        for j in 0..diagnosis::bank::monitored(d, &model, &ff).0.len() {
+        for j in 0..diagnosis::bank::monitored(d, model, ff).0.len() {
             observers.push(ObserverEntry {
                 name: format!("{}-{}", d.name, j + 1),
                 spec: None,

@@ -49,7 +49,7 @@ pub(super) fn true_plant(
             ));
         }
     }
-    let noise = crate::fault_diagnosis::noise(&raw.noise, &model, dt)?;
+    let noise = crate::fault_diagnosis::noise(&raw.noise, model, dt)?;
     if raw.fault.len() > MAX_FAULTS {
         return Err(bad(
             format!("fault[{}]", MAX_FAULTS + 1),
@@ -59,7 +59,7 @@ pub(super) fn true_plant(
             ),
         ));
     }
-    let faults = crate::fault_diagnosis::faults(&raw.fault, &model, &ff, dt)?;
+    let faults = crate::fault_diagnosis::faults(&raw.fault, model, ff, dt)?;
     if p.process.is_some()
         && let Some(what) = [
             (!raw.fault.is_empty(), "fault"),
@@ -129,10 +129,10 @@ pub(super) fn true_plant(
     let builtin = p.process.is_none() && p.fmu.is_none() && p.replay.is_none();
     let operating_point = crate::operating_point::operating_point(
         &p.operating_point,
-        &model,
+        model,
         discrete,
         builtin,
-        &layout_names,
+        layout_names,
     )?;
     let replay = crate::replay_plant::plant_replay(
         &p.replay,
