@@ -149,22 +149,9 @@ def defines(mod, name):
 def resolve(mods, mod, segs, seen=None):
     """The file that defines the item `segs` names, starting at module `mod`; None if external."""
     seen = seen or set()
-    cur = mod
-    first = True
-    while segs:
-        s = segs[0]
-        if s == "crate" and first:
-            cur = mods[()]
-        elif s == "super" and cur.parent is not None:
-            cur = cur.parent
-        elif s == "self":
-            pass
-        elif s in cur.children:
-            cur = cur.children[s]
-        else:
-            break
-        segs, first = segs[1:], False
-    else:
+    cur, used = descend(mods, mod, segs)
+    first, segs = used == 0, segs[used:]
+    if not segs:
         return cur.file
     if first and mod.path == cur.path and segs[0] not in cur.children:
         # A first segment that is neither crate/super/self nor a child: an external crate, a
@@ -192,7 +179,9 @@ def resolve(mods, mod, segs, seen=None):
     return cur.file
 
 
-def walk_mod(mods, mod, segs):
+def descend(mods, mod, segs):
+    """The module the leading segments of a path name (crate, super, self, child modules), and
+    how many segments that took."""
     cur = mod
     for i, s in enumerate(segs):
         if s == "crate" and i == 0:
@@ -204,8 +193,14 @@ def walk_mod(mods, mod, segs):
         elif s in cur.children:
             cur = cur.children[s]
         else:
-            return None
-    return cur
+            return cur, i
+    return cur, len(segs)
+
+
+def walk_mod(mods, mod, segs):
+    """The module `segs` names in full, or None."""
+    cur, used = descend(mods, mod, segs)
+    return cur if used == len(segs) else None
 
 
 WHY = {}
