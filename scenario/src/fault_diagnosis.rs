@@ -11,7 +11,7 @@ use plant::fault::{Fault, Kind, Profile, Target};
 use super::limits::{MAX_CALIBRATION_RUNS, MAX_WINDOW};
 use super::raw::{RawDiagnoser, RawFault, RawNoise};
 use super::untrusted::quoted;
-use crate::check::{Bad, bad, check_name, definite, finite, matrix, placement, poles};
+use crate::check::{Bad, bad, check_name, definite, finite, matrix, one_of, placement, poles};
 
 /// The run's noise: the per-step covariances the plant draws from and the Kalman filter uses.
 #[derive(Debug, Clone, PartialEq)]
@@ -315,353 +315,413 @@ pub(crate) fn diagnosers(
     noise: Option<&NoiseSpec>,
     taken: &mut BTreeSet<String>,
 ) -> Result<Vec<DiagnoserSpec>, Bad> {
-    let mut out = Vec::new();
-    for (i, d) in raw.iter().enumerate() {
-        let at = |key: &str| format!("diagnoser[{}].{key}", i + 1);
-        check_name(
-            &at("name"),
-            &d.name,
-            "it names the bank's observers and signals",
-        )?;
-        let scheme = match d.scheme.as_str() {
-            "generalized" => Scheme::Generalized,
-            "dedicated" => Scheme::Dedicated,
-            other => {
-                return Err(bad(
-                    at("scheme"),
-                    format!(
-                        "{} is not a scheme (generalized, dedicated){}",
-                        quoted(other),
-                        crate::suggest::did_you_mean(other, ["generalized", "dedicated"])
-                    ),
-                ));
-            }
-        };
-        let channels = match d.faults.as_str() {
-            "actuator" => Channels::Actuator,
-            "sensor" => Channels::Sensor,
-            "component" => Channels::Component,
-            other => {
-                return Err(bad(
-                    at("faults"),
-                    format!(
-                        "{} is not a channel class (actuator, sensor, component){}",
-                        quoted(other),
-                        crate::suggest::did_you_mean(other, ["actuator", "sensor", "component"])
-                    ),
-                ));
-            }
-        };
-        let all = diagnosis::bank::channel_labels(channels, model, ff);
-        let subset = match &d.channels {
-            None => None,
-            Some(list) => {
-                let mut ids = Vec::with_capacity(list.len());
-                for &c in list {
-                    if c < 1 || c as usize > all.len() {
-                        return Err(bad(
-                            at("channels"),
-                            format!(
-                                "{c} is not a {} channel: they are 1 … {} ({})",
-                                channels.name(),
-                                all.len(),
-                                all.join(", ")
-                            ),
-                        ));
-                    }
-                    if ids.contains(&(c as usize - 1)) {
-                        return Err(bad(at("channels"), format!("{c} is listed twice")));
-                    }
-                    ids.push(c as usize - 1);
-                }
-                if ids.len() < 2 {
+    raw.iter()
+        .enumerate()
+        .map(|(i, d)| diagnoser(i, d, model, ff, noise, taken))
+        .collect()
+}
+
+/// The `i`-th (0-based) `[[diagnoser]]`, its members' names claimed in `taken`.
+fn diagnoser(
+    i: usize,
+    d: &RawDiagnoser,
+    model: &Model,
+    ff: &Mat,
+    noise: Option<&NoiseSpec>,
+    taken: &mut BTreeSet<String>,
+) -> Result<DiagnoserSpec, Bad> {
+    let at = |key: &str| format!("diagnoser[{}].{key}", i + 1);
+    check_name(
+        &at("name"),
+        &d.name,
+        "it names the bank's observers and signals",
+    )?;
+    let scheme = one_of(
+        at("scheme"),
+        "scheme",
+        &d.scheme,
+        &[
+            ("generalized", Scheme::Generalized),
+            ("dedicated", Scheme::Dedicated),
+        ],
+    )?;
+    let channels = one_of(
+        at("faults"),
+        "channel class",
+        &d.faults,
+        &[
+            ("actuator", Channels::Actuator),
+            ("sensor", Channels::Sensor),
+            ("component", Channels::Component),
+        ],
+    )?;
+    let all = diagnosis::bank::channel_labels(channels, model, ff);
+    let subset = subset(i, d, channels, &all)?;
+    claim_members(i, d, subset.as_ref().map_or(all.len(), Vec::len), taken)?;
+    let member = member(i, d, channels, noise)?;
+    let structure = structure(i, d)?;
+    let evaluation = evaluation(i, d)?;
+    let threshold = threshold(i, d, &evaluation, noise)?;
+    let persistence = d.persistence.unwrap_or(1);
+    if persistence < 1 {
+        return Err(bad(
+            at("persistence"),
+            format!("{persistence} must be a whole number of samples ≥ 1"),
+        ));
+    }
+    let ignore_before = finite(&at("ignore_before"), d.ignore_before.unwrap_or(0.0))?;
+    if ignore_before < 0.0 {
+        return Err(bad(
+            at("ignore_before"),
+            format!("{ignore_before} must be ≥ 0"),
+        ));
+    }
+    Ok(DiagnoserSpec {
+        name: d.name.clone(),
+        scheme,
+        channels,
+        subset,
+        member,
+        structure,
+        evaluation,
+        threshold,
+        persistence: persistence.min(u32::MAX as i64) as u32,
+        ignore_before,
+    })
+}
+
+/// `channels`: a subset of the class's channels (0-based, sorted), at least two; `None`: all.
+fn subset(
+    i: usize,
+    d: &RawDiagnoser,
+    channels: Channels,
+    all: &[String],
+) -> Result<Option<Vec<usize>>, Bad> {
+    let at = |key: &str| format!("diagnoser[{}].{key}", i + 1);
+    Ok(match &d.channels {
+        None => None,
+        Some(list) => {
+            let mut ids = Vec::with_capacity(list.len());
+            for &c in list {
+                if c < 1 || c as usize > all.len() {
                     return Err(bad(
                         at("channels"),
                         format!(
-                            "a bank needs at least two channels to isolate between, {} given",
-                            ids.len()
+                            "{c} is not a {} channel: they are 1 … {} ({})",
+                            channels.name(),
+                            all.len(),
+                            all.join(", ")
                         ),
                     ));
                 }
-                ids.sort_unstable();
-                Some(ids)
+                if ids.contains(&(c as usize - 1)) {
+                    return Err(bad(at("channels"), format!("{c} is listed twice")));
+                }
+                ids.push(c as usize - 1);
             }
-        };
-        let m = subset.as_ref().map_or(all.len(), Vec::len);
-        // The members' observer names must be free, and short enough to be names themselves.
-        for j in 1..=m {
-            let member = format!("{}-{j}", d.name);
-            check_name(&at("name"), &member, "it names the bank's observers")?;
-            if !taken.insert(member.clone()) {
+            if ids.len() < 2 {
                 return Err(bad(
-                    at("name"),
+                    at("channels"),
                     format!(
-                        "its member {} would share a name with an observer or another member",
-                        quoted(&member)
+                        "a bank needs at least two channels to isolate between, {} given",
+                        ids.len()
                     ),
                 ));
             }
+            ids.sort_unstable();
+            Some(ids)
         }
-        let default = if channels == Channels::Sensor {
-            "luenberger"
-        } else {
-            "chen-patton-uio"
-        };
-        let kind = d.observer.as_deref().unwrap_or(default);
-        let pole_list = || match &d.poles {
-            Some(p) => poles(&at("poles"), p),
-            None => Err(bad(at("poles"), format!("{kind} members need poles"))),
-        };
-        let method = placement(&at("placement"), &d.placement)?;
-        let member = match kind {
-            "chen-patton-uio" => MemberKind::ChenPatton {
-                poles: pole_list()?,
-                placement: method,
-            },
-            "luenberger" => MemberKind::Luenberger {
-                poles: pole_list()?,
-                placement: method,
-            },
-            "kalman" => {
-                if d.poles.is_some() {
-                    return Err(bad(
-                        at("poles"),
-                        "kalman members take no poles (the noise sets them)",
-                    ));
-                }
-                if noise.is_none() {
-                    return Err(bad(at("observer"), "kalman members need [noise]"));
-                }
-                MemberKind::Kalman
-            }
-            other => {
-                return Err(bad(
-                    at("observer"),
-                    format!(
-                        "{} is not a member design (chen-patton-uio, luenberger, kalman){}",
-                        quoted(other),
-                        crate::suggest::did_you_mean(
-                            other,
-                            ["chen-patton-uio", "luenberger", "kalman"]
-                        )
-                    ),
-                ));
-            }
-        };
-        if channels != Channels::Sensor && kind != "chen-patton-uio" {
+    })
+}
+
+/// The members' observer names (`<name>-1` … `<name>-m`) must be free, and short enough to be
+/// names themselves.
+fn claim_members(
+    i: usize,
+    d: &RawDiagnoser,
+    m: usize,
+    taken: &mut BTreeSet<String>,
+) -> Result<(), Bad> {
+    let at = |key: &str| format!("diagnoser[{}].{key}", i + 1);
+    for j in 1..=m {
+        let member = format!("{}-{j}", d.name);
+        check_name(&at("name"), &member, "it names the bank's observers")?;
+        if !taken.insert(member.clone()) {
             return Err(bad(
-                at("observer"),
+                at("name"),
                 format!(
-                    "{kind} cannot be blind to a {} channel: use chen-patton-uio",
-                    channels.name()
+                    "its member {} would share a name with an observer or another member",
+                    quoted(&member)
                 ),
             ));
         }
-        let structure = d
-            .structure
-            .as_ref()
-            .map(|rows| {
-                rows.iter()
-                    .enumerate()
-                    .map(|(r, row)| {
-                        row.iter()
-                            .map(|&v| {
-                                if v == 0 || v == 1 {
-                                    Ok(v as u8)
-                                } else {
-                                    Err(bad(
-                                        format!("diagnoser[{}].structure[{}]", i + 1, r + 1),
-                                        format!("{v}: entries are 0 or 1"),
-                                    ))
-                                }
-                            })
-                            .collect::<Result<Vec<u8>, Bad>>()
-                    })
-                    .collect::<Result<Vec<_>, Bad>>()
-            })
-            .transpose()?;
-        let evaluation = match d.evaluation.as_deref().unwrap_or("rms") {
-            "norm" => Evaluation::Norm,
-            "rms" => {
-                let w = d.window.unwrap_or(10);
-                if w < 1 {
-                    return Err(bad(
-                        at("window"),
-                        format!("{w} must be a whole number of samples ≥ 1"),
-                    ));
-                }
-                if w > MAX_WINDOW {
-                    return Err(bad(
-                        at("window"),
-                        format!(
-                            "{w} samples: at most {MAX_WINDOW} (each member keeps its window in memory, 8 bytes a sample)"
-                        ),
-                    ));
-                }
-                Evaluation::Rms { window: w as usize }
-            }
-            "forgetting" => {
-                let l = finite(
-                    &at("forgetting"),
-                    d.forgetting.ok_or_else(|| {
-                        bad(
-                            at("forgetting"),
-                            "evaluation = \"forgetting\" needs forgetting = λ, 0 < λ < 1",
-                        )
-                    })?,
-                )?;
-                if !(l > 0.0 && l < 1.0) {
-                    return Err(bad(
-                        at("forgetting"),
-                        format!("{l} must be between 0 and 1"),
-                    ));
-                }
-                Evaluation::Forgetting { lambda: l }
-            }
-            "chi2" => Evaluation::Chi2,
-            other => {
+    }
+    Ok(())
+}
+
+/// The members' design: `observer` (default: Luenberger for sensor channels, else the
+/// Chen–Patton UIO, the only one blind to an input channel) with its poles and placement.
+fn member(
+    i: usize,
+    d: &RawDiagnoser,
+    channels: Channels,
+    noise: Option<&NoiseSpec>,
+) -> Result<MemberKind, Bad> {
+    let at = |key: &str| format!("diagnoser[{}].{key}", i + 1);
+    let default = if channels == Channels::Sensor {
+        "luenberger"
+    } else {
+        "chen-patton-uio"
+    };
+    let kind = d.observer.as_deref().unwrap_or(default);
+    let pole_list = || match &d.poles {
+        Some(p) => poles(&at("poles"), p),
+        None => Err(bad(at("poles"), format!("{kind} members need poles"))),
+    };
+    let method = placement(&at("placement"), &d.placement)?;
+    let member = match kind {
+        "chen-patton-uio" => MemberKind::ChenPatton {
+            poles: pole_list()?,
+            placement: method,
+        },
+        "luenberger" => MemberKind::Luenberger {
+            poles: pole_list()?,
+            placement: method,
+        },
+        "kalman" => {
+            if d.poles.is_some() {
                 return Err(bad(
-                    at("evaluation"),
+                    at("poles"),
+                    "kalman members take no poles (the noise sets them)",
+                ));
+            }
+            if noise.is_none() {
+                return Err(bad(at("observer"), "kalman members need [noise]"));
+            }
+            MemberKind::Kalman
+        }
+        other => {
+            return Err(bad(
+                at("observer"),
+                format!(
+                    "{} is not a member design (chen-patton-uio, luenberger, kalman){}",
+                    quoted(other),
+                    crate::suggest::did_you_mean(
+                        other,
+                        ["chen-patton-uio", "luenberger", "kalman"]
+                    )
+                ),
+            ));
+        }
+    };
+    if channels != Channels::Sensor && kind != "chen-patton-uio" {
+        return Err(bad(
+            at("observer"),
+            format!(
+                "{kind} cannot be blind to a {} channel: use chen-patton-uio",
+                channels.name()
+            ),
+        ));
+    }
+    Ok(member)
+}
+
+/// `structure`: the structure matrix asked for, of 0 and 1.
+fn structure(i: usize, d: &RawDiagnoser) -> Result<Option<Vec<Vec<u8>>>, Bad> {
+    d.structure
+        .as_ref()
+        .map(|rows| {
+            rows.iter()
+                .enumerate()
+                .map(|(r, row)| {
+                    row.iter()
+                        .map(|&v| {
+                            if v == 0 || v == 1 {
+                                Ok(v as u8)
+                            } else {
+                                Err(bad(
+                                    format!("diagnoser[{}].structure[{}]", i + 1, r + 1),
+                                    format!("{v}: entries are 0 or 1"),
+                                ))
+                            }
+                        })
+                        .collect::<Result<Vec<u8>, Bad>>()
+                })
+                .collect::<Result<Vec<_>, Bad>>()
+        })
+        .transpose()
+}
+
+/// `evaluation` (norm, rms with its window, forgetting with λ, chi2) and the keys only one of
+/// them takes.
+fn evaluation(i: usize, d: &RawDiagnoser) -> Result<Evaluation, Bad> {
+    let at = |key: &str| format!("diagnoser[{}].{key}", i + 1);
+    let evaluation = match d.evaluation.as_deref().unwrap_or("rms") {
+        "norm" => Evaluation::Norm,
+        "rms" => {
+            let w = d.window.unwrap_or(10);
+            if w < 1 {
+                return Err(bad(
+                    at("window"),
+                    format!("{w} must be a whole number of samples ≥ 1"),
+                ));
+            }
+            if w > MAX_WINDOW {
+                return Err(bad(
+                    at("window"),
                     format!(
-                        "{} is not an evaluation (norm, rms, forgetting, chi2){}",
-                        quoted(other),
-                        crate::suggest::did_you_mean(other, ["norm", "rms", "forgetting", "chi2"])
+                        "{w} samples: at most {MAX_WINDOW} (each member keeps its window in memory, 8 bytes a sample)"
                     ),
                 ));
             }
-        };
-        if d.window.is_some() && !matches!(evaluation, Evaluation::Rms { .. }) {
+            Evaluation::Rms { window: w as usize }
+        }
+        "forgetting" => {
+            let l = finite(
+                &at("forgetting"),
+                d.forgetting.ok_or_else(|| {
+                    bad(
+                        at("forgetting"),
+                        "evaluation = \"forgetting\" needs forgetting = λ, 0 < λ < 1",
+                    )
+                })?,
+            )?;
+            if !(l > 0.0 && l < 1.0) {
+                return Err(bad(
+                    at("forgetting"),
+                    format!("{l} must be between 0 and 1"),
+                ));
+            }
+            Evaluation::Forgetting { lambda: l }
+        }
+        "chi2" => Evaluation::Chi2,
+        other => {
             return Err(bad(
-                at("window"),
-                "only evaluation = \"rms\" takes a window",
+                at("evaluation"),
+                format!(
+                    "{} is not an evaluation (norm, rms, forgetting, chi2){}",
+                    quoted(other),
+                    crate::suggest::did_you_mean(other, ["norm", "rms", "forgetting", "chi2"])
+                ),
             ));
         }
-        if d.forgetting.is_some() && !matches!(evaluation, Evaluation::Forgetting { .. }) {
-            return Err(bad(
-                at("forgetting"),
-                "only evaluation = \"forgetting\" takes forgetting",
-            ));
+    };
+    if d.window.is_some() && !matches!(evaluation, Evaluation::Rms { .. }) {
+        return Err(bad(
+            at("window"),
+            "only evaluation = \"rms\" takes a window",
+        ));
+    }
+    if d.forgetting.is_some() && !matches!(evaluation, Evaluation::Forgetting { .. }) {
+        return Err(bad(
+            at("forgetting"),
+            "only evaluation = \"forgetting\" takes forgetting",
+        ));
+    }
+    Ok(evaluation)
+}
+
+/// One of `threshold`, `false_alarm` (a χ² threshold) and `calibrate`.
+fn threshold(
+    i: usize,
+    d: &RawDiagnoser,
+    evaluation: &Evaluation,
+    noise: Option<&NoiseSpec>,
+) -> Result<Threshold, Bad> {
+    let at = |key: &str| format!("diagnoser[{}].{key}", i + 1);
+    let given = [
+        d.threshold.is_some(),
+        d.false_alarm.is_some(),
+        d.calibrate.is_some(),
+    ]
+    .iter()
+    .filter(|&&g| g)
+    .count();
+    if given > 1 {
+        return Err(bad(
+            at("threshold"),
+            "give one of threshold, false_alarm and calibrate",
+        ));
+    }
+    let threshold = match (d.threshold, d.false_alarm) {
+        _ if d.calibrate.is_some() => {
+            let c = d.calibrate.as_ref().expect("given");
+            if c.runs < 1 {
+                return Err(bad(
+                    at("calibrate.runs"),
+                    format!("{} must be a whole number of realisations ≥ 1", c.runs),
+                ));
+            }
+            if c.runs > MAX_CALIBRATION_RUNS {
+                return Err(bad(
+                    at("calibrate.runs"),
+                    format!(
+                        "{} realisations: at most {MAX_CALIBRATION_RUNS} (each is a whole run of the scenario, made before the run starts)",
+                        c.runs
+                    ),
+                ));
+            }
+            let margin = finite(&at("calibrate.margin"), c.margin.unwrap_or(1.2))?;
+            if margin < 1.0 {
+                return Err(bad(
+                    at("calibrate.margin"),
+                    format!(
+                        "{margin} must be ≥ 1 (the threshold is margin × the largest fault-free J)"
+                    ),
+                ));
+            }
+            if noise.is_none() {
+                return Err(bad(
+                    at("calibrate"),
+                    "calibration runs fault-free noisy realisations: the scenario has no [noise]",
+                ));
+            }
+            Threshold::Calibrated {
+                runs: c.runs as usize,
+                margin,
+            }
         }
-        let given = [
-            d.threshold.is_some(),
-            d.false_alarm.is_some(),
-            d.calibrate.is_some(),
-        ]
-        .iter()
-        .filter(|&&g| g)
-        .count();
-        if given > 1 {
-            return Err(bad(
-                at("threshold"),
-                "give one of threshold, false_alarm and calibrate",
-            ));
+        (Some(t), None) => {
+            let t = finite(&at("threshold"), t)?;
+            if t <= 0.0 {
+                return Err(bad(at("threshold"), format!("{t} must be > 0")));
+            }
+            Threshold::Fixed(t)
         }
-        let threshold = match (d.threshold, d.false_alarm) {
-            _ if d.calibrate.is_some() => {
-                let c = d.calibrate.as_ref().expect("given");
-                if c.runs < 1 {
-                    return Err(bad(
-                        at("calibrate.runs"),
-                        format!("{} must be a whole number of realisations ≥ 1", c.runs),
-                    ));
-                }
-                if c.runs > MAX_CALIBRATION_RUNS {
-                    return Err(bad(
-                        at("calibrate.runs"),
-                        format!(
-                            "{} realisations: at most {MAX_CALIBRATION_RUNS} (each is a whole run of the scenario, made before the run starts)",
-                            c.runs
-                        ),
-                    ));
-                }
-                let margin = finite(&at("calibrate.margin"), c.margin.unwrap_or(1.2))?;
-                if margin < 1.0 {
-                    return Err(bad(
-                        at("calibrate.margin"),
-                        format!(
-                            "{margin} must be ≥ 1 (the threshold is margin × the largest fault-free J)"
-                        ),
-                    ));
-                }
-                if noise.is_none() {
-                    return Err(bad(
-                        at("calibrate"),
-                        "calibration runs fault-free noisy realisations: the scenario has no [noise]",
-                    ));
-                }
-                Threshold::Calibrated {
-                    runs: c.runs as usize,
-                    margin,
-                }
-            }
-            (Some(t), None) => {
-                let t = finite(&at("threshold"), t)?;
-                if t <= 0.0 {
-                    return Err(bad(at("threshold"), format!("{t} must be > 0")));
-                }
-                Threshold::Fixed(t)
-            }
-            (None, Some(a)) => {
-                let a = finite(&at("false_alarm"), a)?;
-                if !(a > 0.0 && a < 0.5) {
-                    return Err(bad(
-                        at("false_alarm"),
-                        format!("{a}: a false-alarm probability per sample is between 0 and 0.5"),
-                    ));
-                }
-                if evaluation != Evaluation::Chi2 {
-                    return Err(bad(
-                        at("false_alarm"),
-                        "a false-alarm probability sets a χ² threshold: it needs evaluation = \"chi2\"",
-                    ));
-                }
-                if noise.is_none() {
-                    return Err(bad(
-                        at("false_alarm"),
-                        "a χ² threshold needs the noise statistics: the scenario has no [noise]",
-                    ));
-                }
-                Threshold::FalseAlarm(a)
-            }
-            (Some(_), Some(_)) => {
+        (None, Some(a)) => {
+            let a = finite(&at("false_alarm"), a)?;
+            if !(a > 0.0 && a < 0.5) {
                 return Err(bad(
                     at("false_alarm"),
-                    "give threshold or false_alarm, not both",
+                    format!("{a}: a false-alarm probability per sample is between 0 and 0.5"),
                 ));
             }
-            (None, None) => {
+            if *evaluation != Evaluation::Chi2 {
                 return Err(bad(
-                    at("threshold"),
-                    "a diagnoser needs threshold = value, false_alarm = probability or calibrate = { runs = N }",
+                    at("false_alarm"),
+                    "a false-alarm probability sets a χ² threshold: it needs evaluation = \"chi2\"",
                 ));
             }
-        };
-        let persistence = d.persistence.unwrap_or(1);
-        if persistence < 1 {
+            if noise.is_none() {
+                return Err(bad(
+                    at("false_alarm"),
+                    "a χ² threshold needs the noise statistics: the scenario has no [noise]",
+                ));
+            }
+            Threshold::FalseAlarm(a)
+        }
+        (Some(_), Some(_)) => {
             return Err(bad(
-                at("persistence"),
-                format!("{persistence} must be a whole number of samples ≥ 1"),
+                at("false_alarm"),
+                "give threshold or false_alarm, not both",
             ));
         }
-        let ignore_before = finite(&at("ignore_before"), d.ignore_before.unwrap_or(0.0))?;
-        if ignore_before < 0.0 {
+        (None, None) => {
             return Err(bad(
-                at("ignore_before"),
-                format!("{ignore_before} must be ≥ 0"),
+                at("threshold"),
+                "a diagnoser needs threshold = value, false_alarm = probability or calibrate = { runs = N }",
             ));
         }
-        out.push(DiagnoserSpec {
-            name: d.name.clone(),
-            scheme,
-            channels,
-            subset,
-            member,
-            structure,
-            evaluation,
-            threshold,
-            persistence: persistence.min(u32::MAX as i64) as u32,
-            ignore_before,
-        });
-    }
-    Ok(out)
+    };
+    Ok(threshold)
 }
