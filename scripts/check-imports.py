@@ -48,7 +48,7 @@ def strip(text):
                 i += 2 if text[i] == "\\" else 1
             i += 1
             out.append('""')
-        elif c == "'" and re.match(r"'(\\.|[^\\'])'", text[i:i + 4]) or re.match(r"'\\u\{[0-9a-fA-F]+\}'", text[i:i + 12]):
+        elif c == "'" and (re.match(r"'(\\.|[^\\'])'", text[i:i + 4]) or re.match(r"'\\u\{[0-9a-fA-F]+\}'", text[i:i + 12])):
             m = re.match(r"'(\\u\{[0-9a-fA-F]+\}|\\.|[^\\'])'", text[i:])
             i += len(m.group(0))
             out.append("' '")
@@ -117,7 +117,7 @@ def use_paths(src):
 
 def expand(tree):
     """`a::{b, c::{d, e}}` → ['a::b', 'a::c::d', 'a::c::e']."""
-    depth, i = 0, 0
+    depth = 0
     brace = tree.find("{")
     if brace < 0:
         return [re.sub(r"\bas\w+$", "", tree.split(" as ")[0])] if tree else []
@@ -166,12 +166,12 @@ def resolve(mods, mod, segs, seen=None):
     if key in seen:
         return cur.file
     seen.add(key)
-    for p, public in use_paths(cur.src):
+    for p, _ in use_paths(cur.src):
         parts = p.split("::")
         if parts[-1] == name or p.endswith(f" as {name}"):
             target = resolve(mods, cur, parts, seen)
             return target or cur.file
-    for p, public in use_paths(cur.src):
+    for p, _ in use_paths(cur.src):
         if p.endswith("::*"):
             target_mod = walk_mod(mods, cur, p.split("::")[:-1])
             if target_mod and defines(target_mod, name):

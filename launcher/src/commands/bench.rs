@@ -9,17 +9,14 @@ use launcher::run::Mode;
 use launcher::{limits, print, println, shipped};
 use lockstep::Wait;
 
-use crate::cli::{BenchArgs, ModeArg, OnOff, Pin};
+use crate::cli::{BenchArgs, OnOff, Pin};
 
 pub fn command(a: BenchArgs) -> Result<ExitCode, LaunchError> {
     limits::bench(a.steps, a.repeat).and_then(|_| limits::states(&a.states))?;
     let wait = a.wait.unwrap_or_else(Wait::default_for_machine);
     let modes: Vec<Mode> = match a.mode {
         Some(m) => vec![Mode::from(m)],
-        None => vec![
-            Mode::from(ModeArg::InProcess),
-            Mode::from(ModeArg::Processes),
-        ],
+        None => vec![Mode::InProcess, Mode::Processes],
     };
     let rec: Vec<bool> = match a.recording {
         Some(r) => vec![r == OnOff::On],
