@@ -64,7 +64,7 @@ use nalgebra::DMatrix;
 use crate::dd::DdMatrix;
 use crate::eig::{C64, eigenvalues, format_list, spectral_radius};
 use crate::error::{LtiError, Result};
-use crate::linalg::product::{self, mul};
+use crate::linalg::product::{self, mul, mul_symmetric};
 use crate::lyapunov;
 use crate::staircase::{controllability_staircase, observability_staircase};
 
@@ -151,10 +151,23 @@ fn solve(a: &Mat, b: &Mat, q: &Mat, r: &Mat, words: Words) -> Result<Dare> {
     let g = y.transpose() * &y;
 
     let first = sda(a, &g, &q);
-    let stabilising = match &first {
-        Some((x, _)) => radius(a, b, &r, x)? < 1.0,
-        None => false,
+    // Above DD_MAX states SDA's X is refined first and the radius taken once, of the refined
+    // X's closed loop, which the refinement has already formed (each n × n eigenvalue
+    // computation and residual is ~0.3 s at n = 1000). A non-stabilising X fails the same test
+    // after its refinement, which cannot make it stabilising (Smith's sum diverges with A_c).
+    let (first, large) = match first {
+        Some((x, steps)) if n > DD_MAX => {
+            let refined = refine_large(a, b, &q, &r, x)?;
+            (Some((refined.x.clone(), steps)), Some(refined))
+        }
+        other => (other, None),
     };
+    let first_radius = match (&first, &large) {
+        (_, Some(refined)) => Some(spectral_radius(&eigenvalues(&refined.ac)?)),
+        (Some((x, _)), None) => Some(radius(a, b, &r, x)?),
+        (None, _) => None,
+    };
+    let stabilising = first_radius.is_some_and(|rho| rho < 1.0);
     let (mut x, mut doubling, mut newton) = match first {
         Some((x, steps)) => (x, steps, 0),
         None => (Mat::zeros(n, n), MAX_DOUBLING, 0),
@@ -190,8 +203,8 @@ fn solve(a: &Mat, b: &Mat, q: &Mat, r: &Mat, words: Words) -> Result<Dare> {
         // (quadratic convergence from ~10⁻¹² … 10⁻⁸ off). In a critical case the Stein operator is
         // singular (A − BK has a mode on the circle): the steps fail, and the radius check below
         // names the cause.
-        if n > DD_MAX {
-            (x, newton) = refine_large(a, b, &q, &r, x);
+        if let Some(refined) = &large {
+            newton = refined.kept;
         } else if let Ok((refined, steps, _)) = newton_steps(a, b, &q, &r, x.clone(), MAX_REFINE)
             && let (Ok((new, _)), Ok((old, _))) =
                 (residual(a, b, &q, &r, &refined), residual(a, b, &q, &r, &x))
@@ -201,7 +214,10 @@ fn solve(a: &Mat, b: &Mat, q: &Mat, r: &Mat, words: Words) -> Result<Dare> {
             newton = steps;
         }
     }
-    let rho = radius(a, b, &r, &x)?;
+    let rho = match (stabilising, &large, first_radius) {
+        (true, Some(_), Some(rho)) => rho,
+        _ => radius(a, b, &r, &x)?,
+    };
     let clearly_inside = rho < 1.0 - NEAR_UNIT;
     if !clearly_inside {
         if let Some(why) = obstruction(a, b, &q, words) {
@@ -212,7 +228,10 @@ fn solve(a: &Mat, b: &Mat, q: &Mat, r: &Mat, words: Words) -> Result<Dare> {
             return Err(no_solution(a, b, &q, Some(rho), words));
         }
     }
-    let (res, k) = residual(a, b, &q, &r, &x)?;
+    let (res, k) = match large {
+        Some(refined) if stabilising => (refined.score, refined.k),
+        _ => residual(a, b, &q, &r, &x)?,
+    };
     let small = res <= RESIDUAL_TOL;
     if !small {
         return Err(LtiError::NoConvergence(
@@ -287,17 +306,10 @@ fn sda(a: &Mat, g: &Mat, h: &Mat) -> Option<(Mat, usize)> {
         // Products and solves through `linalg::product`: nalgebra's own below 96 states (the
         // reference cases' bits), faer's blocked kernels above (the 500 … 1000-state models).
         let w = Mat::identity(n, n) + mul(&gk, &hk);
-        let mut rhs = Mat::zeros(n, 2 * n);
-        rhs.columns_mut(0, n).copy_from(&ak);
-        rhs.columns_mut(n, n).copy_from(&gk);
-        let sol = product::solve(&w, &rhs)?;
-        let (wa, wg) = (
-            sol.columns(0, n).into_owned(),
-            sol.columns(n, n).into_owned(),
-        ); // W⁻¹A_k, W⁻¹G_k
+        let (wa, wg) = product::solve_pair(&w, &ak, &gk)?; // W⁻¹A_k, W⁻¹G_k
         let at = ak.transpose();
-        let h_next = sym(&(&hk + mul(&mul(&at, &hk), &wa)));
-        let g_next = sym(&(&gk + mul(&mul(&ak, &wg), &at)));
+        let h_next = sym(&(&hk + mul_symmetric(&mul(&at, &hk), &wa)));
+        let g_next = sym(&(&gk + mul_symmetric(&mul(&ak, &wg), &at)));
         let a_next = mul(&ak, &wa);
         if !(h_next
             .iter()
@@ -361,21 +373,54 @@ fn newton_steps(
 /// 1.2e-15, and the next five moved X only by its rounding (corrections 1.9e-7 … 1.7e-7 on
 /// ‖X‖₁ = 2.2e5) at 4–5 s each — the stopping rule of [`newton_steps`], made for
 /// double-double residuals, never fired.
-fn refine_large(a: &Mat, b: &Mat, q: &Mat, r: &Mat, mut x: Mat) -> (Mat, usize) {
-    let Ok((mut score, _)) = residual(a, b, q, r, &x) else {
-        return (x, 0);
-    };
-    let mut kept = 0;
-    while kept < MAX_REFINE && score > REFINED {
-        let Ok((next, 1, _)) = newton_steps(a, b, q, r, x.clone(), 1) else {
+fn refine_large(a: &Mat, b: &Mat, q: &Mat, r: &Mat, x: Mat) -> Result<Refined> {
+    let mut cur = Refined::of(a, b, q, r, x, 0)?;
+    while cur.kept < MAX_REFINE && cur.score > REFINED {
+        let Ok(delta) = lyapunov::discrete(&cur.ac, &cur.res) else {
             break;
         };
-        match residual(a, b, q, r, &next) {
-            Ok((s, _)) if s < score => (x, score, kept) = (next, s, kept + 1),
+        if !one_norm(&delta).is_finite() {
+            break;
+        }
+        let next_x = sym(&(&cur.x + delta));
+        match Refined::of(a, b, q, r, next_x, cur.kept + 1) {
+            Ok(next) if next.score < cur.score => cur = next,
             _ => break,
         }
     }
-    (x, kept)
+    Ok(cur)
+}
+
+/// A large model's iterate with what its test and its Newton step both need, each formed once:
+/// K and A_c = A − BK, Res(X) (in double above [`DD_MAX`]) and the relative residual of
+/// [`residual`] (A_cᵀXA_c by its lower triangle from 96 states on).
+struct Refined {
+    x: Mat,
+    k: Mat,
+    ac: Mat,
+    res: Mat,
+    score: f64,
+    kept: usize,
+}
+
+impl Refined {
+    fn of(a: &Mat, b: &Mat, q: &Mat, r: &Mat, x: Mat, kept: usize) -> Result<Self> {
+        let (k, ac) = gain(a, b, r, &x)?;
+        let acxac = mul_symmetric(&mul(&ac.transpose(), &x), &ac);
+        let krk = k.transpose() * r * &k;
+        let res = sym(&(q + &acxac + &krk - &x));
+        let scale = one_norm(q) + one_norm(&acxac) + one_norm(&krk) + one_norm(&x);
+        let norm = one_norm(&res);
+        let score = if scale > 0.0 { norm / scale } else { norm };
+        Ok(Refined {
+            x,
+            k,
+            ac,
+            res,
+            score,
+            kept,
+        })
+    }
 }
 
 /// The relative residual (as [`Dare::residual`]) at which a large model's refinement stops:

@@ -52,14 +52,15 @@
 //!
 //! Above [`DOUBLE_DOUBLE_MAX`] rows the double-double products (≈ 20 flops each, no blocking)
 //! would dominate a large model's set-up — minutes at n = 1000 — so there the same algorithm runs
-//! in double precision on nalgebra's blocked GEMM (`Matrix::exp`, a port of scipy's `expm`):
-//! normwise accurate, ‖ΔΦ‖ ≲ u·‖Φ‖, as scipy and MATLAB are. Both paths are deterministic, so a
+//! in double precision on faer's blocked products ([`expm_double`], scipy's `expm`): normwise
+//! accurate, ‖ΔΦ‖ ≲ u·‖Φ‖, as scipy and MATLAB are. Both paths are deterministic, so a
 //! run's processes still compute bit-identical designs.
 
 use nalgebra::DMatrix;
 
 use crate::dd::{Dd, two_prod};
 use crate::linalg::norm::one_norm;
+use crate::linalg::product::{mul, solve};
 
 /// Unit roundoff of IEEE double precision, the u of the paper's θ_m.
 const U: f64 = 1.1102230246251565e-16;
@@ -87,7 +88,7 @@ pub fn expm(m: &DMatrix<f64>, h: f64) -> DMatrix<f64> {
         return DMatrix::from_element(n, n, f64::NAN);
     }
     if n > DOUBLE_DOUBLE_MAX {
-        return (m * h).exp();
+        return expm_double(&(m * h));
     }
     // X = M h exactly, row-major.
     let x = DdMat {
@@ -106,16 +107,94 @@ pub fn expm(m: &DMatrix<f64>, h: f64) -> DMatrix<f64> {
     DMatrix::from_fn(n, n, |i, j| r.v[i * n + j].to_f64())
 }
 
+/// e^X in double precision above [`DOUBLE_DOUBLE_MAX`] rows: the same (m, s) and the same
+/// Padé scheme, on faer's blocked products and LU ([`crate::linalg::product`]), the powers X²,
+/// X⁴, X⁶ of the degree choice reused (scaled by 4^{−s}, 16^{−s}, 64^{−s}, exact powers of two)
+/// for r_m(2^{−s}X). This is scipy's `expm` (the same algorithm, exact norms here where scipy
+/// estimates them): normwise accurate, ‖ΔΦ‖ ≲ u·‖Φ‖ (on the 1100-row ZOH block of the 1000-state
+/// model of BENCHMARKS.md, 3× faster than nalgebra's `Matrix::exp`, which it replaced).
+fn expm_double(x: &DMatrix<f64>) -> DMatrix<f64> {
+    let n = x.nrows();
+    let powers = Powers::of(x, mul);
+    let (deg, s) = degree_and_scaling_from(x, &powers);
+    let c = 2f64.powi(-(s as i32));
+    let b: Vec<f64> = pade_coefficients(deg).iter().map(|d| d.hi).collect();
+    let id = DMatrix::<f64>::identity(n, n);
+    let y = x * c;
+    let y2 = &powers.p2 * (c * c);
+    let (u, v) = if deg == 13 {
+        let y4 = &powers.p4 * c.powi(4);
+        let y6 = &powers.p6 * c.powi(6);
+        let inner_u = mul(&y6, &(&y6 * b[13] + &y4 * b[11] + &y2 * b[9]))
+            + &y6 * b[7]
+            + &y4 * b[5]
+            + &y2 * b[3]
+            + &id * b[1];
+        let v = mul(&y6, &(&y6 * b[12] + &y4 * b[10] + &y2 * b[8]))
+            + &y6 * b[6]
+            + &y4 * b[4]
+            + &y2 * b[2]
+            + &id * b[0];
+        (mul(&y, &inner_u), v)
+    } else {
+        // m < 13 comes with s = 0 (Algorithm 5.1): Y = X, and its even powers are formed.
+        let even = [&id, &powers.p2, &powers.p4, &powers.p6, &powers.p8];
+        let mut odd = DMatrix::zeros(n, n);
+        let mut v = DMatrix::zeros(n, n);
+        for (j, p) in even.iter().enumerate().take(deg / 2 + 1) {
+            odd += *p * b[2 * j + 1];
+            v += *p * b[2 * j];
+        }
+        (mul(&y, &odd), v)
+    };
+    let Some(mut r) = solve(&(&v - &u), &(&v + &u)) else {
+        return DMatrix::from_element(n, n, f64::NAN);
+    };
+    for _ in 0..s {
+        r = mul(&r, &r);
+    }
+    r
+}
+
+/// X², X⁴, X⁶, X⁸, X¹⁰: the powers the degree choice measures.
+struct Powers {
+    p2: DMatrix<f64>,
+    p4: DMatrix<f64>,
+    p6: DMatrix<f64>,
+    p8: DMatrix<f64>,
+    p10: DMatrix<f64>,
+}
+
+impl Powers {
+    /// The powers by `mul`: nalgebra's product on the double-double path (its bits decide
+    /// (m, s) there, as they always have), faer's above it.
+    fn of(a: &DMatrix<f64>, mul: impl Fn(&DMatrix<f64>, &DMatrix<f64>) -> DMatrix<f64>) -> Self {
+        let p2 = mul(a, a);
+        let p4 = mul(&p2, &p2);
+        let p6 = mul(&p4, &p2);
+        let p8 = mul(&p4, &p4);
+        let p10 = mul(&p8, &p2);
+        Powers {
+            p2,
+            p4,
+            p6,
+            p8,
+            p10,
+        }
+    }
+}
+
 /// (m, s) of Al-Mohy & Higham (2009), Algorithm 5.1, steps 1–16, with exact norms.
 fn degree_and_scaling(a: &DMatrix<f64>) -> (usize, usize) {
+    degree_and_scaling_from(a, &Powers::of(a, |x, y| x * y))
+}
+
+/// [`degree_and_scaling`] from the powers already formed.
+fn degree_and_scaling_from(a: &DMatrix<f64>, p: &Powers) -> (usize, usize) {
     let norm = |p: &DMatrix<f64>| one_norm(p);
-    let a2 = a * a;
-    let a4 = &a2 * &a2;
-    let a6 = &a4 * &a2;
-    let a8 = &a4 * &a4;
-    let a10 = &a8 * &a2;
+    let (a4, a6, a8, a10) = (&p.p4, &p.p6, &p.p8, &p.p10);
     let d = |p: &DMatrix<f64>, k: i32| norm(p).powf(1.0 / k as f64);
-    let (d4, d6, d8, d10) = (d(&a4, 4), d(&a6, 6), d(&a8, 8), d(&a10, 10));
+    let (d4, d6, d8, d10) = (d(a4, 4), d(a6, 6), d(a8, 8), d(a10, 10));
     let eta1 = d4.max(d6);
     let eta3 = d6.max(d8);
     for &(m, theta) in &THETA[..4] {
@@ -401,6 +480,46 @@ mod tests {
         assert!((e[(1, 1)] / (-60.0f64).exp() - 1.0).abs() <= f64::EPSILON);
         assert!(expm(&DMatrix::from_element(2, 2, f64::NAN), 1.0)[(0, 0)].is_nan());
         assert_eq!(expm(&DMatrix::zeros(0, 0), 1.0).nrows(), 0);
+    }
+
+    #[test]
+    fn large_rotations_with_squarings_match_their_closed_form() {
+        // 60 damped rotations [[−a, ω], [−ω, −a]] (120 rows: the double path), ‖X‖ up to ~90 so
+        // that m = 13 and several squarings run; e^{Xt} = e^{−at}[[cos ωt, sin ωt], [−sin ωt, cos ωt]].
+        let k = 60;
+        let n = 2 * k;
+        let mut m = DMatrix::zeros(n, n);
+        let pars: Vec<(f64, f64)> = (0..k)
+            .map(|i| (0.1 + 0.7 * i as f64, 1.0 + 1.3 * i as f64))
+            .collect();
+        for (i, &(a, w)) in pars.iter().enumerate() {
+            let j = 2 * i;
+            m[(j, j)] = -a;
+            m[(j + 1, j + 1)] = -a;
+            m[(j, j + 1)] = w;
+            m[(j + 1, j)] = -w;
+        }
+        let t = 0.7;
+        let e = expm(&m, t);
+        for (i, &(a, w)) in pars.iter().enumerate() {
+            let j = 2 * i;
+            let (d, c, s) = ((-a * t).exp(), (w * t).cos(), (w * t).sin());
+            for (r, cc, want) in [(0, 0, d * c), (0, 1, d * s), (1, 0, -d * s), (1, 1, d * c)] {
+                let got = e[(j + r, j + cc)];
+                assert!(
+                    (got - want).abs() <= 1e-13,
+                    "block {i} ({r},{cc}): {got} vs {want}"
+                );
+            }
+        }
+        // Nothing leaks between blocks (the products of a block-diagonal matrix stay block-diagonal).
+        for i in 0..n {
+            for j in 0..n {
+                if i / 2 != j / 2 {
+                    assert_eq!(e[(i, j)], 0.0);
+                }
+            }
+        }
     }
 
     #[test]

@@ -62,7 +62,7 @@ fn solve(k: DMatrix<f64>, q: &DMatrix<f64>, n: usize) -> Result<DMatrix<f64>> {
 /// Smith's doubling for AᵀPA − P = −Q (A Schur-stable): stops when a step changes P by less than
 /// its rounding; refuses when the sum does not settle (ρ(A) ≥ 1, so there is no such P ⪰ 0).
 fn smith(a: &DMatrix<f64>, q: &DMatrix<f64>) -> Result<DMatrix<f64>> {
-    use crate::linalg::product::mul;
+    use crate::linalg::product::{mul, mul_symmetric};
     let n = a.nrows();
     if q.shape() != (n, n) {
         return Err(LtiError::Dimension(format!(
@@ -80,7 +80,7 @@ fn smith(a: &DMatrix<f64>, q: &DMatrix<f64>) -> Result<DMatrix<f64>> {
     for _ in 0..64 {
         // faer's blocked products from 96 rows on (the Newton steps of a 1000-state DARE spent
         // most of their time here in nalgebra's), nalgebra's below: the same bits as before there.
-        let step = mul(&mul(&ak.transpose(), &p), &ak);
+        let step = mul_symmetric(&mul(&ak.transpose(), &p), &ak);
         let (change, size) = (norm(&step), norm(&p));
         p += step;
         if !(change.is_finite() && p.iter().all(|v| v.is_finite())) {

@@ -63,8 +63,24 @@ impl Model {
 
     /// Exact sampling with period dt.
     pub fn discretize(&self, dt: f64) -> Discrete {
-        let (a, b) = zoh(&self.a, &self.b, dt);
-        let (_, e) = zoh(&self.a, &self.e, dt);
+        let (a, b, e) = if self.n() > crate::expm::DOUBLE_DOUBLE_MAX {
+            // Both already take the double-precision exponential: one of [[A, B E], [0, 0]]
+            // gives Φ, Γ and Γ_E at once (half of a 1000-state model's sampling time).
+            let (l, q) = (self.b.ncols(), self.e.ncols());
+            let mut be = DMatrix::zeros(self.n(), l + q);
+            be.columns_mut(0, l).copy_from(&self.b);
+            be.columns_mut(l, q).copy_from(&self.e);
+            let (a, gamma) = zoh(&self.a, &be, dt);
+            (
+                a,
+                gamma.columns(0, l).into_owned(),
+                gamma.columns(l, q).into_owned(),
+            )
+        } else {
+            let (a, b) = zoh(&self.a, &self.b, dt);
+            let (_, e) = zoh(&self.a, &self.e, dt);
+            (a, b, e)
+        };
         Discrete {
             a,
             b,
@@ -103,5 +119,35 @@ impl From<&DMatrix<f64>> for MatData {
 impl From<&MatData> for DMatrix<f64> {
     fn from(m: &MatData) -> Self {
         DMatrix::from_row_slice(m.rows, m.cols, &m.data)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_large_model_samples_its_inputs_as_separate_holds_would() {
+        // 110 states: Φ, Γ and Γ_E from one exponential of [[A, B E], [0, 0]] agree with a
+        // ZOH of B and of E each (the same double-precision path) to rounding.
+        let n = 110;
+        let a = DMatrix::from_fn(n, n, |i, j| {
+            ((i * 7 + j * 13) as f64 * 0.17).sin() / 10.0 - if i == j { 2.0 } else { 0.0 }
+        });
+        let b = DMatrix::from_fn(n, 3, |i, j| ((i + 5 * j) as f64 * 0.3).cos());
+        let e = DMatrix::from_fn(n, 2, |i, j| ((2 * i + j) as f64 * 0.7).sin());
+        let m = Model {
+            a: a.clone(),
+            b: b.clone(),
+            c: DMatrix::identity(4, n),
+            e: e.clone(),
+            d: DMatrix::zeros(4, 0),
+        };
+        let d = m.discretize(0.05);
+        let (phi, gamma) = zoh(&a, &b, 0.05);
+        let (_, gamma_e) = zoh(&a, &e, 0.05);
+        assert!((&d.a - &phi).amax() <= 1e-14 * phi.amax());
+        assert!((&d.b - &gamma).amax() <= 1e-14 * gamma.amax());
+        assert!((&d.e - &gamma_e).amax() <= 1e-14 * gamma_e.amax());
     }
 }

@@ -32,15 +32,62 @@ fn render(r: &DesignReport) -> String {
     text
 }
 
+/// Matrices with more entries than this are shown in part (numpy's print summarisation, with
+/// its 3 edge items; numpy's threshold is 1000 entries, ours keeps every matrix up to 100 × 100 —
+/// all the shipped scenarios' — whole). A 1000-state design printed whole was 46 MB of text and
+/// a tenth of its time; `--json` carries every entry.
+pub const WHOLE_UP_TO: usize = 10_000;
+
+/// The first and last rows and columns a summarised matrix shows.
+const EDGE: usize = 3;
+
+/// A matrix as text under its paper's name: every entry up to [`WHOLE_UP_TO`] entries, else
+/// the first and last [`EDGE`] rows and columns with "…" between.
 pub fn matrix(name: &str, m: &Mat) -> String {
-    let mut s = format!("    {name} =\n");
-    for i in 0..m.nrows() {
-        let row: Vec<String> = m
-            .row(i)
-            .iter()
-            .map(|&v| format!("{:>14}", sig(v)))
-            .collect();
-        s += &format!("      [{} ]\n", row.join(""));
+    let (rows, cols) = m.shape();
+    let whole = rows * cols <= WHOLE_UP_TO;
+    let shown = |len: usize| -> Vec<Option<usize>> {
+        if whole || len <= 2 * EDGE {
+            (0..len).map(Some).collect()
+        } else {
+            (0..EDGE)
+                .map(Some)
+                .chain(std::iter::once(None))
+                .chain((len - EDGE..len).map(Some))
+                .collect()
+        }
+    };
+    let (row_ix, col_ix) = (shown(rows), shown(cols));
+    // One buffer for the whole matrix (a String per entry and per row was a third of a large
+    // report's time).
+    let mut s = String::with_capacity(64 + row_ix.len() * (10 + 14 * col_ix.len()));
+    s.push_str("    ");
+    s.push_str(name);
+    if whole {
+        s.push_str(" =\n");
+    } else {
+        s.push_str(&format!(
+            " = ({rows}×{cols}: its first and last {EDGE} rows and columns; every entry in `launcher design --json`)\n"
+        ));
+    }
+    for i in &row_ix {
+        let Some(i) = *i else {
+            s.push_str("      …\n");
+            continue;
+        };
+        s.push_str("      [");
+        for j in &col_ix {
+            let entry = match *j {
+                Some(j) => sig(m[(i, j)]), // ASCII: its length is its width
+                None => "…".to_string(),
+            };
+            s.extend(std::iter::repeat_n(
+                ' ',
+                14usize.saturating_sub(entry.chars().count()),
+            ));
+            s.push_str(&entry);
+        }
+        s.push_str(" ]\n");
     }
     s
 }
@@ -255,4 +302,51 @@ fn banks(banks: &Result<Vec<diagnosis::Bank>, String>) -> String {
         }
     }
     text
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_matrix_up_to_ten_thousand_entries_is_printed_whole_and_a_larger_one_by_its_corners() {
+        let m = |r: usize, c: usize| Mat::from_fn(r, c, |i, j| (i * 1000 + j) as f64 + 0.25);
+        let small = matrix("K", &m(2, 2));
+        let padded = |v: f64| format!("{:>14}", sig(v));
+        assert_eq!(
+            small,
+            format!(
+                "    K =\n      [{}{} ]\n      [{}{} ]\n",
+                padded(0.25),
+                padded(1.25),
+                padded(1000.25),
+                padded(1001.25)
+            )
+        );
+        let whole = matrix("F", &m(100, 100));
+        assert_eq!(whole.lines().count(), 101);
+        assert!(!whole.contains('…'));
+
+        let big = matrix("F", &m(150, 120));
+        let lines: Vec<&str> = big.lines().collect();
+        assert_eq!(lines.len(), 1 + 3 + 1 + 3, "{big}");
+        assert!(lines[0].contains("150×120") && lines[0].contains("--json"));
+        assert_eq!(lines[4].trim(), "…");
+        let first: Vec<&str> = lines[1]
+            .trim_matches(|c| c == ' ' || c == '[' || c == ']')
+            .split_whitespace()
+            .collect();
+        let want: Vec<String> = [0.25, 1.25, 2.25]
+            .iter()
+            .map(|v| sig(*v))
+            .chain(std::iter::once("…".to_string()))
+            .chain([117.25, 118.25, 119.25].iter().map(|v| sig(*v)))
+            .collect();
+        assert_eq!(first, want);
+        let last: Vec<&str> = lines[7]
+            .trim_matches(|c| c == ' ' || c == '[' || c == ']')
+            .split_whitespace()
+            .collect();
+        assert_eq!(last.last().copied(), Some(sig(149_119.25).as_str()));
+    }
 }

@@ -26,7 +26,7 @@ pub mod product;
 pub mod qr;
 pub mod svd;
 
-use faer::{Mat as FMat, MatRef};
+use faer::{MatMut, MatRef};
 use nalgebra::DMatrix;
 
 /// A borrowed faer view of a column-major nalgebra matrix (no copy).
@@ -34,12 +34,22 @@ pub(crate) fn view(a: &DMatrix<f64>) -> MatRef<'_, f64> {
     MatRef::from_column_major_slice(a.as_slice(), a.nrows(), a.ncols())
 }
 
-/// A faer matrix (or view) copied into nalgebra's type.
-pub(crate) fn to_nalgebra(a: MatRef<'_, f64>) -> DMatrix<f64> {
-    DMatrix::from_fn(a.nrows(), a.ncols(), |i, j| a[(i, j)])
+/// A mutable faer view of a column-major nalgebra matrix (no copy).
+pub(crate) fn view_mut(a: &mut DMatrix<f64>) -> MatMut<'_, f64> {
+    let (m, n) = a.shape();
+    MatMut::from_column_major_slice_mut(a.as_mut_slice(), m, n)
 }
 
-/// An owned faer matrix moved into nalgebra's type.
-pub(crate) fn from_faer(a: &FMat<f64>) -> DMatrix<f64> {
-    to_nalgebra(a.as_ref())
+/// A faer matrix (or view) copied into nalgebra's type.
+pub(crate) fn to_nalgebra(a: MatRef<'_, f64>) -> DMatrix<f64> {
+    let (m, n) = (a.nrows(), a.ncols());
+    let mut data = Vec::with_capacity(m * n);
+    for j in 0..n {
+        match a.col(j).try_as_col_major() {
+            // A contiguous column (faer's own matrices): copied as one slice.
+            Some(col) => data.extend_from_slice(col.as_slice()),
+            None => data.extend((0..m).map(|i| a[(i, j)])),
+        }
+    }
+    DMatrix::from_vec(m, n, data)
 }
