@@ -228,7 +228,7 @@ def test_an_output_that_cannot_be_written(flag, name, exported, tmp_path):
 
 
 def test_a_damaged_recording_writes_nothing(exported, tmp_path):
-    """One bit of a sim_time stamp flipped (as tests/tests/damaged.rs does): exit 6, no file."""
+    """One bit of a sim_time stamp flipped (as tests/tests/features/recording_tools/damaged.rs does): exit 6, no file."""
     data = bytearray(exported["rrd"].read_bytes())
     t = round(exported["groups"]["plant_x"]["times"][1234] * 1e9)
     at = data.find(struct.pack("<q", t))

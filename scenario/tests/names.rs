@@ -5,16 +5,16 @@ use std::path::Path;
 
 use scenario::{Named, Scenario};
 
-const BASE: &str = r#"name = "names"
+const BASE: &str = concat!(
+    r#"name = "names"
 dt = 0.01
 duration = 1.0
 
 [plant]
-A = [[0.0, 1.0, 0.0], [-2.0, -3.0, 0.0], [0.0, 0.0, -2.0]]
-B = [[0.0, 0.0], [4.0, 0.0], [0.0, 1.0]]
-C = [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
-E = [[2.0], [0.0], [0.5]]
-D = [[1.0], [0.0]]
+"#,
+    // The seed-002 plant (scenarios/seed002-*.toml), shared by the tests that need a small UIO plant.
+    include_str!("../../fixtures/seed002_plant.toml"),
+    r#"D = [[1.0], [0.0]]
 x0 = [1.0, -1.0, 2.0]
 
 [[disturbance]]
@@ -32,7 +32,8 @@ value = 0.0
 [[input]]
 kind = "constant"
 value = 0.0
-"#;
+"#
+);
 
 fn with(lines: &str) -> Result<Scenario, String> {
     let text = BASE.replace(
@@ -137,5 +138,18 @@ fn a_wrong_length_or_an_empty_name_is_one_line_naming_file_and_field() {
             "{line}: {e}"
         );
         assert_eq!(e.lines().count(), 1, "{e}");
+    }
+}
+
+#[test]
+fn the_shared_plant_fixture_is_the_shipped_seed002_plant() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let fixture = std::fs::read_to_string(root.join("fixtures/seed002_plant.toml")).unwrap();
+    for shipped in ["seed002-sine.toml", "seed002-piecewise.toml"] {
+        let text = std::fs::read_to_string(root.join("scenarios").join(shipped)).unwrap();
+        assert!(
+            text.contains(&fixture),
+            "{shipped} no longer holds fixtures/seed002_plant.toml"
+        );
     }
 }

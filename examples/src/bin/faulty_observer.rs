@@ -1,5 +1,5 @@
 //! An observer that breaks the protocol on purpose, for the launcher's supervision tests
-//! (`tests/tests/external.rs`). It speaks the protocol by hand — bus, ports, handshake — so that
+//! (`tests/tests/features/supervision/external.rs`). It speaks the protocol by hand — bus, ports, handshake — so that
 //! it can get it wrong; the kit would not let it.
 //!
 //! `params.fault`, from step `params.at` (default 100) on: `nan` (a value is NaN), `wrong_step`

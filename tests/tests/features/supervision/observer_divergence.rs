@@ -5,17 +5,17 @@
 
 use tests::*;
 
-const PLANT: &str = r#"
+const PLANT: &str = concat!(
+    r#"
 name = "observer-divergence"
 dt = 0.001
 duration = 1.0
 
 [plant]
-A = [[0.0, 1.0, 0.0], [-2.0, -3.0, 0.0], [0.0, 0.0, -2.0]]
-B = [[0.0, 0.0], [4.0, 0.0], [0.0, 1.0]]
-C = [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
-E = [[2.0], [0.0], [0.5]]
-x0 = [1.0, -1.0, 2.0]
+"#,
+    // The seed-002 plant (scenarios/seed002-*.toml), shared by the tests that need a small UIO plant.
+    include_str!("../../../../fixtures/seed002_plant.toml"),
+    r#"x0 = [1.0, -1.0, 2.0]
 state_bound = 10.0
 
 [[disturbance]]
@@ -40,7 +40,8 @@ name = "far-off"
 kind = "luenberger"
 poles = [-1.0, -2.0, -3.0]
 xhat0 = [1.0, 49.0, 2.0]
-"#;
+"#
+);
 
 #[test]
 fn an_observer_whose_error_leaves_the_state_bound_stops_the_run_with_exit_4_naming_it() {

@@ -4,7 +4,7 @@
 use lti::Model;
 use tests::*;
 
-#[path = "../../fixtures/zero_plants.rs"]
+#[path = "../../../../fixtures/zero_plants.rs"]
 mod zero_plants;
 
 fn toml_matrix(m: &lti::Mat) -> String {

@@ -5,16 +5,16 @@ use std::ffi::OsStr;
 
 use tests::*;
 
-const BASE: &str = r#"name = "bad"
+const BASE: &str = concat!(
+    r#"name = "bad"
 dt = 0.001
 duration = 1.0
 
 [plant]
-A = [[0.0, 1.0, 0.0], [-2.0, -3.0, 0.0], [0.0, 0.0, -2.0]]
-B = [[0.0, 0.0], [4.0, 0.0], [0.0, 1.0]]
-C = [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
-E = [[2.0], [0.0], [0.5]]
-x0 = [1.0, -1.0, 2.0]
+"#,
+    // The seed-002 plant (scenarios/seed002-*.toml), shared by the tests that need a small UIO plant.
+    include_str!("../../../../fixtures/seed002_plant.toml"),
+    r#"x0 = [1.0, -1.0, 2.0]
 
 [[disturbance]]
 kind = "sine"
@@ -43,7 +43,8 @@ poles = [-1.0, -2.0, -3.0]
 kind = "state-feedback"
 observer = "uio"
 poles = [-4.0, -5.0, -6.0]
-"#;
+"#
+);
 
 /// (case, edit of BASE, text the message must contain besides the file name).
 fn cases() -> Vec<(&'static str, String, &'static str)> {

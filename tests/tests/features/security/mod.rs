@@ -1,0 +1,3 @@
+//! Run directories no other user can turn against their owner.
+
+mod run_dirs;
