@@ -17,7 +17,7 @@
 //! * Per residual, the fraction of fault-free steps whose evaluation exceeds its threshold: for a
 //!   χ² threshold, the measured false-alarm probability against the one asked for.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::decide::{Isolation, Monitor};
 use crate::spec::Channels;
@@ -38,7 +38,7 @@ pub struct FaultInfo {
 }
 
 /// One fault's figures.
-#[derive(Debug, Clone, Serialize, PartialEq)]
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct FaultFigure {
     /// Name.
     pub name: String,
@@ -71,7 +71,7 @@ pub struct FaultFigure {
 }
 
 /// One residual's behaviour without faults.
-#[derive(Debug, Clone, Serialize, PartialEq)]
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct ResidualFigure {
     /// `<diagnoser>-<i>`.
     pub residual: String,
@@ -90,7 +90,7 @@ pub struct ResidualFigure {
 }
 
 /// The `diagnosis` of summary.json.
-#[derive(Debug, Clone, Serialize, PartialEq)]
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct Diagnosis {
     /// Alarm episodes while no fault acted.
     pub false_alarms: u64,

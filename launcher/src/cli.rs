@@ -182,9 +182,13 @@ pub struct ReplayArgs {
 
 // The arguments of `launcher sweep`.
 #[derive(Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
 pub struct SweepArgs {
+    #[command(subcommand)]
+    pub merge: Option<SweepCommand>,
     /// The scenario file, or the name of a shipped scenario (see `list`).
-    pub scenario: PathBuf,
+    #[arg(required = true)]
+    pub scenario: Option<PathBuf>,
     /// Realisations.
     #[arg(long, default_value_t = 100)]
     pub runs: usize,
@@ -203,6 +207,30 @@ pub struct SweepArgs {
     /// Run the K worst realisations again with a recording (DIR/<name>-seed<S>.rrd).
     #[arg(long, value_name = "K", default_value_t = 0)]
     pub keep_worst: usize,
+    /// Run only shard K of N (K = 1 … N) of the --runs realisations, the ⌊(K−1)·runs/N⌋-th to
+    /// the ⌊K·runs/N⌋-th, and write DIR/<name>.shard-K-of-N.json for `launcher sweep merge`
+    /// (a Slurm array: --shard $((SLURM_ARRAY_TASK_ID+1))/$SLURM_ARRAY_TASK_COUNT).
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<launcher::sweep::Shard>,
+}
+
+// `launcher sweep merge`.
+#[derive(Subcommand)]
+pub enum SweepCommand {
+    /// Merge the N shard files of one sweep into DIR/<name>.sweep.json, equal to the unsharded
+    /// sweep's (statistics, worst realisations and their recordings; not the wall time).
+    Merge(MergeArgs),
+}
+
+// The arguments of `launcher sweep merge`.
+#[derive(Args)]
+pub struct MergeArgs {
+    /// The shard files (<name>.shard-K-of-N.json), all N of them, in any order.
+    #[arg(required = true)]
+    pub shards: Vec<PathBuf>,
+    /// Output directory (the kept recordings are copied here from their shards' folders).
+    #[arg(long, default_value = "runs")]
+    pub out: PathBuf,
 }
 
 // The arguments of `launcher design`.

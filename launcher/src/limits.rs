@@ -7,6 +7,8 @@ use crate::error::LaunchError;
 /// Most realisations of a sweep: the summary of each is kept until the statistics are
 /// gathered (a few KiB each).
 pub const MAX_SWEEP_RUNS: usize = 100_000;
+/// Most realisations of a sharded sweep (`--shard K/N`), each shard at most [`MAX_SWEEP_RUNS`].
+pub const MAX_SHARDED_RUNS: usize = 100_000_000;
 /// Most worker threads of a sweep: each holds one realisation in memory.
 pub const MAX_JOBS: usize = 1024;
 /// `--speed` of a paced run: from a thousandth to a million times real time. Slower would
@@ -38,6 +40,31 @@ pub fn sweep_runs(runs: usize) -> Result<(), LaunchError> {
             runs,
             format!(
                 "at most {MAX_SWEEP_RUNS} realisations (each one's summary is kept until the statistics are gathered)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// `--runs` of a sharded sweep: the whole up to [`MAX_SHARDED_RUNS`], this process's share of it
+/// (`count`) up to [`MAX_SWEEP_RUNS`].
+pub fn sharded_runs(runs: usize, count: usize) -> Result<(), LaunchError> {
+    if runs == 0 {
+        return Err(bad("--runs", runs, "must be at least 1"));
+    }
+    if runs > MAX_SHARDED_RUNS {
+        return Err(bad(
+            "--runs",
+            runs,
+            format!("at most {MAX_SHARDED_RUNS} realisations in a sharded sweep"),
+        ));
+    }
+    if count > MAX_SWEEP_RUNS {
+        return Err(bad(
+            "--shard",
+            count,
+            format!(
+                "a shard runs at most {MAX_SWEEP_RUNS} realisations (each one's row is kept until its file is written): use more shards"
             ),
         ));
     }

@@ -1,23 +1,37 @@
-//! `launcher sweep`: N noise realisations (seeds S, S+1, …), DIR/<name>.sweep.json.
+//! `launcher sweep`: N noise realisations (seeds S, S+1, …), DIR/<name>.sweep.json; with
+//! `--shard K/N` one shard of them (DIR/<name>.shard-K-of-N.json), and `sweep merge` the shards
+//! into the sweep they make.
 
+use std::path::Path;
 use std::process::ExitCode;
 
 use launcher::error::LaunchError;
 use launcher::run::{Mode, interrupt};
+use launcher::sweep::{SweepSummary, shard};
 use launcher::{limits, print, println};
 use lockstep::Wait;
 
-use crate::cli::SweepArgs;
+use crate::cli::{MergeArgs, SweepArgs, SweepCommand};
 
 pub fn command(a: SweepArgs) -> Result<ExitCode, LaunchError> {
+    if let Some(SweepCommand::Merge(m)) = a.merge {
+        return merge(m);
+    }
+    let scenario = a
+        .scenario
+        .expect("clap requires a scenario without a subcommand");
     let jobs = a.jobs.unwrap_or_else(|| {
         std::thread::available_parallelism()
             .map_or(1, |n| n.get())
             .min(limits::MAX_JOBS)
     });
-    limits::sweep_runs(a.runs).and_then(|_| limits::jobs(jobs))?;
-    // One calibration for every realisation, from the first seed.
-    let (s, p) = super::prepared(&a.scenario, a.seed)?;
+    match a.shard {
+        None => limits::sweep_runs(a.runs),
+        Some(sh) => limits::sharded_runs(a.runs, sh.range(a.runs).len()),
+    }
+    .and_then(|_| limits::jobs(jobs))?;
+    // One calibration for every realisation, from the first seed (every shard's the same).
+    let (s, p) = super::prepared(&scenario, a.seed)?;
     let opts = launcher::sweep::SweepOptions {
         runs: a.runs,
         jobs,
@@ -26,14 +40,43 @@ pub fn command(a: SweepArgs) -> Result<ExitCode, LaunchError> {
         out: a.out.clone(),
         keep_worst: a.keep_worst,
         wait: Wait::default_for_machine(),
+        shard: a.shard,
     };
     interrupt::install();
+    if let Some(sh) = a.shard {
+        let (file, path) = shard::run_shard(&s, &p, &opts, sh)?;
+        print!("{}", file.text());
+        println!("shard file: {}", path.display());
+        return match file.verdict() {
+            None => Ok(ExitCode::SUCCESS),
+            Some(e) => Err(e),
+        };
+    }
     let sw = launcher::sweep::sweep(&s, &p, &opts)?;
+    finish(&sw, &a.out)
+}
+
+/// The table, the summary file and the exit of a sweep, whole or merged.
+fn finish(sw: &SweepSummary, out: &Path) -> Result<ExitCode, LaunchError> {
     print!("{}", sw.table());
-    let path = sw.write(&a.out).map_err(LaunchError::Component)?;
+    let path = sw.write(out).map_err(LaunchError::Component)?;
     println!("sweep summary: {}", path.display());
     match sw.verdict() {
         None => Ok(ExitCode::SUCCESS),
         Some(e) => Err(e),
     }
+}
+
+fn merge(m: MergeArgs) -> Result<ExitCode, LaunchError> {
+    let (sw, sources) = shard::merge(&m.shards)?;
+    std::fs::create_dir_all(&m.out).map_err(|e| {
+        LaunchError::BadInput(format!(
+            "{}: cannot create the output directory: {e}",
+            m.out.display()
+        ))
+    })?;
+    for (seed, dir) in &sources {
+        shard::copy_kept(&sw.scenario, *seed, dir, &m.out)?;
+    }
+    finish(&sw, &m.out)
 }

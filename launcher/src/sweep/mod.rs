@@ -10,6 +10,8 @@
 //! of the realisations it finished, marked partial ([`outcome`]).
 
 mod outcome;
+mod row;
+pub mod shard;
 mod stats;
 
 use std::path::{Path, PathBuf};
@@ -17,9 +19,11 @@ use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 pub use outcome::Failed;
+pub use row::Row;
+pub use shard::Shard;
 pub use stats::{Spread, spread};
 
 use crate::error::LaunchError;
@@ -45,6 +49,43 @@ pub struct SweepOptions {
     pub keep_worst: usize,
     /// Wait strategy (processes mode).
     pub wait: lockstep::Wait,
+    /// Only this shard's realisations (`--shard K/N`).
+    pub shard: Option<Shard>,
+}
+
+/// What a sweep's statistics are gathered against: the scenario's names, and the sweep asked
+/// for. A shard file carries it, and `launcher sweep merge` gathers with it alone.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct Frame {
+    /// Scenario name.
+    pub scenario: String,
+    /// Its faults' names, in the scenario's order.
+    pub faults: Vec<String>,
+    /// Its observers' names, in the scenario's order.
+    pub observers: Vec<String>,
+    /// The share of a fault's active time it must be isolated correctly for to count.
+    pub isolated_fraction: f64,
+    /// Realisations asked for (`--runs`, of the whole sweep).
+    pub requested: usize,
+    /// The first seed.
+    pub seed: u64,
+    /// "in-process" or "processes".
+    pub mode: String,
+}
+
+impl Frame {
+    /// The frame of sweeping `s` with `opts`.
+    pub fn of(s: &Scenario, opts: &SweepOptions) -> Frame {
+        Frame {
+            scenario: s.name.clone(),
+            faults: s.faults.iter().map(|f| f.name.clone()).collect(),
+            observers: s.observers.iter().map(|o| o.name.clone()).collect(),
+            isolated_fraction: s.isolated_fraction,
+            requested: opts.runs,
+            seed: opts.seed,
+            mode: opts.mode.name().into(),
+        }
+    }
 }
 
 /// One fault over the sweep.
@@ -154,29 +195,36 @@ fn one(s: &Scenario, plan: &Plan, seed: u64, opts: &SweepOptions, record: bool) 
     Ok((outcome.summary, outcome.stop))
 }
 
-/// How bad a realisation went: wrong isolations, then false alarms, then the longest delay.
-fn badness(s: &Summary) -> (usize, u64, u64) {
-    let Some(d) = &s.diagnosis else {
-        return (0, 0, 0);
-    };
-    let wrong = d.faults.iter().filter(|f| !f.correct).count();
-    let delay = d
-        .faults
-        .iter()
-        .map(|f| f.delay.map_or(u64::MAX, |x| (x * 1e9) as u64))
-        .max()
-        .unwrap_or(0);
-    (wrong, d.false_alarms, delay)
+/// The realisations of a sweep (or of its shard) that ended, in seed order.
+pub struct Realised {
+    /// The completed ones.
+    pub rows: Vec<Row>,
+    /// The ones that did not complete.
+    pub failed: Vec<Failed>,
+    /// How many ended, completed or failed.
+    pub finished: usize,
+    /// The signal that interrupted the sweep.
+    pub interrupted: Option<&'static str>,
+    /// Wall-clock time, s.
+    pub wall_s: f64,
+    /// Worker threads used.
+    pub jobs: usize,
 }
 
-/// Runs the sweep.
-pub fn sweep(s: &Scenario, plan: &Plan, opts: &SweepOptions) -> Result<SweepSummary, LaunchError> {
-    crate::limits::sweep_runs(opts.runs)?;
+/// Runs the realisations of `opts.shard` (all of them without one): realisation i has seed
+/// S + i. Realisations are independent and gathered in seed order, whatever the jobs.
+pub fn realise(s: &Scenario, plan: &Plan, opts: &SweepOptions) -> Result<Realised, LaunchError> {
+    let range = opts.shard.map_or(0..opts.runs, |sh| sh.range(opts.runs));
+    let count = range.len();
+    match opts.shard {
+        None => crate::limits::sweep_runs(opts.runs)?,
+        Some(_) => crate::limits::sharded_runs(opts.runs, count)?,
+    }
     crate::limits::jobs(opts.jobs)?;
     let jobs = if opts.mode == Mode::Processes {
         1
     } else {
-        opts.jobs.clamp(1, opts.runs)
+        opts.jobs.clamp(1, count.max(1))
     };
     run::budget::check_memory(s, plan, jobs as u64)?;
     std::fs::create_dir_all(&opts.out).map_err(|e| {
@@ -187,26 +235,27 @@ pub fn sweep(s: &Scenario, plan: &Plan, opts: &SweepOptions) -> Result<SweepSumm
     })?;
     let start = Instant::now();
     let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<Option<Ran>>> = Mutex::new((0..opts.runs).map(|_| None).collect());
-    let bar = progress_bar(opts.runs);
+    let results: Mutex<Vec<Option<Ran>>> = Mutex::new((0..count).map(|_| None).collect());
+    let bar = progress_bar(count);
+    let seed_of = |j: usize| opts.seed.wrapping_add((range.start + j) as u64);
     std::thread::scope(|scope| {
         for _ in 0..jobs {
             scope.spawn(|| {
                 loop {
-                    let i = next.fetch_add(1, Ordering::Relaxed);
-                    if i >= opts.runs || run::interrupt::received().is_some() {
+                    let j = next.fetch_add(1, Ordering::Relaxed);
+                    if j >= count || run::interrupt::received().is_some() {
                         break;
                     }
-                    let r = one(s, plan, opts.seed.wrapping_add(i as u64), opts, false);
+                    let r = one(s, plan, seed_of(j), opts, false);
                     // A realisation that could not run at all (or was interrupted) ends the sweep; one
                     // that ran and failed is counted, and the others go on.
                     let fatal = r.is_err();
-                    results.lock().expect("no worker panics")[i] = Some(r);
+                    results.lock().expect("no worker panics")[j] = Some(r);
                     if let Some(b) = &bar {
                         b.inc(1);
                     }
                     if fatal {
-                        next.store(opts.runs, Ordering::Relaxed);
+                        next.store(count, Ordering::Relaxed);
                     }
                 }
             });
@@ -216,14 +265,14 @@ pub fn sweep(s: &Scenario, plan: &Plan, opts: &SweepOptions) -> Result<SweepSumm
         b.finish_and_clear();
     }
     let interrupted = run::interrupt::received();
-    let (mut completed, mut failed, mut finished) = (Vec::new(), Vec::new(), 0);
-    for (i, r) in results
+    let (mut rows, mut failed, mut finished) = (Vec::new(), Vec::new(), 0);
+    for (j, r) in results
         .into_inner()
         .expect("no worker panics")
         .into_iter()
         .enumerate()
     {
-        let seed = opts.seed.wrapping_add(i as u64);
+        let seed = seed_of(j);
         match r {
             None => {}
             // Cut short by the interruption: not finished.
@@ -233,28 +282,51 @@ pub fn sweep(s: &Scenario, plan: &Plan, opts: &SweepOptions) -> Result<SweepSumm
                 finished += 1;
                 match Failed::of(seed, &stop) {
                     Some(f) => failed.push(f),
-                    None => completed.push((seed, summary)),
+                    None => rows.push(Row::of(seed, &summary)),
                 }
             }
         }
     }
-    let mut out = gather(s, opts, jobs, &completed);
-    out.finished = finished;
-    out.failed = failed;
-    out.partial = interrupted.is_some();
-    out.interrupted_by = interrupted;
-    out.wall_s = start.elapsed().as_secs_f64();
-    if interrupted.is_some() {
+    Ok(Realised {
+        rows,
+        failed,
+        finished,
+        interrupted,
+        wall_s: start.elapsed().as_secs_f64(),
+        jobs,
+    })
+}
+
+/// Runs the `k` worst of `rows` again with a recording (the same seed gives the same run, bit
+/// for bit): their seeds, worst first.
+pub fn keep_worst(
+    s: &Scenario,
+    plan: &Plan,
+    opts: &SweepOptions,
+    rows: &[Row],
+    k: usize,
+) -> Result<Vec<u64>, LaunchError> {
+    let seeds = row::worst(rows, k);
+    for &seed in &seeds {
+        one(s, plan, seed, opts, true)?;
+    }
+    Ok(seeds)
+}
+
+/// Runs the sweep.
+pub fn sweep(s: &Scenario, plan: &Plan, opts: &SweepOptions) -> Result<SweepSummary, LaunchError> {
+    let r = realise(s, plan, opts)?;
+    let mut out = gather(&Frame::of(s, opts), r.jobs, &r.rows);
+    out.finished = r.finished;
+    out.failed = r.failed;
+    out.partial = r.interrupted.is_some();
+    out.interrupted_by = r.interrupted;
+    out.wall_s = r.wall_s;
+    if r.interrupted.is_some() {
         return Ok(out);
     }
     // The worst realisations, again, with their recordings.
-    let mut order: Vec<usize> = (0..completed.len()).collect();
-    order.sort_by_key(|&i| std::cmp::Reverse(badness(&completed[i].1)));
-    for &i in order.iter().take(opts.keep_worst) {
-        let seed = completed[i].0;
-        one(s, plan, seed, opts, true)?;
-        out.kept.push(seed);
-    }
+    out.kept = keep_worst(s, plan, opts, &r.rows, opts.keep_worst)?;
     Ok(out)
 }
 
@@ -271,30 +343,25 @@ fn progress_bar(total: usize) -> Option<indicatif::ProgressBar> {
     })
 }
 
-/// The distributions over the completed realisations' summaries (with their seeds), in seed
-/// order; `finished`, `failed` and `partial` are the caller's.
-pub fn gather(
-    s: &Scenario,
-    opts: &SweepOptions,
-    jobs: usize,
-    completed: &[(u64, Summary)],
-) -> SweepSummary {
-    let runs: Vec<&Summary> = completed.iter().map(|(_, r)| r).collect();
+/// The distributions over the completed realisations' rows, in seed order; `finished`,
+/// `failed` and `partial` are the caller's.
+pub fn gather(frame: &Frame, jobs: usize, rows: &[Row]) -> SweepSummary {
+    let runs = rows;
     let diag: Vec<&diagnosis::Diagnosis> =
         runs.iter().filter_map(|r| r.diagnosis.as_ref()).collect();
-    let faults = s
+    let faults = frame
         .faults
         .iter()
-        .map(|f| {
+        .map(|name| {
             let figs: Vec<&diagnosis::FaultFigure> = diag
                 .iter()
-                .filter_map(|d| d.faults.iter().find(|x| x.name == f.name))
+                .filter_map(|d| d.faults.iter().find(|x| &x.name == name))
                 .collect();
             let delays: Vec<f64> = figs.iter().filter_map(|x| x.delay).collect();
             let correct = figs.iter().filter(|x| x.correct).count();
             let fractions: Vec<f64> = figs.iter().filter_map(|x| x.isolated_fraction).collect();
             FaultSweep {
-                name: f.name.clone(),
+                name: name.clone(),
                 detected: delays.len(),
                 detection_delay: spread(&delays),
                 isolated_correctly: correct,
@@ -329,35 +396,37 @@ pub fn gather(
         x.measured_false_alarm =
             (x.fault_free_steps > 0).then(|| x.exceedances as f64 / x.fault_free_steps as f64);
     }
-    let tail = s
+    let tail = frame
         .observers
         .iter()
-        .map(|o| {
+        .map(|name| {
             let v: Vec<f64> = runs
                 .iter()
                 .filter_map(|r| {
                     r.observers
                         .iter()
-                        .find(|x| x.name == o.name)
-                        .and_then(|x| x.tail_max_abs_error)
+                        .find(|(x, _)| x == name)
+                        .and_then(|(_, e)| *e)
                 })
                 .collect();
-            (o.name.clone(), spread(&v))
+            (name.clone(), spread(&v))
         })
         .collect();
     SweepSummary {
-        scenario: s.name.clone(),
+        scenario: frame.scenario.clone(),
         runs: runs.len(),
-        requested: opts.runs,
+        requested: frame.requested,
         finished: runs.len(),
         partial: false,
-        isolated_fraction: s.isolated_fraction,
+        isolated_fraction: frame.isolated_fraction,
         interrupted_by: None,
         seeds: [
-            opts.seed,
-            opts.seed.wrapping_add(opts.runs.saturating_sub(1) as u64),
+            frame.seed,
+            frame
+                .seed
+                .wrapping_add(frame.requested.saturating_sub(1) as u64),
         ],
-        mode: opts.mode.name().into(),
+        mode: frame.mode.clone(),
         jobs,
         wall_s: 0.0,
         failed: Vec::new(),

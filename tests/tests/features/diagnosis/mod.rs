@@ -3,3 +3,4 @@
 mod banks;
 mod faults_and_noise;
 mod sweep_outcome;
+mod sweep_shards;
