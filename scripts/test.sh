@@ -29,6 +29,7 @@ stamp="$venv/.uio-installed"
 "$venv/bin/python3" -c 'import control, maturin' 2>/dev/null || rm -f "$stamp"  # the Python package
 "$venv/bin/python3" -c 'import rerun' 2>/dev/null || rm -f "$stamp"  # `rerun rrd verify` on our recordings
 "$venv/bin/python3" -c 'import pythonfmu' 2>/dev/null || rm -f "$stamp"  # a third-party exporter's FMUs
+"$venv/bin/python3" -c 'import dask, distributed' 2>/dev/null || rm -f "$stamp"  # sweeps on Dask workers
 if [ ! -x "$venv/bin/python3" ] || [ ! -e "$stamp" ] \
    || [ -n "$(find python/pyproject.toml python/uio_component -newer "$stamp" -print -quit)" ]; then
   if ! python3 -c 'import ensurepip, venv' 2>/dev/null; then
@@ -39,7 +40,7 @@ if [ ! -x "$venv/bin/python3" ] || [ ! -e "$stamp" ] \
   fi
   echo "preparing the Python environment $venv"
   [ -x "$venv/bin/python3" ] || python3 -m venv "$venv"
-  "$venv/bin/pip" install -q --disable-pip-version-check ./python pytest scipy fmpy mcap maturin control rerun-sdk==0.36.3 pythonfmu  # pythonfmu: FMUs from a third-party exporter; fmpy: test FMUs; mcap: export, maturin and control: the Python package; rerun-sdk: Rerun's own CLI checks our recordings
+  "$venv/bin/pip" install -q --disable-pip-version-check ./python pytest scipy fmpy mcap maturin control rerun-sdk==0.36.3 pythonfmu dask distributed  # dask, distributed: the Python package's sweeps on Dask workers; pythonfmu: FMUs from a third-party exporter; fmpy: test FMUs; mcap: export, maturin and control: the Python package; rerun-sdk: Rerun's own CLI checks our recordings
   touch "$stamp"
 fi
 export PATH="$venv/bin:$PATH"

@@ -80,6 +80,86 @@ fn run(py: Python<'_>, path: &str, out: &str, force: bool) -> PyResult<(String, 
     Ok((rrd, summary, ok))
 }
 
+/// `launcher sweep PATH --runs RUNS [--seed SEED] --keep-worst KEEP --shard K/N --jobs JOBS
+/// --out OUT` in this process: the path of the shard file it wrote.
+#[pyfunction]
+#[pyo3(signature = (path, runs, seed, k, n, keep_worst, jobs, out))]
+#[allow(clippy::too_many_arguments)]
+fn sweep_shard(
+    py: Python<'_>,
+    path: &str,
+    runs: usize,
+    seed: Option<u64>,
+    k: usize,
+    n: usize,
+    keep_worst: usize,
+    jobs: usize,
+    out: &str,
+) -> PyResult<String> {
+    let sh: launcher::sweep::Shard = format!("{k}/{n}")
+        .parse()
+        .map_err(|e: String| PyValueError::new_err(format!("shard: {e}")))?;
+    launcher::limits::sharded_runs(runs, sh.range(runs).len())
+        .and_then(|_| launcher::limits::jobs(jobs))
+        .map_err(raise)?;
+    let mut s = scenario(path, None).map_err(raise)?;
+    if let Some(seed) = seed {
+        s.seed = seed;
+    }
+    // One calibration for every realisation, from the first seed: every shard's the same.
+    let p = launcher::calibrate::planned(&s).map_err(raise)?;
+    let opts = launcher::sweep::SweepOptions {
+        runs,
+        jobs,
+        seed: s.seed,
+        mode: Mode::InProcess,
+        out: PathBuf::from(out),
+        keep_worst,
+        wait: lockstep::Wait::default_for_machine(),
+        shard: Some(sh),
+    };
+    let (file, written) = py
+        .detach(|| launcher::sweep::shard::run_shard(&s, &p, &opts, sh))
+        .map_err(raise)?;
+    if let Some(e) = file.verdict()
+        && file.interrupted_by.is_some()
+    {
+        return Err(raise(e));
+    }
+    Ok(written.display().to_string())
+}
+
+/// `launcher sweep merge FILES… --out OUT`: (the sweep summary JSON, its table, the path of
+/// `<name>.sweep.json`). A merged sweep with failed realisations is returned, not raised: its
+/// summary lists them.
+#[pyfunction]
+fn sweep_merge(
+    py: Python<'_>,
+    files: Vec<String>,
+    out: &str,
+) -> PyResult<(String, String, String)> {
+    let files: Vec<PathBuf> = files.into_iter().map(PathBuf::from).collect();
+    let out = PathBuf::from(out);
+    let (sw, path) = py
+        .detach(|| -> Result<_, LaunchError> {
+            let (sw, sources) = launcher::sweep::shard::merge(&files)?;
+            std::fs::create_dir_all(&out).map_err(|e| {
+                LaunchError::BadInput(format!(
+                    "{}: cannot create the output directory: {e}",
+                    out.display()
+                ))
+            })?;
+            for (seed, dir) in &sources {
+                launcher::sweep::shard::copy_kept(&sw.scenario, *seed, dir, &out)?;
+            }
+            let path = sw.write(&out).map_err(LaunchError::Component)?;
+            Ok((sw, path))
+        })
+        .map_err(raise)?;
+    let json = serde_json::to_string(&sw).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+    Ok((json, sw.table(), path.display().to_string()))
+}
+
 /// One entity group of a recording: its path, its members' names and labelled names, and its
 /// values row by row (steps × members, NaN where a member has no value at a step).
 type Group<'py> = (String, Vec<String>, Vec<String>, Bound<'py, PyBytes>);
@@ -132,5 +212,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(design, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(read, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_shard, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_merge, m)?)?;
     Ok(())
 }

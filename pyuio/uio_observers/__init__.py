@@ -4,6 +4,7 @@
     design(sys, E=E, ...)               # sys: a python-control StateSpace (its A, B, C)
     run("seed002-sine")                 # a scenario file or a shipped scenario's name
     read("runs/seed002-sine.rrd")
+    sweep("seed002-actuator-faults", runs=1000, client=dask_client)   # Monte Carlo, on Dask or here
 
 Every number comes from the Rust library the launcher runs (`launcher design --json`,
 `launcher run --mode in-process`, the export's table of a recording), so it equals the CLI's
@@ -18,7 +19,8 @@ import numpy as np
 
 from . import _native
 
-__all__ = ["design", "design_scenario", "run", "read", "Design", "Recording", "RunResult"]
+__all__ = ["design", "design_scenario", "run", "read", "sweep", "Design", "Recording", "RunResult",
+           "SweepResult"]
 
 
 def _toml_number(v):
@@ -240,3 +242,66 @@ def run(scenario, out=None, force=True):
         result = RunResult(rrd, summary, ok)
     result.path = None
     return result
+
+
+class SweepResult:
+    """A merged sweep: `summary` (`<name>.sweep.json` as a dict: per fault detections, delays and
+    isolation, false alarms, per residual the measured false-alarm probability, per observer the
+    tail error, `kept` the worst seeds), `table` (what `launcher sweep` prints) and `path` (the
+    summary file)."""
+
+    def __init__(self, summary, table, path):
+        self.summary, self.table, self.path = json.loads(summary), table, path
+
+    def __repr__(self):
+        return self.table
+
+
+def _shard(scenario, runs, seed, k, n, keep_worst, jobs, out):
+    """One shard, where it runs (a Dask worker, or here): the path of its shard file."""
+    from uio_observers import _native as native  # a worker imports the package itself
+
+    folder = os.path.join(out, f"shard-{k}-of-{n}")
+    return native.sweep_shard(scenario, runs, seed, k, n, keep_worst, jobs, folder)
+
+
+def sweep(scenario, runs=100, *, seed=None, keep_worst=0, shards=None, client=None, out=None,
+          jobs=1):
+    """Monte Carlo over the noise, as `launcher sweep` (realisation i has seed S + i, S = `seed`
+    or the scenario's): returns a SweepResult equal to `launcher sweep`'s, field by field but the
+    wall time and the jobs.
+
+    The realisations run in `shards` shards (`launcher sweep --shard K/N`), each in one process
+    with `jobs` threads: on `client`'s workers when it is a `dask.distributed.Client` (one task
+    per shard; `shards` defaults to four per worker), else here one after another (`shards`
+    defaults to 1). Each shard writes its file and its worst realisations' recordings in
+    `out/shard-K-of-N/`, and the merge (`launcher sweep merge`) writes `out/<name>.sweep.json`
+    with the worst recordings: so `out` must be a folder every worker reaches (always true of a
+    `LocalCluster`; a shared file system for a cluster of machines), and so must `scenario`.
+    Without `out` a temporary folder holds the shards and the result (`path` None after)."""
+    scenario = os.path.abspath(os.fspath(scenario)) if os.path.exists(os.fspath(scenario)) \
+        else os.fspath(scenario)
+    if shards is None:
+        shards = 1 if client is None else 4 * max(1, len(client.scheduler_info().get("workers", {})))
+    shards = max(1, min(int(shards), int(runs)))
+
+    def merged(folder):
+        ks = range(1, shards + 1)
+        args = [(scenario, runs, seed, k, shards, keep_worst, jobs, folder) for k in ks]
+        if client is None:
+            files = [_shard(*a) for a in args]
+        else:
+            futures = [client.submit(_shard, *a, pure=False) for a in args]
+            files = client.gather(futures)
+        summary, table, path = _native.sweep_merge(files, folder)
+        return SweepResult(summary, table, path)
+
+    if out is not None:
+        folder = os.path.abspath(os.fspath(out))
+        os.makedirs(folder, exist_ok=True)
+        return merged(folder)
+    with tempfile.TemporaryDirectory(prefix="uio-sweep-") as tmp:
+        result = merged(tmp)
+    result.path = None
+    return result
+
