@@ -14,15 +14,20 @@
 //! runs directory are where they were. The tmpfs goes away with the last process in the
 //! namespace: a run killed with SIGKILL leaves no segment behind.
 //!
-//! Only as root. An unprivileged user could enter a user namespace first, but inside it every
-//! file of another uid shows as owned by the overflow uid (65534), and the ownership checks of
-//! the runs directory ([`crate::run_dir`]: a parent owned by root or by us) would refuse `/tmp`
-//! itself. A non-root run uses the machine's `/dev/shm` as before (README, "Known gap").
+//! As root, a mount namespace. As another user, a user namespace first (unprivileged user
+//! namespaces: most distributions allow them), in which the process holds CAP_SYS_ADMIN; only our
+//! uid and gid are mapped (to themselves), so files keep their owners as we see them, except
+//! that every other uid, root's included, shows as the overflow uid (65534). The ownership checks
+//! of the runs directory ([`crate::run_dir`]: a parent owned by root or by us) would then refuse
+//! `/tmp` itself, so the parents they judge are noted as root's, by device and inode, before the
+//! namespace is entered. Children inherit both namespaces and lose the capabilities when they
+//! exec (their uid is not 0 there).
 //!
 //! Preconditions: called before the process starts a thread (a mount namespace entered by one
 //! thread is that thread's alone) and before any segment is created. Where the kernel refuses
-//! (a container without `CAP_SYS_ADMIN`) the run uses the machine's `/dev/shm`, and [`enter`]
-//! says why.
+//! (a container without `CAP_SYS_ADMIN`, unprivileged user namespaces switched off) the run uses
+//! the machine's `/dev/shm`, and [`enter`] says why. (A user namespace also needs the process
+//! to be single-threaded: the same precondition.)
 
 use std::ffi::CString;
 use std::io;
@@ -58,12 +63,27 @@ fn try_enter() -> Result<(), String> {
     // The private tmpfs gets the machine's /dev/shm size: the run's budget check compares its
     // shared memory against that, and tmpfs pages are the machine's memory either way.
     let size = shm_size().map_err(|e| format!("{SHM}: {e}"))?;
-    // SAFETY: geteuid and unshare take no pointers.
-    if unsafe { libc::geteuid() } != 0 {
-        return Err("not root (a private /dev/shm needs CAP_SYS_ADMIN)".into());
-    }
-    if unsafe { libc::unshare(libc::CLONE_NEWNS) } != 0 {
-        return Err(format!("unshare: {}", io::Error::last_os_error()));
+    // SAFETY: geteuid, getegid and unshare take no pointers.
+    let (uid, gid) = unsafe { (libc::geteuid(), libc::getegid()) };
+    if uid == 0 {
+        if unsafe { libc::unshare(libc::CLONE_NEWNS) } != 0 {
+            return Err(format!("unshare: {}", io::Error::last_os_error()));
+        }
+    } else {
+        // Another user: a user namespace of our own first (the mount needs CAP_SYS_ADMIN, which
+        // we hold there), mapping our uid and gid to themselves only, so every file keeps its
+        // owner as far as we are concerned; root's show as the overflow uid there, so the
+        // folders the run-directory checks trust as root's are noted first.
+        crate::run_dir::note_root_owned(&crate::run::checked_parents());
+        if unsafe { libc::unshare(libc::CLONE_NEWUSER | libc::CLONE_NEWNS) } != 0 {
+            return Err(format!(
+                "unshare (a user namespace): {}",
+                io::Error::last_os_error()
+            ));
+        }
+        write_proc("/proc/self/setgroups", "deny")?;
+        write_proc("/proc/self/uid_map", &format!("{uid} {uid} 1"))?;
+        write_proc("/proc/self/gid_map", &format!("{gid} {gid} 1"))?;
     }
     mount(None, "/", None, libc::MS_REC | libc::MS_PRIVATE, None)?;
     let options = format!("mode=0700,size={size}");
@@ -74,6 +94,10 @@ fn try_enter() -> Result<(), String> {
         libc::MS_NOSUID | libc::MS_NODEV | libc::MS_NOEXEC,
         Some(&options),
     )
+}
+
+fn write_proc(path: &str, text: &str) -> Result<(), String> {
+    std::fs::write(path, text).map_err(|e| format!("{path}: {e}"))
 }
 
 fn shm_size() -> io::Result<u64> {

@@ -69,6 +69,15 @@ fn runs_dir() -> PathBuf {
     std::path::absolute(&dir).unwrap_or(dir)
 }
 
+/// The folders whose owner the run-directory checks judge: the parents of the runs directory
+/// and of the short iceoryx2 roots.
+pub(crate) fn checked_parents() -> Vec<PathBuf> {
+    [runs_dir(), short_roots()]
+        .iter()
+        .filter_map(|p| p.parent().map(Path::to_path_buf))
+        .collect()
+}
+
 const RUNS: &str = "runs directory";
 const ROOTS: &str = "iceoryx2 root directory";
 

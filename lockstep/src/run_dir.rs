@@ -14,6 +14,7 @@ use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
 use std::os::unix::ffi::{OsStrExt, OsStringExt};
 use std::os::unix::fs::{DirBuilderExt, MetadataExt};
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 use crate::error::LockstepError;
 
@@ -256,12 +257,34 @@ fn not_private(st: Stat) -> Option<String> {
     }
 }
 
+/// Directories the machine's root owns, noted by (device, inode) before this process entered a
+/// user namespace of its own ([`crate::private_shm`]): inside it only our uid is mapped, and root's
+/// files show as the overflow uid (65534) like any other user's. These stay root's.
+static ROOT_OWNED: OnceLock<Vec<(u64, u64)>> = OnceLock::new();
+
+/// Notes which of `paths` root owns (see [`ROOT_OWNED`]); called once, before the namespace.
+pub(crate) fn note_root_owned(paths: &[PathBuf]) {
+    let owned = paths
+        .iter()
+        .filter_map(|p| std::fs::metadata(p).ok())
+        .filter(|m| m.uid() == 0)
+        .map(|m| (m.dev(), m.ino()))
+        .collect();
+    let _ = ROOT_OWNED.set(owned);
+}
+
+fn noted_root_owned(meta: &std::fs::Metadata) -> bool {
+    ROOT_OWNED
+        .get()
+        .is_some_and(|v| v.contains(&(meta.dev(), meta.ino())))
+}
+
 /// Why `parent` would let another user swap a directory inside it; None when it would not.
 /// Like ssh's StrictModes: owned by root or us, and not writable by others unless sticky
 /// (`/tmp` is root's and sticky: others cannot rename or remove what we make there).
 fn unsafe_parent(parent: &Path) -> Option<String> {
     let meta = std::fs::metadata(parent).ok()?;
-    if meta.uid() != 0 && meta.uid() != euid() {
+    if meta.uid() != 0 && meta.uid() != euid() && !noted_root_owned(&meta) {
         Some(format!(
             "its parent {} is owned by uid {}, neither root nor us",
             parent.display(),

@@ -124,3 +124,39 @@ def test_a_watcher_as_nobody_neither_sees_nor_breaks_twenty_runs(public):
     seen, written = map(int, out.split())
     assert failed == [], failed
     assert (seen, written) == (0, 0), f"the watcher saw {seen} run file(s) in /dev/shm and wrote into {written}"
+
+
+def scan_while(proc, prefix):
+    """Names in the machine's /dev/shm starting with `prefix`, seen while `proc` runs."""
+    seen = set()
+    while proc.poll() is None:
+        seen.update(n for n in os.listdir("/dev/shm") if n.startswith(prefix))
+    return seen
+
+
+@pytest.mark.skipif(shutil.which("setpriv") is None, reason="needs setpriv to run the launcher as nobody")
+def test_a_run_by_another_user_keeps_its_segments_out_of_the_machines_dev_shm(public):
+    """Runs as `nobody` (not root) move to a user namespace and a /dev/shm of their own too: a
+    scan of the machine's /dev/shm while each runs sees none of its segments (the node counter's
+    0666 window included), and every run completes. With UIO_SHARED_SHM=1 the same scan sees
+    them: the scan is able to."""
+    out = public / "nobody-runs"
+    out.mkdir()
+    shutil.chown(out, "nobody", "nogroup")
+
+    def runs(extra_env):
+        found = []
+        for i in range(5):
+            env = dict(clean_env(), **extra_env)
+            p = subprocess.Popen(["setpriv", "--reuid=nobody", "--regid=nogroup", "--clear-groups", launcher(), "run",
+                                  str(public / "shared.toml"), "--out", str(out / f"{len(extra_env)}-{i}")],
+                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+            # setpriv execs the launcher: the run's segments are named uio<its pid>x…
+            seen = scan_while(p, f"uio{p.pid}x")
+            _, err = p.communicate(timeout=120)
+            assert p.returncode == 0, err
+            found.append(len(seen))
+        return found
+
+    assert runs({}) == [0] * 5
+    assert any(n > 0 for n in runs({"UIO_SHARED_SHM": "1"}))
