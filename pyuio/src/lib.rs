@@ -141,20 +141,7 @@ fn sweep_merge(
     let files: Vec<PathBuf> = files.into_iter().map(PathBuf::from).collect();
     let out = PathBuf::from(out);
     let (sw, path) = py
-        .detach(|| -> Result<_, LaunchError> {
-            let (sw, sources) = launcher::sweep::shard::merge(&files)?;
-            std::fs::create_dir_all(&out).map_err(|e| {
-                LaunchError::BadInput(format!(
-                    "{}: cannot create the output directory: {e}",
-                    out.display()
-                ))
-            })?;
-            for (seed, dir) in &sources {
-                launcher::sweep::shard::copy_kept(&sw.scenario, *seed, dir, &out)?;
-            }
-            let path = sw.write(&out).map_err(LaunchError::Component)?;
-            Ok((sw, path))
-        })
+        .detach(|| launcher::sweep::shard::merge_into(&files, &out))
         .map_err(raise)?;
     let json = serde_json::to_string(&sw).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
     Ok((json, sw.table(), path.display().to_string()))

@@ -56,10 +56,15 @@ pub fn command(a: SweepArgs) -> Result<ExitCode, LaunchError> {
     finish(&sw, &a.out)
 }
 
-/// The table, the summary file and the exit of a sweep, whole or merged.
+/// The table, the summary file and the exit of a whole sweep.
 fn finish(sw: &SweepSummary, out: &Path) -> Result<ExitCode, LaunchError> {
-    print!("{}", sw.table());
     let path = sw.write(out).map_err(LaunchError::Component)?;
+    ended(sw, &path)
+}
+
+/// The table and the exit of a sweep whose summary is at `path`.
+fn ended(sw: &SweepSummary, path: &Path) -> Result<ExitCode, LaunchError> {
+    print!("{}", sw.table());
     println!("sweep summary: {}", path.display());
     match sw.verdict() {
         None => Ok(ExitCode::SUCCESS),
@@ -68,15 +73,6 @@ fn finish(sw: &SweepSummary, out: &Path) -> Result<ExitCode, LaunchError> {
 }
 
 fn merge(m: MergeArgs) -> Result<ExitCode, LaunchError> {
-    let (sw, sources) = shard::merge(&m.shards)?;
-    std::fs::create_dir_all(&m.out).map_err(|e| {
-        LaunchError::BadInput(format!(
-            "{}: cannot create the output directory: {e}",
-            m.out.display()
-        ))
-    })?;
-    for (seed, dir) in &sources {
-        shard::copy_kept(&sw.scenario, *seed, dir, &m.out)?;
-    }
-    finish(&sw, &m.out)
+    let (sw, path) = shard::merge_into(&m.shards, &m.out)?;
+    ended(&sw, &path)
 }

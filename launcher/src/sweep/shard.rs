@@ -412,10 +412,27 @@ pub fn merge(paths: &[PathBuf]) -> Result<(SweepSummary, Vec<(u64, PathBuf)>), L
     Ok((out, sources))
 }
 
+/// [`merge`], then its result in `out`: the kept realisations' recordings copied there from their
+/// shards' folders and `<name>.sweep.json` written (its path returned).
+pub fn merge_into(paths: &[PathBuf], out: &Path) -> Result<(SweepSummary, PathBuf), LaunchError> {
+    let (sw, sources) = merge(paths)?;
+    std::fs::create_dir_all(out).map_err(|e| {
+        LaunchError::BadInput(format!(
+            "{}: cannot create the output directory: {e}",
+            out.display()
+        ))
+    })?;
+    for (seed, dir) in &sources {
+        copy_kept(&sw.scenario, *seed, dir, out)?;
+    }
+    let path = sw.write(out).map_err(LaunchError::Component)?;
+    Ok((sw, path))
+}
+
 /// Copies realisation `seed`'s recording and summary (`<name>-seed<S>.rrd`, `.summary.json`)
 /// from `from` to `to`, unless they are one folder; a source is read only as a regular file of
 /// its own (never through a link).
-pub fn copy_kept(name: &str, seed: u64, from: &Path, to: &Path) -> Result<(), LaunchError> {
+fn copy_kept(name: &str, seed: u64, from: &Path, to: &Path) -> Result<(), LaunchError> {
     use std::os::unix::fs::OpenOptionsExt;
     let same = std::fs::canonicalize(from)
         .ok()
