@@ -189,9 +189,9 @@ pub struct SweepArgs {
     /// The scenario file, or the name of a shipped scenario (see `list`).
     #[arg(required = true)]
     pub scenario: Option<PathBuf>,
-    /// Realisations.
-    #[arg(long, default_value_t = 100)]
-    pub runs: usize,
+    /// Realisations (default 100; with --vary, each point runs once).
+    #[arg(long)]
+    pub runs: Option<usize>,
     /// Worker threads (default: every core; processes mode runs one at a time).
     #[arg(long)]
     pub jobs: Option<usize>,
@@ -212,6 +212,15 @@ pub struct SweepArgs {
     /// (a Slurm array: --shard $((SLURM_ARRAY_TASK_ID+1))/$SLURM_ARRAY_TASK_COUNT).
     #[arg(long, value_name = "K/N")]
     pub shard: Option<launcher::sweep::Shard>,
+    /// Vary the simulated plant against the design model instead of the noise: an entry or a
+    /// whole matrix of A, B, C, E, D scaled (*=) or set (=), over a list [a, b], a grid lo..hi:N
+    /// or a distribution U(lo, hi), N(mean, sd), LogU(lo, hi); e.g. 'A[2,3] *= 0.8..1.2:5'.
+    /// Repeat for more (grids make a product). Writes DIR/<name>.vary.csv, .vary.json and PNGs.
+    #[arg(long, value_name = "SPEC")]
+    pub vary: Vec<launcher::vary::spec::Vary>,
+    /// Draws of the --vary distributions.
+    #[arg(long, value_name = "N", default_value_t = 20)]
+    pub points: usize,
 }
 
 // `launcher sweep merge`.

@@ -14,6 +14,7 @@ pub mod run;
 pub mod shipped;
 pub mod summary;
 pub mod sweep;
+pub mod vary;
 
 pub use error::LaunchError;
 pub use scenario::Scenario;

@@ -504,6 +504,13 @@ pub fn figures(r: &Recording, selection: &PlotSelection) -> Result<Vec<(String, 
     Ok(out)
 }
 
+/// Draws one figure into the PNG `path` (in the style of `plot`'s views); false when it has
+/// no finite point (nothing written).
+pub fn draw(path: &Path, fig: &Figure) -> Result<bool, String> {
+    register_font();
+    figure::draw(path, fig)
+}
+
 /// Draws every selected view of `r` into `dir`; returns the files written.
 pub fn plot(r: &Recording, dir: &Path, sel: &PlotSelection) -> Result<Vec<PathBuf>, String> {
     let figures = figures(r, sel)?;

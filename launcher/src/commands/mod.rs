@@ -17,6 +17,7 @@ pub mod plot;
 pub mod replay;
 pub mod run;
 pub mod sweep;
+pub mod vary;
 
 use std::path::Path;
 use std::process::ExitCode;

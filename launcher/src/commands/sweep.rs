@@ -19,21 +19,26 @@ pub fn command(a: SweepArgs) -> Result<ExitCode, LaunchError> {
     }
     let scenario = a
         .scenario
+        .clone()
         .expect("clap requires a scenario without a subcommand");
+    if !a.vary.is_empty() {
+        return super::vary::command(a, &scenario);
+    }
+    let runs = a.runs.unwrap_or(100);
     let jobs = a.jobs.unwrap_or_else(|| {
         std::thread::available_parallelism()
             .map_or(1, |n| n.get())
             .min(limits::MAX_JOBS)
     });
     match a.shard {
-        None => limits::sweep_runs(a.runs),
-        Some(sh) => limits::sharded_runs(a.runs, sh.range(a.runs).len()),
+        None => limits::sweep_runs(runs),
+        Some(sh) => limits::sharded_runs(runs, sh.range(runs).len()),
     }
     .and_then(|_| limits::jobs(jobs))?;
     // One calibration for every realisation, from the first seed (every shard's the same).
     let (s, p) = super::prepared(&scenario, a.seed)?;
     let opts = launcher::sweep::SweepOptions {
-        runs: a.runs,
+        runs,
         jobs,
         seed: s.seed,
         mode: Mode::from(a.mode),

@@ -49,14 +49,19 @@ pub fn output_paths(out: &Path, name: &str) -> (PathBuf, PathBuf) {
     )
 }
 
-/// Makes sure the outputs can be written, before anything runs.
-fn prepare_output(out: &Path, name: &str, force: bool) -> Result<(PathBuf, PathBuf), LaunchError> {
+/// Makes the output directory `out` (and its parents) if absent; bad input when it cannot be.
+pub fn create_output_dir(out: &Path) -> Result<(), LaunchError> {
     fs::create_dir_all(out).map_err(|e| {
         LaunchError::BadInput(format!(
             "{}: cannot create the output directory: {e}",
             out.display()
         ))
-    })?;
+    })
+}
+
+/// Makes sure the outputs can be written, before anything runs.
+fn prepare_output(out: &Path, name: &str, force: bool) -> Result<(PathBuf, PathBuf), LaunchError> {
+    create_output_dir(out)?;
     outputs::probe(out).map_err(|e| {
         LaunchError::BadInput(format!(
             "{}: output directory is not writable: {e}",

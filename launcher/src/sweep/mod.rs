@@ -227,12 +227,7 @@ pub fn realise(s: &Scenario, plan: &Plan, opts: &SweepOptions) -> Result<Realise
         opts.jobs.clamp(1, count.max(1))
     };
     run::budget::check_memory(s, plan, jobs as u64)?;
-    std::fs::create_dir_all(&opts.out).map_err(|e| {
-        LaunchError::BadInput(format!(
-            "{}: cannot create the output directory: {e}",
-            opts.out.display()
-        ))
-    })?;
+    run::create_output_dir(&opts.out)?;
     let start = Instant::now();
     let next = AtomicUsize::new(0);
     let results: Mutex<Vec<Option<Ran>>> = Mutex::new((0..count).map(|_| None).collect());

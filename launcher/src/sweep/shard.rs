@@ -416,12 +416,7 @@ pub fn merge(paths: &[PathBuf]) -> Result<(SweepSummary, Vec<(u64, PathBuf)>), L
 /// shards' folders and `<name>.sweep.json` written (its path returned).
 pub fn merge_into(paths: &[PathBuf], out: &Path) -> Result<(SweepSummary, PathBuf), LaunchError> {
     let (sw, sources) = merge(paths)?;
-    std::fs::create_dir_all(out).map_err(|e| {
-        LaunchError::BadInput(format!(
-            "{}: cannot create the output directory: {e}",
-            out.display()
-        ))
-    })?;
+    crate::run::create_output_dir(out)?;
     for (seed, dir) in &sources {
         copy_kept(&sw.scenario, *seed, dir, out)?;
     }

@@ -1,0 +1,299 @@
+//! `launcher sweep --vary`: how far the observers hold when the plant is not the model.
+//!
+//! The observers, banks, thresholds and controller are designed once, on the scenario's model
+//! (the nominal plan); each point of the variation runs the same scenario with the simulated
+//! plant's matrices changed as its `--vary`s say ([`spec`]), at the same seed (common random
+//! numbers: the points differ by the plant alone). Grids make a product; distributions are
+//! drawn `--points` times (ChaCha8, seeded), the same draws for every grid combination. The
+//! nominal point (the model itself) is run too and marked. Per point the run's figures
+//! ([`figures`]); the table, `<name>.vary.csv`, `<name>.vary.json` and one PNG per figure and
+//! varied parameter ([`report`]); per figure its worst point, named.
+
+pub mod figures;
+pub mod report;
+pub mod spec;
+
+use std::path::PathBuf;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, Normal, Uniform};
+
+use crate::error::LaunchError;
+use crate::plan::Plan;
+use crate::run::{self, Mode, Options, Stop};
+use figures::Figures;
+use scenario::Scenario;
+use spec::{Matrix, Op, Values, Vary};
+
+/// Most points of one variation (each a whole run).
+pub const MAX_POINTS: usize = 100_000;
+
+/// How to vary.
+#[derive(Debug, Clone)]
+pub struct VaryOptions {
+    /// What differs.
+    pub varies: Vec<Vary>,
+    /// Draws of the distributions (ignored when every `--vary` is a grid).
+    pub draws: usize,
+    /// The seed of every run and of the draws.
+    pub seed: u64,
+    /// Worker threads.
+    pub jobs: usize,
+    /// Output folder.
+    pub out: PathBuf,
+    /// Wait strategy.
+    pub wait: lockstep::Wait,
+}
+
+/// One point: each `--vary`'s value (the scaling, or the value set).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Point {
+    /// In `--vary` order.
+    pub values: Vec<f64>,
+    /// The model itself.
+    pub nominal: bool,
+}
+
+/// How a point's run ended, and its figures.
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    /// The point.
+    pub point: Point,
+    /// "completed", "diverged" or "failed".
+    pub status: &'static str,
+    /// Why, when not completed.
+    pub reason: Option<String>,
+    /// Its figures (those it reached, for a run cut short).
+    pub figures: Figures,
+}
+
+/// The matrix a `--vary` names, of `s`'s model.
+fn matrix(s: &mut Scenario, m: Matrix) -> &mut lti::Mat {
+    match m {
+        Matrix::A => &mut s.model.a,
+        Matrix::B => &mut s.model.b,
+        Matrix::C => &mut s.model.c,
+        Matrix::E => &mut s.model.e,
+        Matrix::D => &mut s.model.d,
+    }
+}
+
+/// Checks the `--vary`s against the scenario: a built-in plant, entries inside their matrices.
+pub fn check(s: &Scenario, varies: &[Vary]) -> Result<(), LaunchError> {
+    let what = if s.plant_fmu.is_some() {
+        Some("an FMU")
+    } else if s.plant_process.is_some() {
+        Some("an external process")
+    } else if s.plant_replay.is_some() {
+        Some("replayed data")
+    } else {
+        None
+    };
+    if let Some(what) = what {
+        return Err(LaunchError::BadInput(format!(
+            "--vary: {}'s plant is {what}; --vary changes the built-in plant's matrices",
+            s.name
+        )));
+    }
+    let mut s = s.clone();
+    for v in varies {
+        let m = matrix(&mut s, v.matrix);
+        let (r, c) = m.shape();
+        if let Some((i, j)) = v.entry
+            && (i >= r || j >= c)
+        {
+            return Err(LaunchError::BadInput(format!(
+                "--vary '{}': {} is {r}×{c}, it has no entry [{},{}]",
+                v.text,
+                v.matrix.name(),
+                i + 1,
+                j + 1
+            )));
+        }
+        if r * c == 0 {
+            return Err(LaunchError::BadInput(format!(
+                "--vary '{}': {} is empty in this scenario",
+                v.text,
+                v.matrix.name()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The value of `v` at the nominal model: a scaling of 1, or the entry's own value.
+fn nominal_value(s: &Scenario, v: &Vary) -> f64 {
+    match (v.op, v.entry) {
+        (Op::Set, Some((i, j))) => {
+            let mut s = s.clone();
+            matrix(&mut s, v.matrix)[(i, j)]
+        }
+        _ => 1.0,
+    }
+}
+
+/// The points: the nominal one first, then the grids' product times the draws.
+pub fn points(s: &Scenario, opts: &VaryOptions) -> Result<Vec<Point>, LaunchError> {
+    let grids: Vec<Option<&Vec<f64>>> = opts
+        .varies
+        .iter()
+        .map(|v| match &v.values {
+            Values::Grid(g) => Some(g),
+            _ => None,
+        })
+        .collect();
+    let random = grids.iter().any(Option::is_none);
+    let draws = if random { opts.draws.max(1) } else { 1 };
+    let combos: usize = grids
+        .iter()
+        .map(|g| g.map_or(1, Vec::len))
+        .try_fold(draws, |acc: usize, k| acc.checked_mul(k))
+        .filter(|&n| n < MAX_POINTS)
+        .ok_or_else(|| {
+            LaunchError::BadInput(format!(
+                "--vary: more than {MAX_POINTS} points (the grids' product times --points)"
+            ))
+        })?;
+    // The draws, one row per draw, the same for every grid combination. One stream, drawn in
+    // (draw, --vary) order.
+    let mut rng = ChaCha8Rng::seed_from_u64(opts.seed ^ 0x7661_7279); // "vary"
+    let mut drawn = vec![vec![f64::NAN; opts.varies.len()]; draws];
+    for row in drawn.iter_mut() {
+        for (k, v) in opts.varies.iter().enumerate() {
+            row[k] = match v.values {
+                Values::Grid(_) => f64::NAN,
+                Values::Uniform(lo, hi) => Uniform::new_inclusive(lo, hi)
+                    .map_err(|e| LaunchError::BadInput(format!("--vary '{}': {e}", v.text)))?
+                    .sample(&mut rng),
+                Values::Normal(mu, sd) => Normal::new(mu, sd)
+                    .map_err(|e| LaunchError::BadInput(format!("--vary '{}': {e}", v.text)))?
+                    .sample(&mut rng),
+                Values::LogUniform(lo, hi) => 10f64.powf(
+                    Uniform::new_inclusive(lo.log10(), hi.log10())
+                        .map_err(|e| LaunchError::BadInput(format!("--vary '{}': {e}", v.text)))?
+                        .sample(&mut rng),
+                ),
+            };
+        }
+    }
+    let mut out = vec![Point {
+        values: opts.varies.iter().map(|v| nominal_value(s, v)).collect(),
+        nominal: true,
+    }];
+    for n in 0..combos {
+        // Mixed radix over the grids, the last --vary fastest; the draw index slowest.
+        let (mut rest, mut values) = (n, vec![0.0; opts.varies.len()]);
+        for (k, g) in grids.iter().enumerate().rev() {
+            if let Some(g) = g {
+                values[k] = g[rest % g.len()];
+                rest /= g.len();
+            }
+        }
+        for (k, g) in grids.iter().enumerate() {
+            if g.is_none() {
+                values[k] = drawn[rest][k];
+            }
+        }
+        out.push(Point {
+            values,
+            nominal: false,
+        });
+    }
+    Ok(out)
+}
+
+/// `s` with the point's plant: each `--vary` applied to the model's matrices.
+pub fn apply(s: &Scenario, varies: &[Vary], point: &Point) -> Scenario {
+    let mut s = s.clone();
+    for (v, &x) in varies.iter().zip(&point.values) {
+        let m = matrix(&mut s, v.matrix);
+        match (v.op, v.entry) {
+            (Op::Scale, Some((i, j))) => m[(i, j)] *= x,
+            (Op::Scale, None) => *m *= x,
+            (Op::Set, Some((i, j))) => m[(i, j)] = x,
+            (Op::Set, None) => unreachable!("a whole matrix is only scaled (spec.rs)"),
+        }
+    }
+    s
+}
+
+/// Runs every point (in-process, `jobs` at a time), in point order.
+pub fn vary(s: &Scenario, plan: &Plan, opts: &VaryOptions) -> Result<Vec<Outcome>, LaunchError> {
+    check(s, &opts.varies)?;
+    crate::limits::jobs(opts.jobs)?;
+    let points = points(s, opts)?;
+    let jobs = opts.jobs.clamp(1, points.len());
+    run::budget::check_memory(s, plan, jobs as u64)?;
+    run::create_output_dir(&opts.out)?;
+    let mut base = s.clone();
+    base.seed = opts.seed;
+    let next = AtomicUsize::new(0);
+    type Ran = Result<Outcome, LaunchError>;
+    let results: Mutex<Vec<Option<Ran>>> = Mutex::new(points.iter().map(|_| None).collect());
+    std::thread::scope(|scope| {
+        for _ in 0..jobs {
+            scope.spawn(|| {
+                loop {
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    if i >= points.len() || run::interrupt::received().is_some() {
+                        break;
+                    }
+                    let point = &points[i];
+                    let r = one(&base, plan, opts, point);
+                    let fatal = r.is_err();
+                    results.lock().expect("no worker panics")[i] = Some(r);
+                    if fatal {
+                        next.store(points.len(), Ordering::Relaxed);
+                    }
+                }
+            });
+        }
+    });
+    if let Some(sig) = run::interrupt::received() {
+        return Err(LaunchError::Interrupted(format!(
+            "{}: --vary interrupted by {sig}",
+            s.name
+        )));
+    }
+    results
+        .into_inner()
+        .expect("no worker panics")
+        .into_iter()
+        .map(|r| r.expect("every point ran"))
+        .collect()
+}
+
+/// Runs one point.
+fn one(
+    s: &Scenario,
+    plan: &Plan,
+    opts: &VaryOptions,
+    point: &Point,
+) -> Result<Outcome, LaunchError> {
+    let varied = apply(s, &opts.varies, point);
+    let o = run::run(
+        &varied,
+        plan,
+        &Options::quiet(&opts.out, Mode::InProcess, opts.wait, false),
+    )?;
+    let (status, reason) = match &o.stop {
+        Stop::Completed => ("completed", None),
+        Stop::Diverged(w) => ("diverged", Some(w.clone())),
+        Stop::Failed(w) => ("failed", Some(w.clone())),
+        Stop::Interrupted(sig) => {
+            return Err(LaunchError::Interrupted(format!(
+                "{}: --vary interrupted by {sig}",
+                s.name
+            )));
+        }
+    };
+    Ok(Outcome {
+        point: point.clone(),
+        status,
+        reason,
+        figures: Figures::of(&o.summary),
+    })
+}

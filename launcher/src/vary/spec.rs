@@ -1,0 +1,290 @@
+//! What a `--vary` names: one entry (or a whole matrix) of the built-in plant's A, B, C, E or D,
+//! how it differs from the design model, and over which values.
+//!
+//! ```text
+//! A[2,3] *= 0.8..1.2:5        a scaling on a grid: 5 points from 0.8 to 1.2 (linspace)
+//! A[2,3] *= [0.5, 1, 2]       a scaling on the listed values
+//! A[2,3] = U(-3.5, -2.5)      a value drawn uniformly (`--points` draws, seeded)
+//! B *= N(1, 0.05)             every entry of B scaled by one normal draw
+//! E[1,1] *= LogU(0.1, 10)     log-uniform: uniform in log10
+//! ```
+//!
+//! Indices are 1-based (row, column), as the papers and MATLAB write them. A scaling of 1 (or
+//! a set value equal to the model's) is the nominal model; the nominal point is always run too.
+
+use std::str::FromStr;
+
+/// A matrix of the plant model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Matrix {
+    A,
+    B,
+    C,
+    E,
+    D,
+}
+
+impl Matrix {
+    /// Its name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Matrix::A => "A",
+            Matrix::B => "B",
+            Matrix::C => "C",
+            Matrix::E => "E",
+            Matrix::D => "D",
+        }
+    }
+}
+
+/// Scale the nominal value, or set it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Op {
+    Scale,
+    Set,
+}
+
+/// Where the values come from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Values {
+    /// These values.
+    Grid(Vec<f64>),
+    /// Uniform on [lo, hi].
+    Uniform(f64, f64),
+    /// Normal with mean and standard deviation.
+    Normal(f64, f64),
+    /// 10^U(log10 lo, log10 hi), lo, hi > 0.
+    LogUniform(f64, f64),
+}
+
+/// One `--vary`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Vary {
+    /// As given (trimmed): the column name in the outputs.
+    pub text: String,
+    /// What it names, as written: "A[2,3]", "B".
+    pub target: String,
+    /// The matrix.
+    pub matrix: Matrix,
+    /// The entry (0-based), or the whole matrix.
+    pub entry: Option<(usize, usize)>,
+    /// Scale or set.
+    pub op: Op,
+    /// Over which values.
+    pub values: Values,
+}
+
+impl Vary {
+    /// A value of it as text: "A[2,3] *= 1.2", "A[1,1] = -3".
+    pub fn at(&self, x: f64) -> String {
+        let op = match self.op {
+            Op::Scale => "*=",
+            Op::Set => "=",
+        };
+        format!("{} {op} {}", self.target, lti::eig::sig(x))
+    }
+}
+
+/// Most values of one grid.
+pub const MAX_GRID: usize = 10_000;
+
+fn number(s: &str, whole: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{whole}': '{}' is not a number", s.trim()))?;
+    if !v.is_finite() {
+        return Err(format!("'{whole}': '{}' is not finite", s.trim()));
+    }
+    Ok(v)
+}
+
+/// `f(a, b)` → (a, b).
+fn two(args: &str, whole: &str) -> Result<(f64, f64), String> {
+    let (a, b) = args
+        .split_once(',')
+        .ok_or_else(|| format!("'{whole}': a distribution takes two numbers, e.g. U(0.8, 1.2)"))?;
+    Ok((number(a, whole)?, number(b, whole)?))
+}
+
+fn values(v: &str, whole: &str) -> Result<Values, String> {
+    let v = v.trim();
+    if let Some(list) = v.strip_prefix('[').and_then(|x| x.strip_suffix(']')) {
+        let vals = list
+            .split(',')
+            .map(|x| number(x, whole))
+            .collect::<Result<Vec<_>, _>>()?;
+        if vals.is_empty() || vals.len() > MAX_GRID {
+            return Err(format!("'{whole}': a list holds 1 … {MAX_GRID} values"));
+        }
+        return Ok(Values::Grid(vals));
+    }
+    if let Some((range, count)) = v.split_once(':')
+        && let Some((lo, hi)) = range.split_once("..")
+    {
+        let (lo, hi) = (number(lo, whole)?, number(hi, whole)?);
+        let k: usize = count
+            .trim()
+            .parse()
+            .map_err(|_| format!("'{whole}': lo..hi:N takes a whole number of points N"))?;
+        if !(2..=MAX_GRID).contains(&k) {
+            return Err(format!("'{whole}': lo..hi:N needs 2 … {MAX_GRID} points"));
+        }
+        // numpy's linspace: lo + i·(hi − lo)/(N − 1), the last point hi exactly.
+        let step = (hi - lo) / (k - 1) as f64;
+        let grid = (0..k)
+            .map(|i| if i + 1 == k { hi } else { lo + i as f64 * step })
+            .collect();
+        return Ok(Values::Grid(grid));
+    }
+    let dist = |name: &str| {
+        v.strip_prefix(name)
+            .and_then(|x| x.trim_start().strip_prefix('('))
+            .and_then(|x| x.strip_suffix(')'))
+    };
+    if let Some(args) = dist("LogU") {
+        let (lo, hi) = two(args, whole)?;
+        if !(lo > 0.0 && hi > lo) {
+            return Err(format!("'{whole}': LogU(lo, hi) needs 0 < lo < hi"));
+        }
+        return Ok(Values::LogUniform(lo, hi));
+    }
+    if let Some(args) = dist("U") {
+        let (lo, hi) = two(args, whole)?;
+        if hi <= lo {
+            return Err(format!("'{whole}': U(lo, hi) needs lo < hi"));
+        }
+        return Ok(Values::Uniform(lo, hi));
+    }
+    if let Some(args) = dist("N") {
+        let (mu, sigma) = two(args, whole)?;
+        if sigma <= 0.0 {
+            return Err(format!("'{whole}': N(mean, sd) needs sd > 0"));
+        }
+        return Ok(Values::Normal(mu, sigma));
+    }
+    Err(format!(
+        "'{whole}': the values are a list [a, b, …], a grid lo..hi:N, or U(lo, hi), N(mean, sd), LogU(lo, hi)"
+    ))
+}
+
+impl FromStr for Vary {
+    type Err = String;
+
+    fn from_str(whole: &str) -> Result<Self, Self::Err> {
+        let text = whole.trim().to_string();
+        let (target, op, rest) = if let Some((t, r)) = text.split_once("*=") {
+            (t, Op::Scale, r)
+        } else if let Some((t, r)) = text.split_once('=') {
+            (t, Op::Set, r)
+        } else {
+            return Err(format!(
+                "'{whole}': expected TARGET *= VALUES or TARGET = VALUES, e.g. 'A[2,3] *= 0.8..1.2:5'"
+            ));
+        };
+        let target = target.trim().to_string();
+        let target = target.as_str();
+        let (name, index) = match target.split_once('[') {
+            Some((m, idx)) => (m.trim(), Some(idx)),
+            None => (target, None),
+        };
+        let matrix = match name {
+            "A" => Matrix::A,
+            "B" => Matrix::B,
+            "C" => Matrix::C,
+            "E" => Matrix::E,
+            "D" => Matrix::D,
+            other => {
+                return Err(format!(
+                    "'{whole}': '{other}' is not one of the plant's matrices A, B, C, E, D"
+                ));
+            }
+        };
+        let entry = match index {
+            None => None,
+            Some(idx) => {
+                let idx = idx.strip_suffix(']').ok_or_else(|| {
+                    format!("'{whole}': an entry is written {name}[row,column], from 1")
+                })?;
+                let (i, j) = idx.split_once(',').ok_or_else(|| {
+                    format!("'{whole}': an entry is written {name}[row,column], from 1")
+                })?;
+                let at = |x: &str| {
+                    x.trim()
+                        .parse::<usize>()
+                        .ok()
+                        .filter(|&k| k >= 1)
+                        .ok_or_else(|| format!("'{whole}': rows and columns count from 1"))
+                };
+                Some((at(i)? - 1, at(j)? - 1))
+            }
+        };
+        if op == Op::Set && entry.is_none() {
+            return Err(format!(
+                "'{whole}': a whole matrix can be scaled (*=), not set; set an entry, {name}[row,column] = …"
+            ));
+        }
+        Ok(Vary {
+            target: target.to_string(),
+            matrix,
+            entry,
+            op,
+            values: values(rest, whole)?,
+            text,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grids_lists_and_distributions_parse_as_written() {
+        let v: Vary = "A[2,3] *= 0.8..1.2:5".parse().unwrap();
+        assert_eq!(
+            (v.matrix, v.entry, v.op),
+            (Matrix::A, Some((1, 2)), Op::Scale)
+        );
+        let Values::Grid(g) = &v.values else {
+            panic!("{v:?}")
+        };
+        assert_eq!(g.len(), 5);
+        assert_eq!((g[0], g[4]), (0.8, 1.2));
+        assert!((g[2] - 1.0).abs() < 1e-15);
+        let v: Vary = "E *= [0.5, 1, 2]".parse().unwrap();
+        assert_eq!(
+            (v.entry, v.values),
+            (None, Values::Grid(vec![0.5, 1.0, 2.0]))
+        );
+        let v: Vary = "A[1,1] = U(-3.5, -2.5)".parse().unwrap();
+        assert_eq!((v.op, v.values), (Op::Set, Values::Uniform(-3.5, -2.5)));
+        assert_eq!(
+            "B *= N(1, 0.05)".parse::<Vary>().unwrap().values,
+            Values::Normal(1.0, 0.05)
+        );
+        assert_eq!(
+            "D[1,1] *= LogU(0.1, 10)".parse::<Vary>().unwrap().values,
+            Values::LogUniform(0.1, 10.0)
+        );
+    }
+
+    #[test]
+    fn a_malformed_vary_names_what_is_wrong() {
+        for (bad, says) in [
+            ("A[0,1] *= [1]", "count from 1"),
+            ("F[1,1] *= [1]", "not one of the plant's matrices"),
+            ("A *= 1", "the values are"),
+            ("A = [1, 2]", "a whole matrix can be scaled"),
+            ("A[1,1] *= 1..2:1", "2 … 10000 points"),
+            ("A[1,1] *= U(2, 1)", "lo < hi"),
+            ("A[1,1] *= LogU(0, 1)", "0 < lo < hi"),
+            ("A[1,1] *= N(1, 0)", "sd > 0"),
+            ("A[1,1] *= [1, nan]", "not finite"),
+            ("A[1,1]", "expected TARGET"),
+        ] {
+            let e = bad.parse::<Vary>().unwrap_err();
+            assert!(e.contains(says), "{bad}: {e}");
+        }
+    }
+}
