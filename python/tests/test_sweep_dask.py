@@ -73,3 +73,40 @@ def test_a_bad_scenario_raises_the_launchers_reason(tmp_path):
     bad.write_text("name = \"bad\"\ndt = -1.0\n")
     with pytest.raises(ValueError, match="bad.toml:1:1: missing field `duration`"):
         uo.sweep(bad, runs=2)
+
+
+def test_a_worker_killed_mid_sweep_changes_nothing(tmp_path):
+    """A worker process killed (SIGKILL) while it runs a shard: Dask's nanny restarts it and
+    the scheduler runs the lost shards again; the merged sweep is still the launcher's."""
+    distributed = pytest.importorskip("distributed")
+    import signal
+    import threading
+    import time
+
+    scenario, runs = "seed002-sine", 8
+    out = tmp_path / "cli"
+    done = subprocess.run([launcher(), "sweep", scenario, "--runs", str(runs), "--out", str(out)],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    with open(out / f"{scenario}.sweep.json") as f:
+        want = json.load(f)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        pids = client.run(os.getpid)
+        result = {}
+        worker = threading.Thread(target=lambda: result.update(
+            got=uo.sweep(scenario, runs=runs, shards=runs, client=client, out=tmp_path / "dask")))
+        worker.start()
+        victim, killed = sorted(pids)[0], False
+        stop = time.monotonic() + 120
+        while worker.is_alive() and time.monotonic() < stop and not killed:
+            if client.processing().get(victim):
+                os.kill(pids[victim], signal.SIGKILL)
+                killed = True
+            time.sleep(0.005)
+        worker.join(timeout=300)
+    assert killed, "the sweep ended before a task reached the worker to kill"
+    got = result["got"]
+    for key, value in want.items():
+        if key not in ("wall_s", "jobs"):
+            assert got.summary[key] == value, key

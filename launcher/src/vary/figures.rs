@@ -1,5 +1,6 @@
 //! The figures a point of a variation is judged by, from its run's summary: per observer its
-//! tail max |x − x̂| and (an unknown-input estimate) tail max |ŵ − w|; with fault diagnosis the
+//! tail max |x − x̂|, its output residual's tail max |y − Cx̂| and (an unknown-input estimate)
+//! tail max |ŵ − w|; with fault diagnosis the
 //! false alarms and, per fault, its detection delay and the share of its time isolated
 //! correctly. Each is a named column; a figure a run did not reach is missing (NaN in the CSV).
 
@@ -21,6 +22,10 @@ impl Figures {
         let mut v = Vec::new();
         for o in &s.observers {
             v.push((format!("tail max|e| {}", o.name), o.tail_max_abs_error));
+            v.push((
+                format!("tail max|y−Cx̂| {}", o.name),
+                o.tail_max_abs_residual,
+            ));
             if o.tail_max_abs_input_error.is_some() {
                 v.push((
                     format!("tail max|ŵ−w| {}", o.name),
