@@ -33,7 +33,15 @@ fn try_main(cli: Cli) -> Result<ExitCode, LaunchError> {
         // Dead runs of ours in the machine's /dev/shm go first; then this process and all it
         // starts move to a /dev/shm of their own, before any thread or segment exists.
         lockstep::cleanup_dead_runs();
-        let _ = lockstep::private_shm::enter();
+        if let lockstep::private_shm::Shm::Shared(why) = lockstep::private_shm::enter()
+            && !why.starts_with(lockstep::private_shm::SHARED_ENV)
+        {
+            // The kernel refused the namespaces (a container without CAP_SYS_ADMIN, user
+            // namespaces switched off): the run goes on, and says what that leaves open.
+            eprintln!(
+                "warning: shared memory in the machine's /dev/shm ({why}): another local user could open this run's node-counter segment (docs/security.md)"
+            );
+        }
     }
     use commands as c;
     match command {
