@@ -205,6 +205,94 @@ fn sanitize(s: &str) -> String {
         .collect()
 }
 
+/// The values of every parameter but the `k`-th.
+fn others(p: &Point, k: usize) -> Vec<f64> {
+    p.values
+        .iter()
+        .enumerate()
+        .filter(|(j, _)| *j != k)
+        .map(|(_, x)| *x)
+        .collect()
+}
+
+/// The same values, bit for bit.
+fn same(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+}
+
+/// The combinations of the other parameters' values among the varied points, in point order.
+fn combinations(varied: &[&Outcome], k: usize) -> Vec<Vec<f64>> {
+    let mut combos: Vec<Vec<f64>> = Vec::new();
+    for o in varied {
+        let other = others(&o.point, k);
+        if !combos.iter().any(|c| same(c, &other)) {
+            combos.push(other);
+        }
+    }
+    combos
+}
+
+/// Column `c` against parameter `k`: a curve per combination of the others (their values in
+/// its legend), the nominal value as a dashed vertical line.
+fn curves(
+    c: &str,
+    k: usize,
+    varies: &[Vary],
+    combos: &[Vec<f64>],
+    varied: &[&Outcome],
+    nominal: Option<&Outcome>,
+) -> Vec<Curve> {
+    let mut curves = Vec::new();
+    for (n, combo) in combos.iter().enumerate() {
+        let mut pts: Vec<(f64, f64)> = varied
+            .iter()
+            .filter(|o| o.status == "completed" && same(&others(&o.point, k), combo))
+            .filter_map(|o| o.figures.get(c).map(|y| (o.point.values[k], y)))
+            .collect();
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let label = if combos.len() == 1 {
+            c.to_string()
+        } else {
+            let rest: Vec<&Vary> = varies
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != k)
+                .map(|(_, w)| w)
+                .collect();
+            let parts: Vec<String> = rest.iter().zip(combo).map(|(w, x)| w.at(*x)).collect();
+            parts.join(", ")
+        };
+        curves.push(Curve {
+            label,
+            line: Line {
+                color: color(n),
+                width: THIN + 0.5,
+            },
+            points: pts,
+            dashed: false,
+        });
+    }
+    if let Some(nom) = nominal.and_then(|o| o.figures.get(c).map(|y| (o.point.values[k], y))) {
+        let (lo, hi) = curves
+            .iter()
+            .flat_map(|cv| cv.points.iter().map(|p| p.1))
+            .chain([nom.1])
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), y| {
+                (a.min(y), b.max(y))
+            });
+        curves.push(Curve {
+            label: format!("nominal: {} {}", c, lti::eig::sig(nom.1)),
+            line: Line {
+                color: recording::palette::TRUE_STATE,
+                width: THIN,
+            },
+            points: vec![(nom.0, lo), (nom.0, hi)],
+            dashed: true,
+        });
+    }
+    curves
+}
+
 /// The PNGs, into `dir`: one per figure and varied parameter; the files written, and the plots
 /// left out (too many combinations of the other parameters), said as lines.
 pub fn plots(
@@ -218,25 +306,7 @@ pub fn plots(
     let varied: Vec<&Outcome> = outcomes.iter().filter(|o| !o.point.nominal).collect();
     let nominal = outcomes.iter().find(|o| o.point.nominal);
     for (k, v) in varies.iter().enumerate() {
-        // The other parameters' combinations: one curve each.
-        let mut combos: Vec<Vec<f64>> = Vec::new();
-        for o in &varied {
-            let other: Vec<f64> = o
-                .point
-                .values
-                .iter()
-                .enumerate()
-                .filter(|(j, _)| *j != k)
-                .map(|(_, x)| *x)
-                .collect();
-            if !combos.iter().any(|c| {
-                c.iter()
-                    .zip(&other)
-                    .all(|(a, b)| a.to_bits() == b.to_bits())
-            }) {
-                combos.push(other);
-            }
-        }
+        let combos = combinations(&varied, k);
         if combos.len() > MAX_CURVES {
             skipped.push(format!(
                 "no plot against {}: {} combinations of the other parameters (at most {MAX_CURVES} curves)",
@@ -246,75 +316,12 @@ pub fn plots(
             continue;
         }
         for c in &cols {
-            let mut curves = Vec::new();
-            for (n, combo) in combos.iter().enumerate() {
-                let mut pts: Vec<(f64, f64)> = varied
-                    .iter()
-                    .filter(|o| {
-                        let other = o
-                            .point
-                            .values
-                            .iter()
-                            .enumerate()
-                            .filter(|(j, _)| *j != k)
-                            .map(|(_, x)| *x);
-                        other.zip(combo).all(|(a, b)| a.to_bits() == b.to_bits())
-                    })
-                    .filter(|o| o.status == "completed")
-                    .filter_map(|o| o.figures.get(c).map(|y| (o.point.values[k], y)))
-                    .collect();
-                pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-                let label = if combos.len() == 1 {
-                    c.clone()
-                } else {
-                    let others: Vec<String> = varies
-                        .iter()
-                        .enumerate()
-                        .filter(|(j, _)| *j != k)
-                        .zip(combo)
-                        .map(|((_, w), x)| w.at(*x))
-                        .collect();
-                    others.join(", ")
-                };
-                curves.push(Curve {
-                    label,
-                    line: Line {
-                        color: color(n),
-                        width: THIN + 0.5,
-                    },
-                    points: pts,
-                    dashed: false,
-                });
-            }
-            if let Some(nom) =
-                nominal.and_then(|o| o.figures.get(c).map(|y| (o.point.values[k], y)))
-            {
-                let ys: Vec<f64> = curves
-                    .iter()
-                    .flat_map(|cv| cv.points.iter().map(|p| p.1))
-                    .chain([nom.1])
-                    .collect();
-                let (lo, hi) = ys
-                    .iter()
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &y| {
-                        (a.min(y), b.max(y))
-                    });
-                curves.push(Curve {
-                    label: format!("nominal: {} {}", c, lti::eig::sig(nom.1)),
-                    line: Line {
-                        color: recording::palette::TRUE_STATE,
-                        width: THIN,
-                    },
-                    points: vec![(nom.0, lo), (nom.0, hi)],
-                    dashed: true,
-                });
-            }
             let fig = Figure {
                 title: format!("{name}: {c} against {}", v.text),
                 y_label: c.clone(),
                 x_label: v.text.clone(),
                 scale: Scale::Linear,
-                curves,
+                curves: curves(c, k, varies, &combos, &varied, nominal),
             };
             let path = dir.join(format!(
                 "{name}.vary_{}__{}.png",
