@@ -71,6 +71,13 @@ pub fn sharded_runs(runs: usize, count: usize) -> Result<(), LaunchError> {
     Ok(())
 }
 
+/// `--jobs` when not given: every core, at most [`MAX_JOBS`].
+pub fn default_jobs() -> usize {
+    std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(MAX_JOBS)
+}
+
 /// `--jobs` of a sweep.
 pub fn jobs(jobs: usize) -> Result<(), LaunchError> {
     if !(1..=MAX_JOBS).contains(&jobs) {

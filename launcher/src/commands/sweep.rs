@@ -25,11 +25,7 @@ pub fn command(a: SweepArgs) -> Result<ExitCode, LaunchError> {
         return super::vary::command(a, &scenario);
     }
     let runs = a.runs.unwrap_or(100);
-    let jobs = a.jobs.unwrap_or_else(|| {
-        std::thread::available_parallelism()
-            .map_or(1, |n| n.get())
-            .min(limits::MAX_JOBS)
-    });
+    let jobs = a.jobs.unwrap_or_else(limits::default_jobs);
     match a.shard {
         None => limits::sweep_runs(runs),
         Some(sh) => limits::sharded_runs(runs, sh.range(runs).len()),

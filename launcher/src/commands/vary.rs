@@ -35,11 +35,7 @@ pub fn command(a: SweepArgs, scenario: &Path) -> Result<ExitCode, LaunchError> {
     if !(1..=launcher::vary::MAX_POINTS).contains(&a.points) {
         return refuse("--points", &format!("1 … {}", launcher::vary::MAX_POINTS));
     }
-    let jobs = a.jobs.unwrap_or_else(|| {
-        std::thread::available_parallelism()
-            .map_or(1, |n| n.get())
-            .min(limits::MAX_JOBS)
-    });
+    let jobs = a.jobs.unwrap_or_else(limits::default_jobs);
     // Designed (and calibrated) once, on the nominal model.
     let (s, p) = super::prepared(scenario, a.seed)?;
     let opts = VaryOptions {

@@ -10,13 +10,12 @@
 //! of the realisations it finished, marked partial ([`outcome`]).
 
 mod outcome;
+pub mod pool;
 mod row;
 pub mod shard;
 mod stats;
 
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
@@ -229,44 +228,26 @@ pub fn realise(s: &Scenario, plan: &Plan, opts: &SweepOptions) -> Result<Realise
     run::budget::check_memory(s, plan, jobs as u64)?;
     run::create_output_dir(&opts.out)?;
     let start = Instant::now();
-    let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<Option<Ran>>> = Mutex::new((0..count).map(|_| None).collect());
     let bar = progress_bar(count);
     let seed_of = |j: usize| opts.seed.wrapping_add((range.start + j) as u64);
-    std::thread::scope(|scope| {
-        for _ in 0..jobs {
-            scope.spawn(|| {
-                loop {
-                    let j = next.fetch_add(1, Ordering::Relaxed);
-                    if j >= count || run::interrupt::received().is_some() {
-                        break;
-                    }
-                    let r = one(s, plan, seed_of(j), opts, false);
-                    // A realisation that could not run at all (or was interrupted) ends the sweep; one
-                    // that ran and failed is counted, and the others go on.
-                    let fatal = r.is_err();
-                    results.lock().expect("no worker panics")[j] = Some(r);
-                    if let Some(b) = &bar {
-                        b.inc(1);
-                    }
-                    if fatal {
-                        next.store(count, Ordering::Relaxed);
-                    }
-                }
-            });
-        }
-    });
+    // A realisation that could not run at all (or was interrupted) ends the sweep; one that ran
+    // and failed is counted, and the others go on.
+    let results = pool::in_order(
+        count,
+        jobs,
+        |j| one(s, plan, seed_of(j), opts, false),
+        || {
+            if let Some(b) = &bar {
+                b.inc(1);
+            }
+        },
+    );
     if let Some(b) = bar {
         b.finish_and_clear();
     }
     let interrupted = run::interrupt::received();
     let (mut rows, mut failed, mut finished) = (Vec::new(), Vec::new(), 0);
-    for (j, r) in results
-        .into_inner()
-        .expect("no worker panics")
-        .into_iter()
-        .enumerate()
-    {
+    for (j, r) in results.into_iter().enumerate() {
         let seed = seed_of(j);
         match r {
             None => {}

@@ -247,8 +247,8 @@ fn bad(path: &Path, why: impl std::fmt::Display) -> LaunchError {
     LaunchError::BadInput(format!("{}: {why}", path.display()))
 }
 
-/// Reads one shard file (a regular file of at most [`MAX_FILE`] bytes, never through a link).
-fn read(path: &Path) -> Result<ShardFile, LaunchError> {
+/// Opens `path` to read if it is a regular file, never through a link nor waiting on a FIFO.
+fn open_regular(path: &Path) -> Result<(std::fs::File, std::fs::Metadata), LaunchError> {
     use std::os::unix::fs::OpenOptionsExt;
     let file = std::fs::OpenOptions::new()
         .read(true)
@@ -259,6 +259,12 @@ fn read(path: &Path) -> Result<ShardFile, LaunchError> {
     if !meta.is_file() {
         return Err(bad(path, "not a regular file"));
     }
+    Ok((file, meta))
+}
+
+/// Reads one shard file (a regular file of at most [`MAX_FILE`] bytes, never through a link).
+fn read(path: &Path) -> Result<ShardFile, LaunchError> {
+    let (file, meta) = open_regular(path)?;
     if meta.len() > MAX_FILE {
         return Err(bad(
             path,
@@ -428,7 +434,6 @@ pub fn merge_into(paths: &[PathBuf], out: &Path) -> Result<(SweepSummary, PathBu
 /// from `from` to `to`, unless they are one folder; a source is read only as a regular file of
 /// its own (never through a link).
 fn copy_kept(name: &str, seed: u64, from: &Path, to: &Path) -> Result<(), LaunchError> {
-    use std::os::unix::fs::OpenOptionsExt;
     let same = std::fs::canonicalize(from)
         .ok()
         .zip(std::fs::canonicalize(to).ok())
@@ -439,19 +444,7 @@ fn copy_kept(name: &str, seed: u64, from: &Path, to: &Path) -> Result<(), Launch
     for ext in ["rrd", "summary.json"] {
         let file = format!("{name}-seed{seed}.{ext}");
         let src = from.join(&file);
-        let mut input = std::fs::OpenOptions::new()
-            .read(true)
-            .custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK)
-            .open(&src)
-            .map_err(|e| {
-                bad(
-                    &src,
-                    format!("a kept realisation's file cannot be read: {e}"),
-                )
-            })?;
-        if !input.metadata().is_ok_and(|m| m.is_file()) {
-            return Err(bad(&src, "not a regular file"));
-        }
+        let (mut input, _) = open_regular(&src)?;
         let target = to.join(&file);
         let (staged, mut w) = outputs::Staged::create(&target).map_err(LaunchError::Component)?;
         std::io::copy(&mut input, &mut w)

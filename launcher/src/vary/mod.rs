@@ -14,8 +14,6 @@ pub mod report;
 pub mod spec;
 
 use std::path::PathBuf;
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -81,6 +79,17 @@ fn matrix(s: &mut Scenario, m: Matrix) -> &mut lti::Mat {
     }
 }
 
+/// [`matrix`], to read.
+fn matrix_ref(s: &Scenario, m: Matrix) -> &lti::Mat {
+    match m {
+        Matrix::A => &s.model.a,
+        Matrix::B => &s.model.b,
+        Matrix::C => &s.model.c,
+        Matrix::E => &s.model.e,
+        Matrix::D => &s.model.d,
+    }
+}
+
 /// Checks the `--vary`s against the scenario: a built-in plant, entries inside their matrices.
 pub fn check(s: &Scenario, varies: &[Vary]) -> Result<(), LaunchError> {
     let what = if s.plant_fmu.is_some() {
@@ -98,10 +107,8 @@ pub fn check(s: &Scenario, varies: &[Vary]) -> Result<(), LaunchError> {
             s.name
         )));
     }
-    let mut s = s.clone();
     for v in varies {
-        let m = matrix(&mut s, v.matrix);
-        let (r, c) = m.shape();
+        let (r, c) = matrix_ref(s, v.matrix).shape();
         if let Some((i, j)) = v.entry
             && (i >= r || j >= c)
         {
@@ -127,10 +134,7 @@ pub fn check(s: &Scenario, varies: &[Vary]) -> Result<(), LaunchError> {
 /// The value of `v` at the nominal model: a scaling of 1, or the entry's own value.
 fn nominal_value(s: &Scenario, v: &Vary) -> f64 {
     match (v.op, v.entry) {
-        (Op::Set, Some((i, j))) => {
-            let mut s = s.clone();
-            matrix(&mut s, v.matrix)[(i, j)]
-        }
+        (Op::Set, Some((i, j))) => matrix_ref(s, v.matrix)[(i, j)],
         _ => 1.0,
     }
 }
@@ -230,40 +234,28 @@ pub fn vary(s: &Scenario, plan: &Plan, opts: &VaryOptions) -> Result<Vec<Outcome
     run::create_output_dir(&opts.out)?;
     let mut base = s.clone();
     base.seed = opts.seed;
-    let next = AtomicUsize::new(0);
-    type Ran = Result<Outcome, LaunchError>;
-    let results: Mutex<Vec<Option<Ran>>> = Mutex::new(points.iter().map(|_| None).collect());
-    std::thread::scope(|scope| {
-        for _ in 0..jobs {
-            scope.spawn(|| {
-                loop {
-                    let i = next.fetch_add(1, Ordering::Relaxed);
-                    if i >= points.len() || run::interrupt::received().is_some() {
-                        break;
-                    }
-                    let point = &points[i];
-                    let r = one(&base, plan, opts, point);
-                    let fatal = r.is_err();
-                    results.lock().expect("no worker panics")[i] = Some(r);
-                    if fatal {
-                        next.store(points.len(), Ordering::Relaxed);
-                    }
-                }
-            });
-        }
-    });
+    let results = crate::sweep::pool::in_order(
+        points.len(),
+        jobs,
+        |i| one(&base, plan, opts, &points[i]),
+        || {},
+    );
     if let Some(sig) = run::interrupt::received() {
         return Err(LaunchError::Interrupted(format!(
             "{}: --vary interrupted by {sig}",
             s.name
         )));
     }
-    results
-        .into_inner()
-        .expect("no worker panics")
-        .into_iter()
-        .map(|r| r.expect("every point ran"))
-        .collect()
+    // A point that could not run ends the variation (the points after it never started).
+    let mut out = Vec::with_capacity(results.len());
+    for r in results {
+        match r {
+            Some(Ok(o)) => out.push(o),
+            Some(Err(e)) => return Err(e),
+            None => {}
+        }
+    }
+    Ok(out)
 }
 
 /// Runs one point.
