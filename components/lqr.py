@@ -15,7 +15,7 @@ from r.
 
 `params`: `Q` (n×n rows, or a list of n diagonal weights), `R` (l×l rows, a list of l diagonal
 weights, or a number for l = 1), optional `track`. At 1 kHz the continuous gain applied to
-samples held over a step behaves like the sampled design; `launcher design` does not see this
+samples held over a step behaves like the sampled design; `uio-launcher design` does not see this
 controller, so its closed-loop poles are printed on stderr at start (eig(A − BK)).
 """
 

@@ -120,7 +120,7 @@ def main():
     ap.add_argument("--dt", type=float, default=DT)
     args = ap.parse_args()
     target = os.environ.get("CARGO_TARGET_DIR") or str(REPO / "target")
-    launcher = os.path.join(target, "release", "launcher")
+    launcher = os.path.join(target, "release", "uio-launcher")
     rows = []
     cases = args.andes.split(",") if args.andes else [int(s) for s in args.sizes.split(",")]
     for case in cases:

@@ -7,7 +7,7 @@ percentiles and steps/s and the medians with the FMU/built-in ratios.
 
     scripts/fmu-latency.py FMU_DIR [STEPS] [REPS]
       FMU_DIR: where fmu/testfmus/build.sh put the test FMUs; STEPS default 100000, REPS 3.
-    (the launcher: $CARGO_TARGET_DIR/release/launcher, else target/release/launcher)
+    (the launcher: $CARGO_TARGET_DIR/release/uio-launcher, else target/release/uio-launcher)
 """
 
 import json
@@ -22,7 +22,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "python" / "tests")
 from test_fmu_plant import discrete_seed002, lti_table  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
-LAUNCHER = Path(os.environ.get("CARGO_TARGET_DIR") or REPO / "target") / "release" / "launcher"
+LAUNCHER = Path(os.environ.get("CARGO_TARGET_DIR") or REPO / "target") / "release" / "uio-launcher"
 
 
 def run(scenario, out):

@@ -3,11 +3,11 @@
 throughput test (two DC motors, every state measured, one Chen–Patton UIO, dt = 1 ms, 100 s)
 replayed from a CSV and from an MCAP log (one JSON message per row, stamped with its time), and
 the same scenario with the built-in plant driven by the same inputs (sines, w = 0) — each timed
-as a whole `launcher run` process (pre-flight, start-up, run, recording), interleaved, REPS
+as a whole `uio-launcher run` process (pre-flight, start-up, run, recording), interleaved, REPS
 times; prints every run and the medians in rows/s with the ratios to the built-in plant.
 
     scripts/replay-throughput.py [REPS]      REPS default 3
-    (the launcher: $CARGO_TARGET_DIR/release/launcher, else target/release/launcher)
+    (the launcher: $CARGO_TARGET_DIR/release/uio-launcher, else target/release/uio-launcher)
 """
 
 import json
@@ -25,7 +25,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "python" / "tests")
 from test_replay import DT, C, motor_scenario, write_csv, write_mcap  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
-LAUNCHER = Path(os.environ.get("CARGO_TARGET_DIR") or REPO / "target") / "release" / "launcher"
+LAUNCHER = Path(os.environ.get("CARGO_TARGET_DIR") or REPO / "target") / "release" / "uio-launcher"
 UIO = '[[observer]]\nname = "uio"\nkind = "chen-patton-uio"\npoles = [-20.0, -25.0, -30.0, -35.0, -40.0, -45.0]\n'
 SINES = "".join(f'\n[[input]]\nkind = "sine"\namplitude = 1.0\nfrequency_hz = {1 / (2 * np.pi)}\nphase = {p}\n' for p in (0.0, np.pi / 2))
 ZERO_W = '\n[[disturbance]]\nkind = "constant"\nvalue = 0.0\n' * 2

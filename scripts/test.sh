@@ -53,7 +53,7 @@ python3 scripts/check-imports.py
 
 # The multi-process tests start the component binaries: build them all first.
 cargo build --release --workspace --bins
-# The observer FMUs' library (a cdylib, which --bins does not build), for `launcher export-fmu`.
+# The observer FMUs' library (a cdylib, which --bins does not build), for `uio-launcher export-fmu`.
 cargo build --release -p fmu-observer
 # Lints on every target of the workspace (and the LMI design path), warnings as errors.
 cargo clippy --release --workspace --all-targets -- -D warnings

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Two "hosts" on one machine: network namespaces joined by a veth pair with private test
-# addresses (10.77.0.1 ↔ 10.77.0.2). Host B runs an agent (`launcher agent`); host A runs the
+# addresses (10.77.0.1 ↔ 10.77.0.2). Host B runs an agent (`uio-launcher agent`); host A runs the
 # launcher with the seed 002 closed loop whose plant and Luenberger observer are placed on B
 # (`[hosts]`, `host = …`).
 # Traffic stays between the two namespaces; both are removed on exit, also on failure.
@@ -16,7 +16,7 @@
 #   scripts/two-hosts.sh concurrent      two runs at once through one agent
 #   scripts/two-hosts.sh insecure        plain TCP: refused unless the agent says --insecure
 #
-# Links are mutual TLS with credentials made by `launcher agent init` (one CA; the agent's and
+# Links are mutual TLS with credentials made by `uio-launcher agent init` (one CA; the agent's and
 # the launcher's certificates), except in the insecure case.
 # Each case checks its own outcome and that neither host keeps a process, a run directory or a
 # shared-memory file; it prints "ok <case>: …" and exits 0, or says why and exits 1. Without
@@ -25,7 +25,7 @@ set -euo pipefail
 case_name="${1:-run}"
 repo="$(cd "$(dirname "$0")/.." && pwd)"
 bin="${CARGO_TARGET_DIR:-$repo/target}/release"
-launcher="$bin/launcher"
+launcher="$bin/uio-launcher"
 intruder="$bin/examples/intruder"
 [ -x "$launcher" ] && [ -x "$bin/uio-bridge" ] || { echo "two-hosts: build first (cargo build --release --workspace)"; exit 1; }
 
@@ -162,7 +162,7 @@ case "$case_name" in
     run_pid=$!
     for _ in $(seq 200); do
       grep -q . "$work/launcher.out" 2>/dev/null && break
-      pgrep -f "^$bin/plant --run" >/dev/null && break
+      pgrep -f "^$bin/uio-plant --run" >/dev/null && break
       sleep 0.05
     done
     sleep 1.5
@@ -177,7 +177,7 @@ case "$case_name" in
     rc=0; wait "$run_pid" || rc=$?
     t1="$(now)"
     took="$(python3 -c "print(f'{$t1 - $t0:.2f}')")"
-    [ "$rc" -eq 3 ] || fail "launcher run exited $rc, not 3"
+    [ "$rc" -eq 3 ] || fail "uio-launcher run exited $rc, not 3"
     python3 -c "import sys; sys.exit(0 if $t1 - $t0 <= 2.0 else 1)" || fail "the run took $took s to stop"
     why="$(grep -m1 -E 'error|stopped' "$work/launcher.err" || tail -1 "$work/launcher.err")"
     # A lost agent or link is noticed by whichever of B's components' proxies sees it first.

@@ -1,4 +1,4 @@
-//! The agent: runs on a host that takes part in runs, as `launcher agent --host NAME --listen
+//! The agent: runs on a host that takes part in runs, as `uio-launcher agent --host NAME --listen
 //! quic/ADDRESS:PORT`. It is a Zenoh router listening on that one endpoint (nothing else), admits
 //! only peers with the user's credentials ([`crate::credentials`]) under its access rules
 //! ([`crate::access`]), holds the liveliness token that tells launchers it is there, and starts
@@ -29,7 +29,7 @@ extern "C" fn on_term(_: libc::c_int) {
     STOP.store(true, Ordering::Relaxed);
 }
 
-/// How the agent is started (`launcher agent …`).
+/// How the agent is started (`uio-launcher agent …`).
 pub struct Options {
     /// This host's name, as scenarios' `[hosts]` tables call it.
     pub host: String,
@@ -94,7 +94,7 @@ pub fn run(o: &Options) -> i32 {
         None
     } else if o.listen.starts_with("tcp/") {
         say!(
-            "agent {}: --listen {}: plain TCP admits anyone who reaches it; listen on quic/… with credentials (`launcher agent init`), or add --insecure on a network you trust",
+            "agent {}: --listen {}: plain TCP admits anyone who reaches it; listen on quic/… with credentials (`uio-launcher agent init`), or add --insecure on a network you trust",
             o.host,
             o.listen
         );

@@ -1,5 +1,5 @@
 //! The credentials of runs across hosts: a certificate authority the user makes once
-//! (`launcher agent init`), a certificate for agents (and the workers they start) and one for
+//! (`uio-launcher agent init`), a certificate for agents (and the workers they start) and one for
 //! launchers. Links are mutual TLS: an agent admits only peers whose certificate that CA signed,
 //! and a launcher talks only to an agent whose certificate it signed. The certificates' common
 //! names are the peers' roles, which the agent's access rules ([`crate::access`]) tell apart.
@@ -88,7 +88,7 @@ pub fn load(dir: &Path, side: Side) -> Result<Credentials, String> {
     // Whoever could write the folder or a certificate could swap in a CA of their own.
     let d = fs::symlink_metadata(dir).map_err(|e| {
         format!(
-            "{}: {e} (make the credentials with `launcher agent init`)",
+            "{}: {e} (make the credentials with `uio-launcher agent init`)",
             dir.display()
         )
     })?;
@@ -103,7 +103,7 @@ pub fn load(dir: &Path, side: Side) -> Result<Credentials, String> {
     for f in [&c.ca, &c.cert, &c.key] {
         let m = fs::symlink_metadata(f).map_err(|e| {
             format!(
-                "{}: {e} (make the credentials with `launcher agent init`)",
+                "{}: {e} (make the credentials with `uio-launcher agent init`)",
                 f.display()
             )
         })?;
@@ -296,7 +296,7 @@ mod tests {
         assert!(
             load(&dir, Side::Launcher)
                 .unwrap_err()
-                .contains("launcher agent init")
+                .contains("uio-launcher agent init")
         );
     }
 }

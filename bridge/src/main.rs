@@ -1,5 +1,5 @@
 //! `uio-bridge`: a run across hosts over Zenoh (see the crate's modules). The launcher starts
-//! `uio-bridge remote` in place of a component that runs on another host; `launcher agent` is
+//! `uio-bridge remote` in place of a component that runs on another host; `uio-launcher agent` is
 //! `uio-bridge agent` on that host; the agent starts `uio-bridge worker`s.
 
 /// One line on stderr in a single write: the agent and its workers (processes of their own)

@@ -223,7 +223,7 @@ fn wait_for_agent(z: &zenoh::Session, host: &str, connect: &str) -> Result<(), S
         }
         if asked.elapsed() > Duration::from_secs(2) {
             return Err(format!(
-                "no agent answers at {connect} (start `launcher agent --host {host} --listen {connect}` there)"
+                "no agent answers at {connect} (start `uio-launcher agent --host {host} --listen {connect}` there)"
             ));
         }
         std::thread::sleep(Duration::from_millis(50));

@@ -278,7 +278,7 @@ fn spawn(
     }
     let exe = std::env::current_exe()
         .map_err(|e| e.to_string())?
-        .with_file_name(builtin);
+        .with_file_name(lockstep::programs::builtin(builtin));
     Command::new(&exe)
         .args([
             "--run",

@@ -59,7 +59,7 @@ impl From<FmiArg> for fmu_export::Fmi {
 
 #[derive(Parser)]
 #[command(
-    name = "launcher",
+    name = "uio-launcher",
     version,
     about = "Design and co-simulate unknown input observers for LTI plants"
 )]
@@ -82,13 +82,13 @@ pub enum Command {
     Design(DesignArgs),
     /// Benchmark the seed-002 closed loop in one process and across processes.
     Bench(BenchArgs),
-    /// One node of the benchmark's floor ring (started by `launcher bench`).
+    /// One node of the benchmark's floor ring (started by `uio-launcher bench`).
     #[command(hide = true)]
     FloorNode(FloorNodeArgs),
     /// Take part in runs from another host: start the components a launcher places on this
     /// host (`host = NAME` and `[hosts]` in its scenario). Runs `uio-bridge agent` with these
     /// arguments: `agent init` makes the credentials, `agent --host NAME --listen quic/ADDR:PORT`
-    /// serves (`launcher agent --help` for all).
+    /// serves (`uio-launcher agent --help` for all).
     #[command(disable_help_flag = true)]
     Agent(AgentArgs),
     /// List the shipped scenarios.
@@ -112,7 +112,7 @@ pub enum Command {
     Component(ComponentArgs),
 }
 
-// The arguments of `launcher run`.
+// The arguments of `uio-launcher run`.
 #[derive(Args)]
 pub struct RunArgs {
     /// The scenario file, or the name of a shipped scenario (see `list`).
@@ -164,7 +164,7 @@ pub struct RunArgs {
     pub stall_timeout: Option<f64>,
 }
 
-// The arguments of `launcher replay`.
+// The arguments of `uio-launcher replay`.
 #[derive(Args)]
 pub struct ReplayArgs {
     /// The run's recording.
@@ -180,7 +180,7 @@ pub struct ReplayArgs {
     pub force: bool,
 }
 
-// The arguments of `launcher sweep`.
+// The arguments of `uio-launcher sweep`.
 #[derive(Args)]
 #[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
 pub struct SweepArgs {
@@ -208,7 +208,7 @@ pub struct SweepArgs {
     #[arg(long, value_name = "K", default_value_t = 0)]
     pub keep_worst: usize,
     /// Run only shard K of N (K = 1 … N) of the --runs realisations, the ⌊(K−1)·runs/N⌋-th to
-    /// the ⌊K·runs/N⌋-th, and write DIR/<name>.shard-K-of-N.json for `launcher sweep merge`
+    /// the ⌊K·runs/N⌋-th, and write DIR/<name>.shard-K-of-N.json for `uio-launcher sweep merge`
     /// (a Slurm array: --shard $((SLURM_ARRAY_TASK_ID+1))/$SLURM_ARRAY_TASK_COUNT).
     #[arg(long, value_name = "K/N")]
     pub shard: Option<launcher::sweep::Shard>,
@@ -223,7 +223,7 @@ pub struct SweepArgs {
     pub points: usize,
 }
 
-// `launcher sweep merge`.
+// `uio-launcher sweep merge`.
 #[derive(Subcommand)]
 pub enum SweepCommand {
     /// Merge the N shard files of one sweep into DIR/<name>.sweep.json, equal to the unsharded
@@ -231,7 +231,7 @@ pub enum SweepCommand {
     Merge(MergeArgs),
 }
 
-// The arguments of `launcher sweep merge`.
+// The arguments of `uio-launcher sweep merge`.
 #[derive(Args)]
 pub struct MergeArgs {
     /// The shard files (<name>.shard-K-of-N.json), all N of them, in any order.
@@ -242,7 +242,7 @@ pub struct MergeArgs {
     pub out: PathBuf,
 }
 
-// The arguments of `launcher design`.
+// The arguments of `uio-launcher design`.
 #[derive(Args)]
 pub struct DesignArgs {
     /// The scenario file, or the name of a shipped scenario (see `list`).
@@ -252,7 +252,7 @@ pub struct DesignArgs {
     pub json: bool,
 }
 
-// The arguments of `launcher bench`.
+// The arguments of `uio-launcher bench`.
 #[derive(Args)]
 pub struct BenchArgs {
     /// Steps per run.
@@ -295,7 +295,7 @@ pub struct FloorNodeArgs {
     pub wait: Wait,
 }
 
-// The arguments of `launcher agent`.
+// The arguments of `uio-launcher agent`.
 #[derive(Args)]
 pub struct AgentArgs {
     /// Passed to `uio-bridge agent`.
@@ -303,7 +303,7 @@ pub struct AgentArgs {
     pub args: Vec<String>,
 }
 
-// The arguments of `launcher list`.
+// The arguments of `uio-launcher list`.
 #[derive(Args)]
 pub struct ListArgs {
     /// Directory of scenarios.
@@ -311,7 +311,7 @@ pub struct ListArgs {
     pub dir: Option<PathBuf>,
 }
 
-// The arguments of `launcher inspect`.
+// The arguments of `uio-launcher inspect`.
 #[derive(Args)]
 pub struct InspectArgs {
     /// The recording.
@@ -321,7 +321,7 @@ pub struct InspectArgs {
     pub json: bool,
 }
 
-// The arguments of `launcher compare`.
+// The arguments of `uio-launcher compare`.
 #[derive(Args)]
 pub struct CompareArgs {
     /// First recording.
@@ -336,7 +336,7 @@ pub struct CompareArgs {
     pub rel_tol: Option<f64>,
 }
 
-// The arguments of `launcher plot`.
+// The arguments of `uio-launcher plot`.
 #[derive(Args)]
 pub struct PlotArgs {
     /// The recording.
@@ -360,7 +360,7 @@ pub struct PlotArgs {
     pub deviations: bool,
 }
 
-// The arguments of `launcher export`.
+// The arguments of `uio-launcher export`.
 #[derive(Args)]
 pub struct ExportArgs {
     /// The recording.
@@ -386,7 +386,7 @@ pub struct ExportArgs {
     pub force: bool,
 }
 
-// The arguments of `launcher export-fmu`.
+// The arguments of `uio-launcher export-fmu`.
 #[derive(Args)]
 pub struct ExportFmuArgs {
     /// The scenario file, or the name of a shipped scenario (see `list`).
@@ -402,7 +402,7 @@ pub struct ExportFmuArgs {
     pub fmi: FmiArg,
 }
 
-// The arguments of `launcher linearize`.
+// The arguments of `uio-launcher linearize`.
 #[derive(Args)]
 pub struct LinearizeArgs {
     /// The scenario file: dt, [plant.fmu] and [plant.operating_point] are read.
@@ -416,7 +416,7 @@ pub struct LinearizeArgs {
     pub out: PathBuf,
 }
 
-// The arguments of `launcher component`.
+// The arguments of `uio-launcher component`.
 #[derive(Args)]
 pub struct ComponentArgs {
     /// plant, observer or controller.

@@ -1,7 +1,7 @@
 //! Everything the launcher prints goes through here, so that printing never panics and never
 //! passes a terminal control sequence through.
 //!
-//! `println!` panics when stdout is a closed pipe (`launcher list | head -1`) or a terminal
+//! `println!` panics when stdout is a closed pipe (`uio-launcher list | head -1`) or a terminal
 //! that hung up; these functions drop what cannot be written instead, and the command ends
 //! with its own exit code. Control characters in the text (which may quote a file's contents
 //! or name) are escaped: in stdout's multi-line output all but newlines and tabs, in a

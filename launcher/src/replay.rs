@@ -1,4 +1,4 @@
-//! `launcher replay <run.rrd> [--scenario other.toml]`: observers on a run's recorded plant
+//! `uio-launcher replay <run.rrd> [--scenario other.toml]`: observers on a run's recorded plant
 //! samples. The scenario (the one recorded in the run, or another with the same plant sizes)
 //! is rewritten with its plant replaced by `[plant.replay]` of the recording and without its
 //! controller — recorded data cannot react to one, so a closed-loop run is replayed open loop

@@ -1,4 +1,4 @@
-//! The shipped scenarios: where they are, finding one by the name `launcher list` prints, and
+//! The shipped scenarios: where they are, finding one by the name `uio-launcher list` prints, and
 //! the list itself.
 
 use std::collections::BTreeMap;
@@ -46,7 +46,7 @@ pub fn resolve(arg: &Path) -> Result<PathBuf, LaunchError> {
     let hint =
         scenario::suggest::did_you_mean(&text, entries.iter().filter_map(|e| e.name.as_deref()));
     Err(LaunchError::BadInput(format!(
-        "{}: no such file, nor a shipped scenario of that name in {} (see `launcher list`){hint}",
+        "{}: no such file, nor a shipped scenario of that name in {} (see `uio-launcher list`){hint}",
         quoted(&text),
         dir.display()
     )))
@@ -66,7 +66,7 @@ pub struct Entry {
 }
 
 impl Entry {
-    /// One line of `launcher list`.
+    /// One line of `uio-launcher list`.
     pub fn line(&self) -> String {
         let Some(name) = &self.name else {
             return scenario::untrusted::one_line(&format!(

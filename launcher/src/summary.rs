@@ -128,7 +128,7 @@ pub struct Summary {
     /// (`states: false`: the recorded "errors" are −x̂, not estimation errors).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub replay: Option<serde_json::Value>,
-    /// The design's warnings (the ones `launcher design` prints), so the figures carry them.
+    /// The design's warnings (the ones `uio-launcher design` prints), so the figures carry them.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
     /// `[plant.operating_point]`: the point the design model is linearised at; every figure
@@ -227,7 +227,7 @@ impl Summary {
         summary
     }
 
-    /// Takes a replay's facts (`replay_plant --check`): where its data holds no x (`states`
+    /// Takes a replay's facts (`uio-replay-plant --check`): where its data holds no x (`states`
     /// false) every state-error figure becomes null, where it holds no w (`disturbances` false)
     /// every |w − ŵ|, each with its reason in `unmeasured`; the expectations are checked again.
     pub fn with_replay(&mut self, s: &Scenario, facts: serde_json::Value, completed: bool) {

@@ -34,7 +34,7 @@ pub fn parse_launch(
 ) -> Result<Launch, String> {
     let how = format!(
         "{component}: this program is one process of a co-simulation and is started by the launcher, \
-         e.g. `launcher run scenarios/seed002-sine.toml`"
+         e.g. `uio-launcher run scenarios/seed002-sine.toml`"
     );
     let mut run = None;
     let mut name = None;

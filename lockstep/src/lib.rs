@@ -33,6 +33,7 @@ mod handshake;
 mod layout;
 mod port;
 pub mod private_shm;
+pub mod programs;
 mod quiet;
 mod run;
 mod run_dir;

@@ -1,4 +1,4 @@
-"""The `[controller]` designs of `launcher design --json` against scipy, from the scenario's matrices.
+"""The `[controller]` designs of `uio-launcher design --json` against scipy, from the scenario's matrices.
 
 Every expected number is computed here from the scenario's own TOML: Φ = e^{A dt} and
 Γ_B = ∫₀^dt e^{As} ds B from one `scipy.linalg.expm` of [[A, B], [0, 0]]·dt; the LQR gain

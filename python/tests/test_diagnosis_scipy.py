@@ -1,4 +1,4 @@
-"""`launcher design --json` against numbers computed here, independently, with numpy and scipy.
+"""`uio-launcher design --json` against numbers computed here, independently, with numpy and scipy.
 
 Nothing below is a hard-coded result: every expected number comes from the scenario's own
 matrices through scipy, by a route other than the Rust code's.
@@ -19,7 +19,7 @@ matrices through scipy, by a route other than the Rust code's.
   fault-to-residual Markov parameters of the augmented system vanish for the member's own
   actuator (and for the unknown input) and not for the other one.
 
-The launcher is `$CARGO_TARGET_DIR/release/launcher`, or `target/release/launcher` of this
+The launcher is `$CARGO_TARGET_DIR/release/uio-launcher`, or `target/release/uio-launcher` of this
 checkout (as README.md says); scripts/test.sh builds it before the tests run.
 """
 
@@ -44,18 +44,18 @@ SEED_SCENARIOS = sorted(
 def launcher():
     """The launcher binary of this checkout (cargo's target directory)."""
     target = os.environ.get("CARGO_TARGET_DIR") or os.path.join(REPO, "target")
-    path = os.path.join(target, "release", "launcher")
+    path = os.path.join(target, "release", "uio-launcher")
     if not os.access(path, os.X_OK):
         pytest.fail(f"{path} is not built: run ./scripts/test.sh (it builds every binary first)")
     return path
 
 
 def design(tmp_path, text, name="scenario"):
-    """`launcher design <file> --json` of a scenario written from `text`, parsed."""
+    """`uio-launcher design <file> --json` of a scenario written from `text`, parsed."""
     path = tmp_path / f"{name}.toml"
     path.write_text(text)
     done = subprocess.run([launcher(), "design", str(path), "--json"], capture_output=True, text=True, timeout=60)
-    assert done.returncode == 0, f"launcher design {path} --json exited {done.returncode}: {done.stderr}"
+    assert done.returncode == 0, f"uio-launcher design {path} --json exited {done.returncode}: {done.stderr}"
     return json.loads(done.stdout)
 
 

@@ -1,4 +1,4 @@
-"""`launcher export --mcap/--npz/--mat`: the same signals as the CSV export, bit for bit.
+"""`uio-launcher export --mcap/--npz/--mat`: the same signals as the CSV export, bit for bit.
 
 Two shipped scenarios (seed 002 with its piecewise unknown input and two observers; the vehicle
 with a camera bias fault and a diagnoser) are run in-process and exported to all four formats in

@@ -1,4 +1,4 @@
-"""Observers as FMUs (`launcher export-fmu`): FMPy — an FMI importer independent of this
+"""Observers as FMUs (`uio-launcher export-fmu`): FMPy — an FMI importer independent of this
 repository — runs each exported observer on a recording's u and y, and its x̂ and r must be the
 recording's bit for bit.
 
@@ -42,7 +42,7 @@ XHAT0 = [0.5, -0.05, 0.1, 0.02]  # for seed003's four states, away from x0 = [1,
 
 
 def table(path):
-    """A CSV of `launcher export`: the value columns (after step, sim_time) as float64."""
+    """A CSV of `uio-launcher export`: the value columns (after step, sim_time) as float64."""
     with open(path) as f:
         rows = list(csv.reader(f))
     return np.array([[float(v) for v in r[2:]] for r in rows[1:]])
@@ -71,7 +71,7 @@ def recordings(tmp_path_factory):
 
 
 def export(scenario, observer, out, fmi):
-    """`launcher export-fmu`; the FMU's path (what it prints)."""
+    """`uio-launcher export-fmu`; the FMU's path (what it prints)."""
     done = subprocess.run([launcher(), "export-fmu", str(scenario), "--observer", observer, "--out", str(out), "--fmi", str(fmi)], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     path = Path(done.stdout.strip())
@@ -248,7 +248,7 @@ def test_a_step_of_another_size_and_garbled_resources_are_refused(tmp_path):
 
 
 def refused(tmp_path, *args):
-    """`launcher export-fmu …` that must fail: its one-line message; nothing written."""
+    """`uio-launcher export-fmu …` that must fail: its one-line message; nothing written."""
     out = tmp_path / "out"
     out.mkdir(exist_ok=True)
     done = subprocess.run([*args[:1], "export-fmu", *map(str, args[1:]), "--out", str(out)], capture_output=True, text=True, timeout=120)
@@ -271,7 +271,7 @@ def test_refusals_are_one_line_exit_2_and_write_nothing(tmp_path):
     e = refused(tmp_path, launcher(), external, "--observer", "ext")
     assert "external process" in e and "no matrices" in e
     # A launcher with no library beside it.
-    lonely = tmp_path / "bin" / "launcher"
+    lonely = tmp_path / "bin" / "uio-launcher"
     lonely.parent.mkdir()
     try:
         os.link(launcher(), lonely)

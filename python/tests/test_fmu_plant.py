@@ -1,7 +1,7 @@
 """FMUs as the plant of a run (`[plant.fmu]`), checked against independent numbers:
 
 * the linear test FMU (lti_plant, the exact ZOH step of seed 002 as parameters) gives a recording
-  equal, bit for bit, to the built-in plant's on the same discrete model (`launcher compare`),
+  equal, bit for bit, to the built-in plant's on the same discrete model (`uio-launcher compare`),
   in FMI 2.0 and 3.0;
 * FMPy, an importer that is not ours, drives the same FMU with the recorded u and w and reads
   the recorded x and y back, bit for bit;
@@ -67,7 +67,7 @@ parameters = {{ {params} }}
 
 
 def run(scenario, out, runs_dir, *extra, timeout=300):
-    """`launcher run` in its own runs directory; returns (process, seconds, launcher pid)."""
+    """`uio-launcher run` in its own runs directory; returns (process, seconds, launcher pid)."""
     env = {**os.environ, "UIO_RUNS_DIR": str(runs_dir)}
     start = time.monotonic()
     p = subprocess.Popen([launcher(), "run", str(scenario), "--out", str(out), *extra], env=env,

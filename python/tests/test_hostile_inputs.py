@@ -1,7 +1,7 @@
 """Readers bounded by what they read: hostile logs built here, each refused
 with exit 2 and one line, quickly, within a memory bound, and leaving no process behind.
 
-* A 1.7 KB MCAP whose zstd chunk declares 2^62 bytes uncompressed: before, `replay_plant
+* A 1.7 KB MCAP whose zstd chunk declares 2^62 bytes uncompressed: before, `uio-replay-plant
   --check` spun at 100 % CPU forever. Now refused from the chunk header (≤ 64 MiB a chunk).
 * SIGINT while the pre-flight check reads a 200 MB CSV: exit 130 at once, the check stopped
   (before, the launcher ignored the interrupt while it waited).
@@ -161,7 +161,7 @@ def big_log(tmp_path):
 
 
 def test_an_interrupt_during_the_preflight_stops_it_at_once(tmp_path):
-    """A 200 MB CSV log: its pre-flight check (`replay_plant --check`, which reads every row)
+    """A 200 MB CSV log: its pre-flight check (`uio-replay-plant --check`, which reads every row)
     takes seconds. SIGINT to the launcher while the check runs: before, the launcher ignored
     it while it waited. Now exit 130 at once, naming the check, and the check is gone."""
     big_log(tmp_path)
@@ -180,9 +180,9 @@ def test_an_interrupt_during_the_preflight_stops_it_at_once(tmp_path):
     _, err = launched.communicate(timeout=30)
     seconds = time.monotonic() - t
     print(f"interrupted pre-flight: exit {launched.returncode} after {seconds:.3f} s: {err.strip()}")
-    assert launched.returncode == 130 and "interrupted by SIGINT during replay_plant --check" in err, err
+    assert launched.returncode == 130 and "interrupted by SIGINT during uio-replay-plant --check" in err, err
     assert seconds < 5
-    assert b"replay_plant" not in cmdline(check)
+    assert b"uio-replay-plant" not in cmdline(check)
     assert leftovers(str(tmp_path)) == []
     assert not (tmp_path / "out").exists() or list((tmp_path / "out").iterdir()) == []
 
@@ -196,7 +196,7 @@ def test_a_preflight_past_its_time_limit_is_stopped_and_named(tmp_path):
     done = subprocess.run([launcher(), "run", str(tmp_path / "s.toml"), "--out", str(tmp_path / "out")], capture_output=True, text=True, env=env, timeout=60)
     seconds = time.monotonic() - t
     print(f"pre-flight past 1 s: exit {done.returncode} after {seconds:.2f} s: {done.stderr.strip()}")
-    assert done.returncode == 2 and "replay_plant --check did not answer within 1 s; it was stopped" in done.stderr, done.stderr
+    assert done.returncode == 2 and "uio-replay-plant --check did not answer within 1 s; it was stopped" in done.stderr, done.stderr
     assert len(done.stderr.strip().splitlines()) == 1 and seconds < 10
     assert leftovers(str(tmp_path)) == []
     assert not (tmp_path / "out").exists() or list((tmp_path / "out").iterdir()) == []

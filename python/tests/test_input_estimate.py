@@ -1,6 +1,6 @@
 """The unknown-input estimate ŵ of a UIO, read back from the recording.
 
-Each run is exported to CSV (`launcher export --csv`); here, independently, scipy samples the
+Each run is exported to CSV (`uio-launcher export --csv`); here, independently, scipy samples the
 plant (one `expm` of [[A, B, E], [0, 0, 0]]·dt) and forms ŵ_k = (CΓ_E)⁺(y_{k+1} − CΦx̂_k − CΓ_Bu_k)
 from the recorded y, x̂ and the input the plant held (the controller's u, or the open-loop r).
 The recorded ŵ must be that, and must estimate the recorded w:

@@ -2,7 +2,7 @@
 
 The matrices are made here with numpy and saved in three flavours (C order, Fortran order,
 big-endian) that the scenario names by path. Both modes must give the same recording bit for
-bit (`launcher compare`), and the recorded plant states must follow the exact sampled plant
+bit (`uio-launcher compare`), and the recorded plant states must follow the exact sampled plant
 computed here, independently, from one `scipy.linalg.expm` of [[A, B, E], [0, 0, 0]]·dt:
 x_{k+1} = Φx_k + Γ_B u_k + Γ_E w, with the controller's recorded u_k held over the step and a
 constant unknown input w. At 200 states the Rust exponential runs in double precision
@@ -84,7 +84,7 @@ def run(path, out, mode):
         [launcher(), "run", str(path), "--out", str(out), "--mode", mode, "--force"],
         capture_output=True, text=True, timeout=300,
     )
-    assert done.returncode == 0, f"launcher run --mode {mode} exited {done.returncode}: {done.stderr}"
+    assert done.returncode == 0, f"uio-launcher run --mode {mode} exited {done.returncode}: {done.stderr}"
     return out / "large.rrd"
 
 

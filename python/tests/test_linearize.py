@@ -1,4 +1,4 @@
-"""`launcher linearize`: the sampled model of an FMU plant at an operating
+"""`uio-launcher linearize`: the sampled model of an FMU plant at an operating
 point, made from the FMU itself (trim by Newton's method on the one-sample map, central
 differences with Richardson's extrapolation), checked against independent numbers:
 
@@ -202,7 +202,7 @@ def test_the_python_fmu_is_trimmed_linearised_and_its_scenario_runs_under_a_uio(
 
 
 def test_the_python_fmus_run_and_the_same_run_in_deviations_by_hand_give_the_same_observer(fmu_dir, tmp_path):
-    """The pythonfmu three-tank run at its operating point (the scenario `launcher linearize`
+    """The pythonfmu three-tank run at its operating point (the scenario `uio-launcher linearize`
     wrote, absolute levels recorded) and the same data written in deviations by hand — every
     recorded u, w, x and y less its value at the point, replayed through the same (Φ, Γ_B, Γ_E,
     C) without an operating point — give the same observer: x̂ − x_op and ŵ − w_op equal the

@@ -4,7 +4,7 @@ For each family the error pair (Φ₁, C₁) of its sampled design is formed ind
 scenario's matrices (one `scipy.linalg.expm` of [[A, B, E], [0, 0, 0]]·dt for Φ, Γ_B, Γ_E) by
 the family's published construction; `scipy.linalg.solve_discrete_are(Φ₁ᵀ, C₁ᵀ, Q, R)` gives P,
 the predictor gain K = Φ₁PC₁ᵀ(C₁PC₁ᵀ + R)⁻¹, and the sampled observer's matrices follow. They
-must equal what `launcher design --json` reports the observer runs with, to 1e-9. Weights given
+must equal what `uio-launcher design --json` reports the observer runs with, to 1e-9. Weights given
 for the plant (Q n×n, R p×p) are carried to a reduced pair as TQTᵀ and MRMᵀ. Only structural
 choices that are not part of the gain (the basis L of ker C, Cumming's H) are read from the
 report.

@@ -11,7 +11,7 @@ with integral action on the UIO's estimate.
   −20 kW and commanded T_out to −4.3 °C).
 * The same loop written in deviations by hand (no operating point, every signal shifted by hand)
   gives the same observer estimate, controller output and plant state, to rounding; and
-  `launcher export --deviations` of the run at the point gives the by-hand run's signals.
+  `uio-launcher export --deviations` of the run at the point gives the by-hand run's signals.
 * A diagnoser bank at the point is the bank of the loop in deviations.
 * A measured disturbance that is not an input, or every input declared measured, is refused
   (exit 2, the field named).
@@ -239,7 +239,7 @@ def test_the_loop_written_in_deviations_by_hand_is_the_same_loop(loop):
         gap = np.abs(s[name] - op - d[name]).max()
         print(f"{name}: max |absolute − op − by hand| = {gap:.2e}")
         assert gap < 1e-9 * scale, (name, gap)
-    # `launcher export --deviations` of the run at the point is the run written by hand: states,
+    # `uio-launcher export --deviations` of the run at the point is the run written by hand: states,
     # estimates, inputs and references (the thermostats' r_op = C_t x_op, T_out's u_op).
     dev = tmp / "deviations-csv"
     p = subprocess.run([launcher(), "export", "--deviations", "--csv", str(dev), str(s["rrd"])], capture_output=True, text=True, timeout=120)

@@ -1,5 +1,5 @@
 """The Python package `uio_observers` (pyuio/, PyO3 + maturin), against the CLI:
-its designs equal `launcher design --json` bit for bit, a design from a python-control
+its designs equal `uio-launcher design --json` bit for bit, a design from a python-control
 StateSpace equals the one from its matrices, `run` and `read` give the recording's values as
 the CSV export does, and bad input raises with the launcher's message."""
 

@@ -4,7 +4,7 @@
   components' files import and define their functions).
 * The README's three components — `zoh_plant.py` as `[plant.process]`, `estimator.py` and
   `perfect.py` as `kind = "process"` observers — run in a scenario launched by
-  `launcher run`, closed loop (the built-in controller on the estimator's x̂, the other observers
+  `uio-launcher run`, closed loop (the built-in controller on the estimator's x̂, the other observers
   then trailing with `lag` 4096) and open loop (no controller: u = r). The same scenario is run
   again with the built-in exact plant in place of `zoh_plant.py`, and:
   - w, v, r of the two runs are equal bit for bit (`Signals` samples as the built-in plant,
@@ -14,7 +14,7 @@
     one block exponential and u_{−1} = 0 (what `u_prev` holds in sample 0);
   - `perfect.py`'s error x − x̂ is 0 at every step.
 
-The launcher is `$CARGO_TARGET_DIR/release/launcher`, or `target/release/launcher` of this
+The launcher is `$CARGO_TARGET_DIR/release/uio-launcher`, or `target/release/uio-launcher` of this
 checkout (`test_diagnosis_scipy.launcher`). The components run with this interpreter's `python3`
 first in PATH and this checkout's kit on PYTHONPATH; everything is written to a temporary
 directory that is removed afterwards.
@@ -137,7 +137,7 @@ def table(path):
 
 
 def run(scratch, label, builtin_plant, closed_loop):
-    """`launcher run` of the scenario in its own folder with the README's components; the
+    """`uio-launcher run` of the scenario in its own folder with the README's components; the
     summary and the CSV export."""
     folder = scratch / label
     folder.mkdir()
@@ -150,7 +150,7 @@ def run(scratch, label, builtin_plant, closed_loop):
     out = folder / "out"
     done = subprocess.run([launcher(), "run", str(folder / "readme.toml"), "--out", str(out)],
                           capture_output=True, text=True, timeout=300, env=env, cwd=folder)
-    assert done.returncode == 0, f"launcher run ({label}) exited {done.returncode}:\n{done.stdout}\n{done.stderr}"
+    assert done.returncode == 0, f"uio-launcher run ({label}) exited {done.returncode}:\n{done.stdout}\n{done.stderr}"
     csv_dir = folder / "csv"
     done = subprocess.run([launcher(), "export", "--csv", str(csv_dir), str(out / "readme.rrd")],
                           capture_output=True, text=True, timeout=120)

@@ -1,4 +1,4 @@
-"""Observers on recorded data (`[plant.replay]`, `launcher replay`):
+"""Observers on recorded data (`[plant.replay]`, `uio-launcher replay`):
 
 * a CSV log of the DC motor with Coulomb friction, simulated here by scipy's solve_ivp (not our
   plant) with an additive actuator fault in it, replayed through a UIO and a bank of UIOs: the
@@ -9,7 +9,7 @@
 * bad data exits 2 before anything runs, naming file, line/column and reason, leaving nothing;
 * `resample = "zoh"` puts a log with missing rows on the grid and counts the held samples;
 * an MCAP log of the CSV's rows (JSON messages) replays to the CSV replay's recording bit for
-  bit, a run's `launcher export --mcap` replays to its observer signals bit for bit, and a bad
+  bit, a run's `uio-launcher export --mcap` replays to its observer signals bit for bit, and a bad
   MCAP (no such channel, not JSON, a missing or non-finite field, time going back) exits 2.
 """
 
@@ -155,7 +155,7 @@ def nothing_left(tmp_path, out):
 
 
 def refused(tmp_path, scen, want):
-    """`launcher run scen` exits 2 with one line holding every phrase of `want`, leaving nothing."""
+    """`uio-launcher run scen` exits 2 with one line holding every phrase of `want`, leaving nothing."""
     out = tmp_path / "out"
     p = launch(tmp_path, "run", scen, "--out", out)
     assert p.returncode == 2, p.stderr
@@ -426,7 +426,7 @@ def test_mcap_log_replays_as_the_csv_bit_for_bit(motor, tmp_path, time_field):
 
 
 def test_mcap_of_our_export_replays_open_loop_bit_for_bit(tmp_path):
-    """`launcher export --mcap` of an open-loop run, replayed with the run's scenario on the
+    """`uio-launcher export --mcap` of an open-loop run, replayed with the run's scenario on the
     exported /plant/x, /plant/y and /input channels: every observer signal is the original's."""
     from mcap.reader import make_reader
 
@@ -443,7 +443,7 @@ def test_mcap_of_our_export_replays_open_loop_bit_for_bit(tmp_path):
         for _, channel, message in make_reader(f).iter_messages(topics=["/plant/x", "/plant/y", "/input"]):
             fields.setdefault(channel.topic, [f"{channel.topic}.{k}" for k in json.loads(message.data) if k not in ("step", "sim_time")])
     assert [len(fields[c]) for c in ("/plant/x", "/plant/y", "/input")] == [4, 3, 1], fields
-    # The path absolute, as `launcher replay` writes it: the recording's copy of the scenario
+    # The path absolute, as `uio-launcher replay` writes it: the recording's copy of the scenario
     # then parses anywhere, so the exported headers carry the names and units too.
     text = open(os.path.join(SCEN, "seed003-sensor-faults.toml")).read()
     text += f"""

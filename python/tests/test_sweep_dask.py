@@ -1,8 +1,8 @@
-"""The Python package's sweep, here and on Dask workers, gives `launcher sweep`'s result: every
+"""The Python package's sweep, here and on Dask workers, gives `uio-launcher sweep`'s result: every
 field of `<name>.sweep.json` but the wall time and the jobs, and its worst realisations'
-recordings the same runs bit for bit (`launcher compare`). The shards run in worker processes of
+recordings the same runs bit for bit (`uio-launcher compare`). The shards run in worker processes of
 a `distributed.LocalCluster` (each imports the package and runs its shards in-process), and the
-merge is `launcher sweep merge`'s."""
+merge is `uio-launcher sweep merge`'s."""
 
 import json
 import os

@@ -1,7 +1,7 @@
-"""`launcher sweep --vary`: the observers stay designed on the nominal model while the simulated
+"""`uio-launcher sweep --vary`: the observers stay designed on the nominal model while the simulated
 plant's matrices change. Checked against an independent simulation in NumPy/SciPy of each
 point — the varied plant sampled exactly with its sinusoidal unknown input (the generator
-augmented, `expm`), the observers' sampled matrices from `launcher design --json`
+augmented, `expm`), the observers' sampled matrices from `uio-launcher design --json`
 (z⁺ = Fz + Gu + Ky, x̂ = Pz + Qy, z₀ = 0) — the tail max |x − x̂| of every observer at every
 point to 1e-9; the grid's values are numpy's linspace; a distribution's draws are in range and
 follow the seed; the nominal point is the plain run's; one PNG per figure and varied parameter.

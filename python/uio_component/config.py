@@ -297,7 +297,7 @@ def launch(environ: Optional[Dict[str, str]] = None) -> Config:
     """
     env = os.environ if environ is None else environ
     how = ("this program is one process of a co-simulation and is started by the launcher, "
-           "e.g. `launcher run scenarios/cartpole-python-plant.toml`")
+           "e.g. `uio-launcher run scenarios/cartpole-python-plant.toml`")
     version = env.get("UIO_PROTOCOL")
     if version is None:
         raise ComponentExit(EXIT_USAGE, f"{how} (UIO_PROTOCOL is not set)")

@@ -1,6 +1,6 @@
 //! `uio_observers._native`: the launcher's own design, run and read paths, reached from Python.
-//! Nothing here designs or simulates: `design` is `launcher design --json`'s report, `run` is
-//! `launcher run --mode in-process`, `read` is the export's table of a recording — so the Python
+//! Nothing here designs or simulates: `design` is `uio-launcher design --json`'s report, `run` is
+//! `uio-launcher run --mode in-process`, `read` is the export's table of a recording — so the Python
 //! package gives the CLI's numbers, bit for bit. The Python layer (`uio_observers/__init__.py`)
 //! turns what these return into NumPy arrays.
 
@@ -31,7 +31,7 @@ fn scenario(path: &str, text: Option<&str>) -> Result<Scenario, LaunchError> {
     })
 }
 
-/// `launcher design --json`: (every design holds, the JSON report, the text report).
+/// `uio-launcher design --json`: (every design holds, the JSON report, the text report).
 #[pyfunction]
 #[pyo3(signature = (path, text=None))]
 fn design(path: &str, text: Option<&str>) -> PyResult<(bool, String, String)> {
@@ -44,7 +44,7 @@ fn design(path: &str, text: Option<&str>) -> PyResult<(bool, String, String)> {
     ))
 }
 
-/// `launcher run --mode in-process --out OUT`: (the recording, the summary JSON, completed and
+/// `uio-launcher run --mode in-process --out OUT`: (the recording, the summary JSON, completed and
 /// every expectation met).
 #[pyfunction]
 #[pyo3(signature = (path, out, force=false))]
@@ -80,7 +80,7 @@ fn run(py: Python<'_>, path: &str, out: &str, force: bool) -> PyResult<(String, 
     Ok((rrd, summary, ok))
 }
 
-/// `launcher sweep PATH --runs RUNS [--seed SEED] --keep-worst KEEP --shard K/N --jobs JOBS
+/// `uio-launcher sweep PATH --runs RUNS [--seed SEED] --keep-worst KEEP --shard K/N --jobs JOBS
 /// --out OUT` in this process: the path of the shard file it wrote.
 #[pyfunction]
 #[pyo3(signature = (path, runs, seed, k, n, keep_worst, jobs, out))]
@@ -129,7 +129,7 @@ fn sweep_shard(
     Ok(written.display().to_string())
 }
 
-/// `launcher sweep merge FILES… --out OUT`: (the sweep summary JSON, its table, the path of
+/// `uio-launcher sweep merge FILES… --out OUT`: (the sweep summary JSON, its table, the path of
 /// `<name>.sweep.json`). A merged sweep with failed realisations is returned, not raised: its
 /// summary lists them.
 #[pyfunction]

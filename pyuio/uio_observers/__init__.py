@@ -6,8 +6,8 @@
     read("runs/seed002-sine.rrd")
     sweep("seed002-actuator-faults", runs=1000, client=dask_client)   # Monte Carlo, on Dask or here
 
-Every number comes from the Rust library the launcher runs (`launcher design --json`,
-`launcher run --mode in-process`, the export's table of a recording), so it equals the CLI's
+Every number comes from the Rust library the launcher runs (`uio-launcher design --json`,
+`uio-launcher run --mode in-process`, the export's table of a recording), so it equals the CLI's
 bit for bit. Bad input raises ValueError, a failed run RuntimeError, with the launcher's message.
 """
 
@@ -141,7 +141,7 @@ class Design:
     """An observer's design: `continuous` (the design's own matrices, e.g. N, L, G, H for a
     Chen–Patton UIO), `sampled` (F, G, K, P, Q of z⁺ = Fz + Gu + Ky, x̂ = Pz + Qy at `dt`),
     `poles`, `discrete_poles`, `fixed_modes` (complex arrays), `conditions` [(name, ok, detail)],
-    `report` (the launcher's text) and `json` (its JSON, as `launcher design --json` prints it)."""
+    `report` (the launcher's text) and `json` (its JSON, as `uio-launcher design --json` prints it)."""
 
     def __init__(self, report, text):
         self.json = report
@@ -233,7 +233,7 @@ def run(scenario, out=None, force=True):
     `out`; returns a RunResult. Without `out` the recording goes to a temporary folder that is
     removed once its signals are read (the result's `path` is then None: pass `out` to keep the
     `.rrd`). External components (`kind = "process"`, `[plant.process]`, an FMU plant) need
-    `launcher run` across processes."""
+    `uio-launcher run` across processes."""
     if out is not None:
         rrd, summary, ok = _native.run(os.fspath(scenario), os.fspath(out), force)
         return RunResult(rrd, summary, ok)
@@ -247,7 +247,7 @@ def run(scenario, out=None, force=True):
 class SweepResult:
     """A merged sweep: `summary` (`<name>.sweep.json` as a dict: per fault detections, delays and
     isolation, false alarms, per residual the measured false-alarm probability, per observer the
-    tail error, `kept` the worst seeds), `table` (what `launcher sweep` prints) and `path` (the
+    tail error, `kept` the worst seeds), `table` (what `uio-launcher sweep` prints) and `path` (the
     summary file)."""
 
     def __init__(self, summary, table, path):
@@ -267,15 +267,15 @@ def _shard(scenario, runs, seed, k, n, keep_worst, jobs, out):
 
 def sweep(scenario, runs=100, *, seed=None, keep_worst=0, shards=None, client=None, out=None,
           jobs=1):
-    """Monte Carlo over the noise, as `launcher sweep` (realisation i has seed S + i, S = `seed`
-    or the scenario's): returns a SweepResult equal to `launcher sweep`'s, field by field but the
+    """Monte Carlo over the noise, as `uio-launcher sweep` (realisation i has seed S + i, S = `seed`
+    or the scenario's): returns a SweepResult equal to `uio-launcher sweep`'s, field by field but the
     wall time and the jobs.
 
-    The realisations run in `shards` shards (`launcher sweep --shard K/N`), each in one process
+    The realisations run in `shards` shards (`uio-launcher sweep --shard K/N`), each in one process
     with `jobs` threads: on `client`'s workers when it is a `dask.distributed.Client` (one task
     per shard; `shards` defaults to four per worker), else here one after another (`shards`
     defaults to 1). Each shard writes its file and its worst realisations' recordings in
-    `out/shard-K-of-N/`, and the merge (`launcher sweep merge`) writes `out/<name>.sweep.json`
+    `out/shard-K-of-N/`, and the merge (`uio-launcher sweep merge`) writes `out/<name>.sweep.json`
     with the worst recordings: so `out` must be a folder every worker reaches (always true of a
     `LocalCluster`; a shared file system for a cluster of machines), and so must `scenario`.
     Without `out` a temporary folder holds the shards and the result (`path` None after)."""

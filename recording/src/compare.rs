@@ -1,4 +1,4 @@
-//! `launcher compare`: two recordings, signal by signal and step by step, within
+//! `uio-launcher compare`: two recordings, signal by signal and step by step, within
 //! max(abs_tol, rel_tol·|a|) — the rule of Simulink's Data Inspector — or, with no tolerance
 //! given, bit for bit. Latency series are timing, not signals, and are left out.
 

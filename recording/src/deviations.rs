@@ -1,5 +1,5 @@
-//! A recording of a run at an operating point in deviations (`launcher export --deviations`,
-//! `launcher plot --deviations`): every recorded signal is in the plant's own (absolute) units,
+//! A recording of a run at an operating point in deviations (`uio-launcher export --deviations`,
+//! `uio-launcher plot --deviations`): every recorded signal is in the plant's own (absolute) units,
 //! and this shifts each by its value at the point,
 //!
 //! ```text

@@ -1,4 +1,4 @@
-//! Entity globs, with the one rule shared by `launcher run --record` and `launcher plot
+//! Entity globs, with the one rule shared by `uio-launcher run --record` and `uio-launcher plot
 //! --signals`: `*` matches within one path segment, `**` across segments, and a pattern
 //! without a leading `/` gets one (entity paths are rooted).
 

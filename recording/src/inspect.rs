@@ -1,4 +1,4 @@
-//! `launcher inspect`: what a recording holds — its entities with their row counts and time
+//! `uio-launcher inspect`: what a recording holds — its entities with their row counts and time
 //! ranges — and the run's figures recomputed from the recorded data alone: per observer the
 //! largest |x − x̂| and |y − Cx̂| over the tail (the last quarter of the steps completed), and the latency percentiles.
 

@@ -1,4 +1,4 @@
-//! `launcher plot`: one PNG per view of the recording's blueprint — each state with every
+//! `uio-launcher plot`: one PNG per view of the recording's blueprint — each state with every
 //! observer's estimate, every observer's max |e| on a log axis, each observer's errors and
 //! residuals, the unknown inputs, the inputs, the outputs, and the latency (log axis) — with
 //! the names, units and colours of the Rerun views, drawn with plotters' pure-Rust bitmap

@@ -1,4 +1,4 @@
-//! `replay_plant --check`: the launcher's pre-flight. Parameters (JSON) on stdin; the whole
+//! `uio-replay-plant --check`: the launcher's pre-flight. Parameters (JSON) on stdin; the whole
 //! file is read as the run would read it; the facts the summary reports go to stdout as JSON.
 
 use std::io::Read;
@@ -9,10 +9,10 @@ pub fn main() -> ExitCode {
     let mut text = String::new();
     let run = std::io::stdin()
         .read_to_string(&mut text)
-        .map_err(|e| format!("replay_plant --check: stdin: {e}"))
+        .map_err(|e| format!("uio-replay-plant --check: stdin: {e}"))
         .and_then(|_| {
             serde_json::from_str::<replay::Params>(&text)
-                .map_err(|e| format!("replay_plant --check: parameters: {e}"))
+                .map_err(|e| format!("uio-replay-plant --check: parameters: {e}"))
         })
         .and_then(|p| replay::load(&p));
     match run {

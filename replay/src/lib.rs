@@ -2,7 +2,7 @@
 //! mapped by header name, an MCAP log whose JSON messages' fields are mapped by name the same
 //! way, or a run's own `.rrd`, read into a [`Table`] of plant samples on the
 //! run's grid (PROTOCOL.md §4, without the fault slots, which the scenario's `[[fault]]` table
-//! fills). The `replay_plant` component publishes them; `replay_plant --check` reads the file
+//! fills). The `uio-replay-plant` component publishes them; `uio-replay-plant --check` reads the file
 //! before a run so that bad data is refused with exit 2 before anything runs.
 
 pub mod csv;

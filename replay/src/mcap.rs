@@ -1,5 +1,5 @@
 //! An MCAP log as plant samples. `[plant.replay] channel` names a JSON channel (or a list of
-//! them, joined message by message: a `launcher export --mcap` file holds x, y, u and w on
+//! them, joined message by message: a `uio-launcher export --mcap` file holds x, y, u and w on
 //! channels of their own); each message is a row, its fields mapped by name to u, y and
 //! optionally w and x exactly as a CSV's header names are (`"/topic.field"` names a field of
 //! one channel of the list; a bare name is looked up in the channels in order). The time is the

@@ -1,5 +1,5 @@
 //! `[plant.fmu]`: an FMU (FMI 2.0/3.0 co-simulation) as the true plant. The scenario names
-//! which FMU variables carry u, w, y and the true x; the FMU itself is read by the `fmu_plant`
+//! which FMU variables carry u, w, y and the true x; the FMU itself is read by the `uio-fmu-plant`
 //! component (crate `fmu-plant`), which the launcher also asks to check the file before a run.
 //! Here only what the scenario alone can tell is checked: the sizes against `[plant]` and that
 //! the file exists.
@@ -14,7 +14,7 @@ use super::raw::RawFmu;
 use crate::check::{Bad, bad};
 
 /// The program that runs an FMU plant (a kit component built beside the launcher).
-pub const FMU_PLANT_PROGRAM: &str = "fmu_plant";
+pub const FMU_PLANT_PROGRAM: &str = lockstep::programs::FMU_PLANT;
 
 /// The FMU plant as the process that runs it, and the FMU's absolute path.
 /// `x0`, when the scenario gives it, sets the start values of the `states` variables.

@@ -1,4 +1,4 @@
-//! `launcher linearize`: what it needs of a scenario, and the scenario it writes.
+//! `uio-launcher linearize`: what it needs of a scenario, and the scenario it writes.
 //!
 //! Its input need not run yet: only `dt`, `[plant.fmu]` (the FMU and its map), and where to
 //! linearise — `[plant.operating_point]` x, u, w (u, w default 0; x defaults to `[plant] x0`,
@@ -17,7 +17,7 @@ use super::raw::{RawFmu, RawOperatingPoint};
 use super::{MAX_SCENARIO_BYTES, ScenarioError, untrusted};
 use crate::check::{Bad, bad, check_name, finite};
 
-/// What `fmu_plant --linearize` is asked.
+/// What `uio-fmu-plant --linearize` is asked.
 #[derive(Debug, Clone)]
 pub struct Request {
     /// The scenario's name (the output file's stem).
@@ -34,13 +34,13 @@ pub struct Request {
 }
 
 impl Request {
-    /// The request as `fmu_plant --linearize` reads it.
+    /// The request as `uio-fmu-plant --linearize` reads it.
     pub fn json(&self, trim: bool) -> serde_json::Value {
         json!({ "params": self.params, "u": self.u, "w": self.w, "dt": self.dt, "trim": trim })
     }
 }
 
-/// Reads what `launcher linearize` needs from the scenario at `path`.
+/// Reads what `uio-launcher linearize` needs from the scenario at `path`.
 pub fn request(path: &Path) -> Result<Request, ScenarioError> {
     let err = |Bad { field, reason }: Bad| ScenarioError {
         file: path.to_path_buf(),
@@ -91,7 +91,7 @@ pub fn request(path: &Path) -> Result<Request, ScenarioError> {
         .ok_or_else(|| {
             err(bad(
                 "plant.fmu",
-                "missing: `launcher linearize` makes the model of an FMU plant",
+                "missing: `uio-launcher linearize` makes the model of an FMU plant",
             ))
         })?
         .clone()
@@ -172,7 +172,7 @@ pub fn request(path: &Path) -> Result<Request, ScenarioError> {
     })
 }
 
-/// The model made, as `fmu_plant --linearize` answers.
+/// The model made, as `uio-fmu-plant --linearize` answers.
 pub struct Linearized<'a> {
     pub x: &'a [f64],
     pub u: &'a [f64],
@@ -230,7 +230,7 @@ pub fn write(req: &Request, m: &Linearized, out: &Path) -> Result<PathBuf, Strin
         fmu.insert("path".into(), req.fmu.display().to_string().into());
     }
     let header = format!(
-        "# Made by `launcher linearize` from the FMU {}: the sampled model at dt = {} in deviations\n# from [plant.operating_point] (Phi, Gamma_B, Gamma_E, C beside this file, as .npy).\n{}",
+        "# Made by `uio-launcher linearize` from the FMU {}: the sampled model at dt = {} in deviations\n# from [plant.operating_point] (Phi, Gamma_B, Gamma_E, C beside this file, as .npy).\n{}",
         req.fmu.display(),
         req.dt,
         if at_rest {

@@ -191,7 +191,7 @@ fn data_offset<R: std::io::Read + std::io::Seek>(file: &mut R, len: u64) -> Resu
 }
 
 /// A 2-D float64 `.npy` file's bytes (C order), as `numpy.save` writes it: what
-/// `launcher linearize` leaves beside the scenario it writes.
+/// `uio-launcher linearize` leaves beside the scenario it writes.
 pub fn npy_bytes(rows: &[Vec<f64>]) -> Result<Vec<u8>, String> {
     let (r, c) = (rows.len(), rows.first().map_or(0, Vec::len));
     if rows.iter().any(|row| row.len() != c) {

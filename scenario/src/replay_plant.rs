@@ -1,7 +1,7 @@
 //! `[plant.replay]`: recorded data as the true plant. A CSV log (its columns mapped by header
 //! name to u, y and optionally w and x), an MCAP log (the fields of a JSON channel's messages
 //! mapped the same way) or a run's own `.rrd` is replayed sample by sample by
-//! the `replay_plant` component (crate `replay`), which the launcher also asks to read the file
+//! the `uio-replay-plant` component (crate `replay`), which the launcher also asks to read the file
 //! before a run. Here only what the scenario alone can tell is checked: the map's sizes against
 //! `[plant]`, the options, and that the file exists. The data is open loop: it cannot react
 //! to a controller, so a scenario with one is refused.
@@ -16,7 +16,7 @@ use super::{ProcessSpec, quoted};
 use crate::check::{Bad, bad};
 
 /// The program that replays recorded data as the plant (a kit component built beside the launcher).
-pub const REPLAY_PLANT_PROGRAM: &str = "replay_plant";
+pub const REPLAY_PLANT_PROGRAM: &str = lockstep::programs::REPLAY_PLANT;
 
 /// The replayed plant as the process that runs it, and the data file's absolute path.
 /// `r` is the number of columns of D (the replayed v is zero: D v is in the recorded y).

@@ -15,7 +15,12 @@ pub fn bin_dir() -> PathBuf {
         .and_then(Path::parent)
         .expect("target/<profile>")
         .to_path_buf();
-    for b in ["launcher", "plant", "observer", "controller"] {
+    for b in [
+        "uio-launcher",
+        "uio-plant",
+        "uio-observer",
+        "uio-controller",
+    ] {
         assert!(
             dir.join(b).is_file(),
             "{} is missing: build the workspace binaries first (cargo test --release --workspace builds them)",
@@ -76,7 +81,7 @@ impl Drop for Scratch {
 /// `scripts/test.sh` makes (`.venv/`, with the Python kit) comes first in its `PATH`, so the
 /// Python components' `python3` finds the kit under plain `cargo test` too.
 pub fn launcher(scratch: &Scratch) -> Command {
-    let mut c = Command::new(bin_dir().join("launcher"));
+    let mut c = Command::new(bin_dir().join("uio-launcher"));
     c.env(lockstep_runs_env(), scratch.runs())
         .current_dir(&scratch.0);
     let venv = std::env::var_os("UIO_VENV")
@@ -97,7 +102,7 @@ pub fn lockstep_runs_env() -> &'static str {
     "UIO_RUNS_DIR"
 }
 
-/// Runs `launcher run <scenario> --out <scratch>/out` with extra args; returns the output.
+/// Runs `uio-launcher run <scenario> --out <scratch>/out` with extra args; returns the output.
 pub fn run(scratch: &Scratch, scenario: &Path, extra: &[&str]) -> Output {
     launcher(scratch)
         .arg("run")
@@ -299,7 +304,7 @@ pub fn variant(s: &Scratch, name: &str, seconds: f64, keep_expect: bool) -> Path
     p
 }
 
-/// Runs `launcher run <path> --out <scratch>/out <args>`; returns its exit code, its stderr and
+/// Runs `uio-launcher run <path> --out <scratch>/out <args>`; returns its exit code, its stderr and
 /// how long it took, and asserts that it left nothing behind (processes, shared memory).
 pub fn run_checked(
     s: &Scratch,

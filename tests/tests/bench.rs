@@ -1,4 +1,4 @@
-//! `launcher bench` measures its floor — a bare three-process ring over the same
+//! `uio-launcher bench` measures its floor — a bare three-process ring over the same
 //! transport — in the same session, and gives the multi-process figures as ratios to it.
 
 use tests::*;

@@ -1,4 +1,4 @@
-//! The shared library inside every observer FMU that `launcher export-fmu` writes: FMI 2.0 and
+//! The shared library inside every observer FMU that `uio-launcher export-fmu` writes: FMI 2.0 and
 //! FMI 3.0 co-simulation (one .so exports both APIs; the FMU's modelDescription says which one
 //! an importer uses).
 //!

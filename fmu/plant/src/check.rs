@@ -1,6 +1,6 @@
 //! The scenario's map checked against the FMU: every named variable exists, has the causality
 //! and type its role needs; the result is the value references the plant exchanges.
-//! `fmu_plant --check` runs this alone (the launcher's pre-flight).
+//! `uio-fmu-plant --check` runs this alone (the launcher's pre-flight).
 
 use std::path::Path;
 
@@ -139,7 +139,7 @@ pub fn resolve(p: &Params) -> Result<(Fmu, Map), String> {
     ))
 }
 
-/// `fmu_plant --check`: the map (the plant's `params`) on stdin; exit 0, or 2 with one line.
+/// `uio-fmu-plant --check`: the map (the plant's `params`) on stdin; exit 0, or 2 with one line.
 pub fn main() -> std::process::ExitCode {
     crate::request::answer(
         crate::request::read::<Params>("params")

@@ -15,7 +15,7 @@ use crate::log_capture;
 use crate::version::Version;
 
 /// An extracted FMU, its library ready to instantiate: extracted once however many instances
-/// are made of it (`launcher linearize` makes dozens).
+/// are made of it (`uio-launcher linearize` makes dozens).
 #[derive(Clone)]
 pub enum Archive {
     Two(Rc<Fmi2Import>),

@@ -1,4 +1,4 @@
-//! The floor of `launcher bench`: a bare ring of three processes over the same transport
+//! The floor of `uio-launcher bench`: a bare ring of three processes over the same transport
 //! (`lockstep` ports on iceoryx2, the same wait strategy and payload lengths as the seed-002
 //! closed loop's plant → observer → controller → plant), doing no work and recording nothing.
 //! Node 0 stands for the plant: it sends step k and waits for node 2's step k; the step time is

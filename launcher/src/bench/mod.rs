@@ -1,4 +1,4 @@
-//! `launcher bench`: the seed-002 closed loop (plant, two observers, controller) for N steps,
+//! `uio-launcher bench`: the seed-002 closed loop (plant, two observers, controller) for N steps,
 //! in one process and across processes, with and without recording — and, in the same session,
 //! its floor: a bare ring of three processes over the same transport ([`floor`]), against which
 //! the multi-process figures are given as ratios. Every repetition runs the floor and then each

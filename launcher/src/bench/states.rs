@@ -1,4 +1,4 @@
-//! `launcher bench --states N[,N…]`: how the cost of a step grows with the model. For each n, a
+//! `uio-launcher bench --states N[,N…]`: how the cost of a step grows with the model. For each n, a
 //! random stable plant (seeded, so every call measures the same plants) with a Chen–Patton UIO
 //! and a Luenberger observer in closed loop runs for the benchmark's steps in each mode; the
 //! table gives steps/s, the step's p50 and, with recording, the bytes written per step.

@@ -1,4 +1,4 @@
-//! `launcher agent …`: becomes `uio-bridge agent …` (exec), which serves the components a
+//! `uio-launcher agent …`: becomes `uio-bridge agent …` (exec), which serves the components a
 //! launcher on another host places here.
 
 use std::os::unix::process::CommandExt;

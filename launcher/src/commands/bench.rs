@@ -1,4 +1,4 @@
-//! `launcher bench`: the seed-002 closed loop against the bare iceoryx2 ring (the floor), in one
+//! `uio-launcher bench`: the seed-002 closed loop against the bare iceoryx2 ring (the floor), in one
 //! process and across processes, with and without recording; or (`--states`) how a step's cost
 //! grows with the model.
 

@@ -1,4 +1,4 @@
-//! `launcher compare`: two recordings signal by signal, step by step (bit for bit without
+//! `uio-launcher compare`: two recordings signal by signal, step by step (bit for bit without
 //! tolerances); exit 1 when they differ.
 
 use std::process::ExitCode;

@@ -1,4 +1,4 @@
-//! `launcher component` (hidden): a component's shell in this process, the fallback when its
+//! `uio-launcher component` (hidden): a component's shell in this process, the fallback when its
 //! binary is not installed beside the launcher.
 
 use std::process::ExitCode;

@@ -1,4 +1,4 @@
-//! `launcher design`: the existence conditions and the designs of a scenario, as text or JSON.
+//! `uio-launcher design`: the existence conditions and the designs of a scenario, as text or JSON.
 
 use std::process::ExitCode;
 

@@ -1,4 +1,4 @@
-//! `launcher export`: a recording's signals for other tools (CSV, MCAP, NumPy .npz, MATLAB .mat).
+//! `uio-launcher export`: a recording's signals for other tools (CSV, MCAP, NumPy .npz, MATLAB .mat).
 
 use std::path::Path;
 use std::process::ExitCode;

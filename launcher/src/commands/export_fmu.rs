@@ -1,4 +1,4 @@
-//! `launcher export-fmu`: one of a scenario's observers as an FMI 2.0 or 3.0 co-simulation FMU.
+//! `uio-launcher export-fmu`: one of a scenario's observers as an FMI 2.0 or 3.0 co-simulation FMU.
 //!
 //! Orchestration only: the observer is designed exactly as a run designs it
 //! ([`launcher::plan::design_observer`]), and crate `fmu-export` writes its matrices, the

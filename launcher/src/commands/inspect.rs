@@ -1,4 +1,4 @@
-//! `launcher inspect`: what a recording holds, its figures recomputed from the recorded data.
+//! `uio-launcher inspect`: what a recording holds, its figures recomputed from the recorded data.
 
 use std::process::ExitCode;
 

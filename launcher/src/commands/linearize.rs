@@ -1,8 +1,8 @@
-//! `launcher linearize <scenario> [--trim] --out DIR`: the sampled model of a scenario's FMU
+//! `uio-launcher linearize <scenario> [--trim] --out DIR`: the sampled model of a scenario's FMU
 //! plant at its operating point, made from the FMU itself.
 //!
 //! Orchestration only: crate `scenario` reads what is needed and writes the result
-//! (`scenario::linearized`), the FMU plant program computes it (`fmu_plant --linearize`, its
+//! (`scenario::linearized`), the FMU plant program computes it (`uio-fmu-plant --linearize`, its
 //! module `linearize`: trim by Newton's method, central differences with Richardson's
 //! extrapolation). This prints the report: the trim, the point, each matrix's estimated
 //! difference error, and a direct feedthrough the sampled model has no place for.
@@ -16,7 +16,7 @@ use crate::cli::LinearizeArgs;
 use scenario::linearized::{self, Linearized};
 use serde_json::Value;
 
-const PROGRAM: &str = "fmu_plant";
+const PROGRAM: &str = lockstep::programs::FMU_PLANT;
 
 fn rows(v: &Value) -> Vec<Vec<f64>> {
     v["rows"]
@@ -55,7 +55,7 @@ pub fn command(a: LinearizeArgs) -> Result<ExitCode, LaunchError> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Runs `launcher linearize`; the scenario written.
+/// Runs `uio-launcher linearize`; the scenario written.
 pub fn linearize(path: &Path, trim: bool, out: &Path) -> Result<PathBuf, LaunchError> {
     let req = linearized::request(path)?;
     let answer = launcher::run::preflight::sibling(

@@ -1,4 +1,4 @@
-//! `launcher list`: the shipped scenarios, one line each.
+//! `uio-launcher list`: the shipped scenarios, one line each.
 
 use std::process::ExitCode;
 

@@ -1,4 +1,4 @@
-//! `launcher plot`: a recording's views as PNG files.
+//! `uio-launcher plot`: a recording's views as PNG files.
 
 use std::process::ExitCode;
 

@@ -1,4 +1,4 @@
-//! `launcher replay`: observers on a run's recorded plant samples, the plant replayed from the
+//! `uio-launcher replay`: observers on a run's recorded plant samples, the plant replayed from the
 //! recording, the controller removed (open loop).
 
 use std::path::Path;

@@ -1,4 +1,4 @@
-//! `launcher run`: a scenario, recorded to DIR/<name>.rrd and DIR/<name>.summary.json.
+//! `uio-launcher run`: a scenario, recorded to DIR/<name>.rrd and DIR/<name>.summary.json.
 
 use std::process::ExitCode;
 

@@ -1,4 +1,4 @@
-//! `launcher sweep`: N noise realisations (seeds S, S+1, …), DIR/<name>.sweep.json; with
+//! `uio-launcher sweep`: N noise realisations (seeds S, S+1, …), DIR/<name>.sweep.json; with
 //! `--shard K/N` one shard of them (DIR/<name>.shard-K-of-N.json), and `sweep merge` the shards
 //! into the sweep they make.
 

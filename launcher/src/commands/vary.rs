@@ -1,4 +1,4 @@
-//! `launcher sweep --vary`: the scenario at points where the simulated plant differs from the
+//! `uio-launcher sweep --vary`: the scenario at points where the simulated plant differs from the
 //! design model (`launcher::vary`), its table, CSV, JSON and plots.
 
 use std::path::Path;

@@ -1,4 +1,4 @@
-//! `launcher design`: every condition with its value and verdict, the design matrices under the
+//! `uio-launcher design`: every condition with its value and verdict, the design matrices under the
 //! papers' names, the observer and closed-loop eigenvalues (continuous and sampled), warnings.
 //!
 //! One typed value, [`DesignReport`], made once by [`report`] (every design made once, as a run

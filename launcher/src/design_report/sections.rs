@@ -17,7 +17,7 @@ pub struct DesignReport {
     pub banks: Option<Result<Vec<diagnosis::Bank>, String>>,
     pub controller: ControllerSection,
     pub warnings: Vec<String>,
-    /// Whether everything was designed (and the loop is stable): `launcher design` exits 0.
+    /// Whether everything was designed (and the loop is stable): `uio-launcher design` exits 0.
     pub ok: bool,
 }
 

@@ -67,7 +67,7 @@ pub fn matrix(name: &str, m: &Mat) -> String {
         s.push_str(" =\n");
     } else {
         s.push_str(&format!(
-            " = ({rows}×{cols}: its first and last {EDGE} rows and columns; every entry in `launcher design --json`)\n"
+            " = ({rows}×{cols}: its first and last {EDGE} rows and columns; every entry in `uio-launcher design --json`)\n"
         ));
     }
     for i in &row_ix {

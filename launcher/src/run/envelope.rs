@@ -29,8 +29,8 @@ pub enum Program {
 /// other hosts, so that Zenoh stays out of the launcher.
 pub fn bridge_path() -> std::path::PathBuf {
     std::env::current_exe()
-        .unwrap_or_else(|_| "launcher".into())
-        .with_file_name("uio-bridge")
+        .unwrap_or_else(|_| lockstep::programs::LAUNCHER.into())
+        .with_file_name(lockstep::programs::BRIDGE)
 }
 
 /// A component ready to be started.

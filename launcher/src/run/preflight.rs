@@ -1,5 +1,5 @@
 //! Before a run whose plant is one of our data- or FMU-reading components: the component that
-//! will read the file (`fmu_plant --check`, `replay_plant --check`) reads it against the
+//! will read the file (`uio-fmu-plant --check`, `uio-replay-plant --check`) reads it against the
 //! scenario's map, so that a bad file is refused with exit 2 and one line before any process,
 //! shared memory or output exists.
 //!
@@ -19,7 +19,7 @@ use scenario::{FMU_PLANT_PROGRAM, REPLAY_PLANT_PROGRAM, Scenario};
 
 use crate::error::LaunchError;
 
-/// Exit 2 with `fmu_plant`'s one line when the FMU cannot be this scenario's plant.
+/// Exit 2 with `uio-fmu-plant`'s one line when the FMU cannot be this scenario's plant.
 pub fn fmu(s: &Scenario) -> Result<(), LaunchError> {
     let (Some(_), Some(spec)) = (&s.plant_fmu, &s.plant_process) else {
         return Ok(());
@@ -35,7 +35,7 @@ pub fn fmu(s: &Scenario) -> Result<(), LaunchError> {
     .map(drop)
 }
 
-/// The facts `replay_plant --check` reports, or exit 2 with its one line when the data cannot
+/// The facts `uio-replay-plant --check` reports, or exit 2 with its one line when the data cannot
 /// be this scenario's plant.
 pub fn replay(s: &Scenario) -> Result<Option<serde_json::Value>, LaunchError> {
     let (Some(_), Some(spec)) = (&s.plant_replay, &s.plant_process) else {
@@ -61,7 +61,7 @@ pub fn replay(s: &Scenario) -> Result<Option<serde_json::Value>, LaunchError> {
 /// logs the caps allow; a hostile file must not hold the launcher longer.
 pub const CHECK_TIMEOUT: Duration = Duration::from_secs(120);
 
-/// How long `fmu_plant --linearize` may take (2(n + l + q) + 1 FMU simulations of one sample
+/// How long `uio-fmu-plant --linearize` may take (2(n + l + q) + 1 FMU simulations of one sample
 /// each, twice for Richardson's extrapolation, and the trim's Newton steps).
 pub const LINEARIZE_TIMEOUT: Duration = Duration::from_secs(1800);
 
@@ -113,7 +113,7 @@ fn check_timeout() -> Result<Duration, LaunchError> {
 /// `program flag` (a kit component built beside the launcher, of cargo package `package`) with
 /// `input` as JSON on stdin: its stdout, or its reason on stderr as bad input of `file`.
 /// `field` heads this function's own messages and the component's line. `--check` here, and
-/// `fmu_plant --linearize` for `launcher linearize`.
+/// `uio-fmu-plant --linearize` for `uio-launcher linearize`.
 ///
 /// The child runs in a process group of its own with its address space capped
 /// ([`SIBLING_ADDRESS_SPACE`]); past `timeout`, or on SIGINT/SIGTERM/SIGHUP/SIGQUIT to the
@@ -129,7 +129,7 @@ pub fn sibling(
 ) -> Result<Vec<u8>, LaunchError> {
     use std::os::unix::process::CommandExt;
     let exe = std::env::current_exe()
-        .unwrap_or_else(|_| "launcher".into())
+        .unwrap_or_else(|_| lockstep::programs::LAUNCHER.into())
         .with_file_name(program);
     let path = if exe.is_file() { exe } else { program.into() };
     let bad = |why: String| LaunchError::BadInput(format!("{}: {}{why}", file.display(), field[0]));

@@ -1,4 +1,4 @@
-//! `launcher sweep`: Monte Carlo over the noise. Realisation i runs the scenario with seed
+//! `uio-launcher sweep`: Monte Carlo over the noise. Realisation i runs the scenario with seed
 //! S + i (S = `--seed`, or the scenario's `seed`), without a recording; the figures of every
 //! realisation are gathered into distributions: detection delay, isolation accuracy,
 //! false-alarm rate per hour of fault-free simulated time, each residual's measured exceedance
@@ -53,7 +53,7 @@ pub struct SweepOptions {
 }
 
 /// What a sweep's statistics are gathered against: the scenario's names, and the sweep asked
-/// for. A shard file carries it, and `launcher sweep merge` gathers with it alone.
+/// for. A shard file carries it, and `uio-launcher sweep merge` gathers with it alone.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct Frame {
     /// Scenario name.

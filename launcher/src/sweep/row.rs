@@ -1,6 +1,6 @@
 //! What a sweep keeps of a realisation: the figures its statistics and its choice of the worst
 //! realisations are made of, and nothing else. A shard writes these rows to its file and
-//! `launcher sweep merge` reads them back (JSON numbers read back to the same bits: serde_json's
+//! `uio-launcher sweep merge` reads them back (JSON numbers read back to the same bits: serde_json's
 //! `float_roundtrip`), so the merged statistics are computed from the same values, in the same
 //! order, as the unsharded sweep's.
 

@@ -3,7 +3,7 @@
 //!
 //! Shard K of N runs realisations ⌊(K − 1)·R/N⌋ … ⌊K·R/N⌋ − 1 of the R asked for (seeds S + i),
 //! keeps its own worst with their recordings, and writes `<name>.shard-K-of-N.json`: the sweep's
-//! [`Frame`], the scenario's digest, and one [`Row`] per completed realisation. `launcher sweep
+//! [`Frame`], the scenario's digest, and one [`Row`] per completed realisation. `uio-launcher sweep
 //! merge` checks that the files are the N shards of one sweep, each once and none interrupted,
 //! puts their rows back in seed order and gathers them as the unsharded sweep does: the same
 //! values in the same order give the same statistics, bit for bit, and the same worst
@@ -281,7 +281,7 @@ fn read(path: &Path) -> Result<ShardFile, LaunchError> {
     let f: ShardFile = serde_json::from_str(&text).map_err(|e| {
         bad(
             path,
-            format!("not a sweep shard file (`launcher sweep … --shard K/N` writes them): {e}"),
+            format!("not a sweep shard file (`uio-launcher sweep … --shard K/N` writes them): {e}"),
         )
     })?;
     if f.format != FORMAT {

@@ -1,4 +1,4 @@
-//! `launcher sweep --vary`: how far the observers hold when the plant is not the model.
+//! `uio-launcher sweep --vary`: how far the observers hold when the plant is not the model.
 //!
 //! The observers, banks, thresholds and controller are designed once, on the scenario's model
 //! (the nominal plan); each point of the variation runs the same scenario with the simulated

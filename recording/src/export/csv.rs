@@ -1,4 +1,4 @@
-//! `launcher export --csv DIR`: one CSV per entity group (e.g. `/observer/uio/error` →
+//! `uio-launcher export --csv DIR`: one CSV per entity group (e.g. `/observer/uio/error` →
 //! `observer_uio_error.csv`) with columns `step,sim_time,<member>…`, each member headed by its
 //! name and unit from the recorded scenario (`eta [rad]`, `e3 [rad]`, `plant->observer/uio [ns]`).
 //! Floats are written in Rust's shortest round-trip form, so they parse back to the same bits;

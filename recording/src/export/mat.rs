@@ -1,4 +1,4 @@
-//! `launcher export --mat FILE`: a MATLAB level-5 MAT-file (`load` in MATLAB, `scipy.io.loadmat`)
+//! `uio-launcher export --mat FILE`: a MATLAB level-5 MAT-file (`load` in MATLAB, `scipy.io.loadmat`)
 //! with the arrays of the npz export ([`super::npz`]): `step` (int64) and `t` (sim_time in s,
 //! NaN without `dt`) as column vectors over every step of the recording, and one double matrix
 //! per entity group, steps × members, named by its path (`observer_uio_xhat`); NaN where a
@@ -32,7 +32,7 @@ const MX_INT64_CLASS: u32 = 14;
 /// The 128-byte file header: text, no subsystem data, version 0x0100, "IM" (little-endian).
 pub fn file_header() -> [u8; 128] {
     let mut h = [b' '; 128];
-    let text = b"MATLAB 5.0 MAT-file, written by uio-observers (launcher export)";
+    let text = b"MATLAB 5.0 MAT-file, written by uio-observers (uio-launcher export)";
     h[..text.len()].copy_from_slice(text);
     h[116..124].fill(0);
     h[124..126].copy_from_slice(&0x0100u16.to_le_bytes());

@@ -1,4 +1,4 @@
-//! `launcher export --mcap FILE`: an MCAP file for Foxglove and PlotJuggler, which both read
+//! `uio-launcher export --mcap FILE`: an MCAP file for Foxglove and PlotJuggler, which both read
 //! JSON messages described by a JSON Schema. One channel per entity group, its topic the group's
 //! path (`/observer/uio/xhat`); one message per step at which the group has a value, stamped
 //! (log and publish time) with sim_time in ns as the `.rrd` stamps it (round(k·dt·1e9); the

@@ -1,4 +1,4 @@
-//! `launcher export`: a recording's signals for other tools, one file (or directory) per
+//! `uio-launcher export`: a recording's signals for other tools, one file (or directory) per
 //! format, each in its own module — [`csv`] (one CSV per entity group), [`mcap`] (Foxglove,
 //! PlotJuggler), [`npz`] (NumPy) and [`mat`] (MATLAB, scipy.io.loadmat). Every format groups
 //! the series the same way ([`table::groups`]) and gives a member no value where CSV leaves its

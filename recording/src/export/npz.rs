@@ -1,4 +1,4 @@
-//! `launcher export --npz FILE`: a NumPy `.npz` (a zip of `.npy` files, stored uncompressed as
+//! `uio-launcher export --npz FILE`: a NumPy `.npz` (a zip of `.npy` files, stored uncompressed as
 //! `numpy.savez` writes it) holding `step` (int64) and `t` (sim_time in s, float64; NaN when
 //! the recording has no `dt`) over every step of the recording, and one float64 array per entity
 //! group, steps × members, named by the group's path (`/observer/uio/xhat` →

@@ -1,13 +1,13 @@
-//! What `launcher plot` draws: entities chosen by glob (`--signals '/observer/uio/**'`) and a
+//! What `uio-launcher plot` draws: entities chosen by glob (`--signals '/observer/uio/**'`) and a
 //! time window (`--from`, `--to`).
 
 use crate::globs::Globs;
 
-/// What `launcher plot` draws: the choice of signals and time.
+/// What `uio-launcher plot` draws: the choice of signals and time.
 #[derive(Debug, Clone, Default)]
 pub struct PlotSelection {
     /// Entity globs; empty means every entity. `*` matches within one path segment, `**` any
-    /// number of segments (as `launcher run --record`).
+    /// number of segments (as `uio-launcher run --record`).
     pub signals: Vec<String>,
     /// First time drawn, s (steps for a recording without its scenario).
     pub from: Option<f64>,
@@ -36,7 +36,7 @@ impl PlotSelection {
         {
             return Err(format!("--from {a} must be before --to {b}"));
         }
-        // The rules of `launcher run --record`: `*` stops at '/', a leading '/' is implied.
+        // The rules of `uio-launcher run --record`: `*` stops at '/', a leading '/' is implied.
         let globs = if self.signals.is_empty() {
             None
         } else {

@@ -1,5 +1,5 @@
-//! `fmu_plant --linearize`: the sampled linear model of an FMU at an operating point, made
-//! from the FMU itself (the machinery behind `launcher linearize`).
+//! `uio-fmu-plant --linearize`: the sampled linear model of an FMU at an operating point, made
+//! from the FMU itself (the machinery behind `uio-launcher linearize`).
 //!
 //! The FMU's one-sample map, from the state x at t = 0 with u and w held over one sample
 //! (`substeps` doStep calls of dt / substeps, as the FMU plant steps it), is
@@ -87,7 +87,7 @@ fn run(req: &Request) -> Result<Answer, String> {
     })
 }
 
-/// `fmu_plant --linearize`: the request on stdin, the answer (JSON) on stdout; exit 2 with one
+/// `uio-fmu-plant --linearize`: the request on stdin, the answer (JSON) on stdout; exit 2 with one
 /// line for a request the FMU cannot answer.
 pub fn main() -> std::process::ExitCode {
     let answer = crate::request::read::<Request>("request").and_then(|r| run(&r));

@@ -1,4 +1,4 @@
-//! What `fmu_plant --linearize` reads (the request, JSON on stdin) and writes (the answer).
+//! What `uio-fmu-plant --linearize` reads (the request, JSON on stdin) and writes (the answer).
 
 use serde::{Deserialize, Serialize};
 

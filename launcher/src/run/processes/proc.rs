@@ -101,8 +101,8 @@ pub(super) fn stop_all(procs: &mut [Proc]) {
 /// The command that starts a component: its binary next to the launcher's, or, when only the
 /// launcher was built (`cargo run`), the launcher itself in component mode.
 fn component_command(kind: &str) -> Command {
-    let exe = std::env::current_exe().unwrap_or_else(|_| "launcher".into());
-    let sibling = exe.with_file_name(kind);
+    let exe = std::env::current_exe().unwrap_or_else(|_| lockstep::programs::LAUNCHER.into());
+    let sibling = exe.with_file_name(lockstep::programs::builtin(kind));
     if sibling.is_file() {
         Command::new(sibling)
     } else {
@@ -113,14 +113,21 @@ fn component_command(kind: &str) -> Command {
 }
 
 /// An external command's program: a bare name (no `/`) of a program built beside the launcher —
-/// a kit component of this workspace — is that one; anything else as given (a bare name then
+/// a kit component of this workspace, also by its name before the `uio-` names
+/// ([`lockstep::programs::renamed`]) — is that one; anything else as given (a bare name then
 /// goes through `PATH`, a relative path from the scenario's folder).
 fn program_path(program: &str, workdir: &Path) -> std::path::PathBuf {
     if !program.contains('/') {
         if let Ok(exe) = std::env::current_exe() {
-            let sibling = exe.with_file_name(program);
-            if sibling.is_file() {
-                return sibling;
+            // The renamed program first: a build directory may still hold the old binary.
+            let names = lockstep::programs::renamed(program)
+                .into_iter()
+                .chain(std::iter::once(program.to_string()));
+            for name in names {
+                let sibling = exe.with_file_name(name);
+                if sibling.is_file() {
+                    return sibling;
+                }
             }
         }
         return program.into();

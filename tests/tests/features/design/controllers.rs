@@ -5,7 +5,7 @@ use controller::design::{Domain, FeedbackSpec};
 use lti::C64;
 use tests::*;
 
-/// The sorted sampled closed-loop poles of `launcher design --json`, against e^{p·dt} of the
+/// The sorted sampled closed-loop poles of `uio-launcher design --json`, against e^{p·dt} of the
 /// poles the file asks for: to 1e-12 (relative to 1) for every shipped closed-loop scenario that
 /// places its poles for the sampled loop (the default).
 #[test]

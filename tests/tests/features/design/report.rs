@@ -1,6 +1,6 @@
-//! `launcher design` reports conditions, matrices and poles (text and JSON), and a model
+//! `uio-launcher design` reports conditions, matrices and poles (text and JSON), and a model
 //! without an unknown-input observer is refused with the condition named, exit 2, by both
-//! `launcher design` and `launcher run`.
+//! `uio-launcher design` and `uio-launcher run`.
 
 use tests::*;
 
@@ -223,7 +223,7 @@ fn design_json_sampled_matrices_reproduce_the_recorded_estimates() {
     }
 }
 
-/// `launcher design` exits non-zero whenever something the run needs cannot be designed: an
+/// `uio-launcher design` exits non-zero whenever something the run needs cannot be designed: an
 /// observer whose condition fails, like a bank member or an unstable loop, and 0 otherwise.
 #[test]
 fn design_exits_non_zero_when_an_observer_fails() {

@@ -453,7 +453,7 @@ fn a_calibrated_threshold_is_the_margin_times_the_fault_free_maximum() {
 }
 
 /// `--keep-worst K` runs the K worst realisations again with their recordings — the same runs,
-/// bit for bit, as `launcher run --seed` gives; `--runs 0` is bad input.
+/// bit for bit, as `uio-launcher run --seed` gives; `--runs 0` is bad input.
 #[test]
 fn a_sweep_keeps_its_worst_realisations_as_recordings() {
     let name = "seed003-sensor-faults";
@@ -560,7 +560,7 @@ fn non_decoupling_bank_under_a_disturbance_is_warned() {
 
 /// Isolation over the whole fault. The camera-offset bias through a bank of UIOs is
 /// isolated at its first alarm, then its residual 2 returns to zero and the pattern matches no
-/// channel: `launcher design` warns that y1 (and y2) are isolable only during transients, and
+/// channel: `uio-launcher design` warns that y1 (and y2) are isolable only during transients, and
 /// the summary's shares of the fault's time — isolated correctly, as another channel, unknown, no
 /// alarm — equal those counted from the recorded isolation signal, for the bias and for the
 /// look-ahead drift (a ramp) alike; `correct` holds only for a share ≥ `isolated_fraction`.

@@ -1,7 +1,7 @@
 //! A sweep cut into shards (`--shard K/N`, each in a folder of its own, as a Slurm array's tasks
-//! would run them) and merged (`launcher sweep merge`) is the unsharded sweep: the same
+//! would run them) and merged (`uio-launcher sweep merge`) is the unsharded sweep: the same
 //! statistics bit for bit (every field of `<name>.sweep.json` but the wall time), the same worst
-//! realisations, and their recordings the same runs (`launcher compare`: bit for bit). Shard
+//! realisations, and their recordings the same runs (`uio-launcher compare`: bit for bit). Shard
 //! files that do not make one whole sweep are refused with one line and exit 2.
 
 use std::path::{Path, PathBuf};

@@ -1,4 +1,4 @@
-//! `launcher plot` stays inside its axes, draws one colour per observer,
+//! `uio-launcher plot` stays inside its axes, draws one colour per observer,
 //! an |e| view on a log axis, and what `--signals`, `--from` and `--to` select; every signal is
 //! numbered from 1 and named with its unit in plots and CSV headers.
 

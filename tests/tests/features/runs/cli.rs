@@ -81,7 +81,7 @@ fn a_shipped_scenario_is_run_by_its_name() {
     let (_, err) = text(&out);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
-        err.contains("no-such-scenario") && err.contains("launcher list"),
+        err.contains("no-such-scenario") && err.contains("uio-launcher list"),
         "{err}"
     );
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");

@@ -157,7 +157,7 @@ fn default_command_runs_seed002_sine() {
         s.join("scenarios/seed002-sine.toml"),
     )
     .unwrap();
-    let out = Command::new(bin_dir().join("launcher"))
+    let out = Command::new(bin_dir().join("uio-launcher"))
         .env(lockstep_runs_env(), s.runs())
         .current_dir(&s.0)
         .output()

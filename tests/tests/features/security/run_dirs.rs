@@ -87,7 +87,7 @@ fn assert_victim_intact(path: &Path) {
     assert_eq!(fs::read_to_string(path.join("file")).unwrap(), "precious");
 }
 
-/// Runs `launcher run <scenario>` with `runs` as UIO_RUNS_DIR (None: unset, with `env` added),
+/// Runs `uio-launcher run <scenario>` with `runs` as UIO_RUNS_DIR (None: unset, with `env` added),
 /// killing it if it is not done by [`DEADLINE`].
 fn run_launcher(
     s: &Scratch,

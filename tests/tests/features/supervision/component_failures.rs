@@ -223,10 +223,11 @@ fn four_parallel_runs_give_what_each_gives_alone() {
 
 #[test]
 fn components_started_by_hand_say_how_to_start_them() {
-    for bin in ["plant", "observer", "controller"] {
+    for kind in ["plant", "observer", "controller"] {
+        let bin = lockstep::programs::builtin(kind);
         for args in [&[][..], &["--run", "nosuchrun1", "--name", "x"][..]] {
             let started = Instant::now();
-            let out = Command::new(bin_dir().join(bin))
+            let out = Command::new(bin_dir().join(&bin))
                 .args(args)
                 .stdin(Stdio::null())
                 .output()
