@@ -50,6 +50,8 @@ cargo fmt --all --check >/dev/null || { echo "cargo fmt --all --check: the sourc
 # No import circle between the files of a crate (each file's uses resolved to the file that
 # defines the item).
 python3 scripts/check-imports.py
+# No function over 120 lines outside tests, unless a `// one job:` comment says why it is one.
+python3 scripts/check-functions.py
 
 # The multi-process tests start the component binaries: build them all first.
 cargo build --release --workspace --bins

@@ -48,6 +48,8 @@ pub fn run(host: &str, connect: &str, builtin: &str) -> i32 {
     }
 }
 
+// one job: one remote component's life seen from this host (link, config hand-over, relay, exit
+// code): its stages share the link and one cleanup path.
 fn proxy(host: &str, connect: &str, builtin: &str) -> Result<i32, String> {
     let path = std::env::var("UIO_CONFIG")
         .map_err(|_| "UIO_CONFIG is not set: the proxy is started by the launcher".to_string())?;

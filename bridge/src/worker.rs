@@ -71,6 +71,8 @@ pub fn run(connect: &str, credentials: Option<&std::path::Path>) -> i32 {
     code
 }
 
+// one job: one component request served on the agent's host (spawn, relay, wait, clean up): every
+// exit path shares the same locals and cleanup.
 fn serve(
     connect: &str,
     credentials: Option<&std::path::Path>,

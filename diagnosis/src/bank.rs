@@ -112,6 +112,8 @@ pub fn role(spec: &DiagnoserSpec, labels: &[String], i: usize) -> String {
 }
 
 /// Designs every member, computes the structure matrix and each member's threshold.
+// one job: a bank's design: its members, then the structure, the DC structure and the thresholds,
+// all from the same members.
 pub fn design_bank(
     spec: &DiagnoserSpec,
     model: &Model,

@@ -359,6 +359,7 @@ impl Summary {
     }
 
     /// The table printed after a run.
+    // one job: the table printed after a run, section by section in print order.
     pub fn table(&self) -> String {
         let mut t = String::new();
         let us = |ns: u64| format!("{:.1} µs", ns as f64 / 1000.0);

@@ -118,6 +118,8 @@ pub struct Plant {
 
 impl Plant {
     /// Precomputes the transition matrices; fails on inconsistent sizes.
+    // one job: the plant's precomputed transition matrices, built once from a config whose every size
+    // is checked where it is used.
     pub fn new(cfg: &PlantConfig) -> Result<Self, String> {
         let a: DMatrix<f64> = (&cfg.a).into();
         let b: DMatrix<f64> = (&cfg.b).into();

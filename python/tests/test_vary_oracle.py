@@ -184,3 +184,22 @@ def test_a_bad_vary_is_refused_with_one_line(scenario, tmp_path, args, says):
     # The reason on the first line (clap adds its "For more information" line to its own).
     assert says in done.stderr.splitlines()[0], done.stderr
     assert not (tmp_path / "bad" / "mismatch.vary.csv").exists()
+
+
+def test_the_python_package_varies_as_the_launcher_does(scenario, tmp_path):
+    import uio_observers as uo
+
+    varies = ["A[2,1] *= [0.5, 1.5]", "A[2,2] = U(-3.5, -2.5)"]
+    cli = run(["sweep", str(scenario), *sum((["--vary", v] for v in varies), []), "--points", "3", "--jobs", "1",
+               "--out", str(tmp_path / "cli")])
+    assert cli.returncode == 0, cli.stderr
+    got = uo.sweep(scenario, vary=varies, points=3, out=tmp_path / "py")
+    assert got.summary == json.loads((tmp_path / "cli" / "mismatch.vary.json").read_text())
+    for f in ("mismatch.vary.csv", "mismatch.vary.json"):
+        assert (tmp_path / "py" / f).read_bytes() == (tmp_path / "cli" / f).read_bytes(), f
+    assert got.table in cli.stdout
+    assert len(list((tmp_path / "py").glob("*.png"))) == len(list((tmp_path / "cli").glob("*.png")))
+    with pytest.raises(ValueError, match="not one of the plant's matrices"):
+        uo.sweep(scenario, vary="Q *= [1]")
+    with pytest.raises(ValueError, match="a noise sweep's"):
+        uo.sweep(scenario, vary=varies[0], runs=5)

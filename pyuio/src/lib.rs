@@ -147,6 +147,58 @@ fn sweep_merge(
     Ok((json, sw.table(), path.display().to_string()))
 }
 
+/// `uio-launcher sweep PATH --vary V… --points POINTS [--seed SEED] --jobs JOBS --out OUT`: (the
+/// variation's JSON, its table). The CSV, JSON and plots are written into `out`.
+#[pyfunction]
+#[pyo3(signature = (path, varies, points, seed, jobs, out))]
+fn vary(
+    py: Python<'_>,
+    path: &str,
+    varies: Vec<String>,
+    points: usize,
+    seed: Option<u64>,
+    jobs: usize,
+    out: &str,
+) -> PyResult<(String, String)> {
+    let varies = varies
+        .iter()
+        .map(|v| v.parse::<launcher::vary::spec::Vary>())
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| PyValueError::new_err(format!("vary: {e}")))?;
+    if varies.is_empty() {
+        return Err(PyValueError::new_err("vary: give at least one"));
+    }
+    if !(1..=launcher::vary::MAX_POINTS).contains(&points) {
+        return Err(PyValueError::new_err(format!(
+            "points: 1 … {}",
+            launcher::vary::MAX_POINTS
+        )));
+    }
+    launcher::limits::jobs(jobs).map_err(raise)?;
+    let mut s = scenario(path, None).map_err(raise)?;
+    if let Some(seed) = seed {
+        s.seed = seed;
+    }
+    // Designed (and calibrated) once, on the nominal model, as the launcher does.
+    let p = launcher::calibrate::planned(&s).map_err(raise)?;
+    let opts = launcher::vary::VaryOptions {
+        varies,
+        draws: points,
+        seed: s.seed,
+        jobs,
+        out: PathBuf::from(out),
+        wait: lockstep::Wait::default_for_machine(),
+    };
+    let outcomes = py
+        .detach(|| launcher::vary::vary(&s, &p, &opts))
+        .map_err(raise)?;
+    let written =
+        launcher::vary::report::write(&opts.out, &s, &opts.varies, &outcomes).map_err(raise)?;
+    let jobs = launcher::vary::mode_of(&s, jobs).1.clamp(1, outcomes.len());
+    let table = launcher::vary::report::table(&s.name, &opts.varies, s.seed, jobs, &outcomes);
+    Ok((written.json_text, table))
+}
+
 /// One entity group of a recording: its path, its members' names and labelled names, and its
 /// values row by row (steps × members, NaN where a member has no value at a step).
 type Group<'py> = (String, Vec<String>, Vec<String>, Bound<'py, PyBytes>);
@@ -201,5 +253,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_shard, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_merge, m)?)?;
+    m.add_function(wrap_pyfunction!(vary, m)?)?;
     Ok(())
 }

@@ -19,7 +19,7 @@ import numpy as np
 
 from . import _native
 
-__all__ = ["design", "design_scenario", "run", "read", "sweep", "Design", "Recording", "RunResult",
+__all__ = ["design", "design_scenario", "run", "read", "sweep", "Design", "Recording", "RunResult", "VaryResult",
            "SweepResult"]
 
 
@@ -265,11 +265,39 @@ def _shard(scenario, runs, seed, k, n, keep_worst, jobs, out):
     return native.sweep_shard(scenario, runs, seed, k, n, keep_worst, jobs, folder)
 
 
+class VaryResult:
+    """A variation (`sweep(…, vary=…)`): `summary` (`<name>.vary.json` as a dict: per point its
+    values, status and figures; per figure its worst point), `table` (what `uio-launcher sweep
+    --vary` prints) and `path` (the folder holding the CSV, JSON and PNGs, None when temporary)."""
+
+    def __init__(self, summary, table, path):
+        self.summary, self.table, self.path = json.loads(summary), table, path
+
+    def __repr__(self):
+        return self.table
+
+
+def _vary(scenario, vary, points, seed, jobs, out):
+    if isinstance(vary, str):
+        vary = [vary]
+    if out is not None:
+        folder = os.path.abspath(os.fspath(out))
+        os.makedirs(folder, exist_ok=True)
+        return VaryResult(*_native.vary(scenario, list(vary), points, seed, jobs, folder), folder)
+    with tempfile.TemporaryDirectory(prefix="uio-vary-") as tmp:
+        return VaryResult(*_native.vary(scenario, list(vary), points, seed, jobs, tmp), None)
+
+
 def sweep(scenario, runs=100, *, seed=None, keep_worst=0, shards=None, client=None, out=None,
-          jobs=1):
+          jobs=1, vary=None, points=20):
     """Monte Carlo over the noise, as `uio-launcher sweep` (realisation i has seed S + i, S = `seed`
     or the scenario's): returns a SweepResult equal to `uio-launcher sweep`'s, field by field but the
     wall time and the jobs.
+
+    With `vary` (one `--vary` text or a list of them, e.g. `"A[2,3] *= 0.8..1.2:5"` or
+    `"plant.fmu.parameters.J *= [0.5, 2]"`), the plant is varied instead, as `uio-launcher sweep
+    --vary` (`points` draws of a distribution, `jobs` threads): returns a VaryResult equal to its
+    JSON. A variation runs here (`runs`, `keep_worst`, `shards` and `client` are a noise sweep's).
 
     The realisations run in `shards` shards (`uio-launcher sweep --shard K/N`), each in one process
     with `jobs` threads: on `client`'s workers when it is a `dask.distributed.Client` (one task
@@ -281,6 +309,11 @@ def sweep(scenario, runs=100, *, seed=None, keep_worst=0, shards=None, client=No
     Without `out` a temporary folder holds the shards and the result (`path` None after)."""
     scenario = os.path.abspath(os.fspath(scenario)) if os.path.exists(os.fspath(scenario)) \
         else os.fspath(scenario)
+    if vary is not None:
+        if client is not None or shards is not None or keep_worst or runs != 100:
+            raise ValueError("vary: a variation runs each point once, here; runs, keep_worst, shards "
+                             "and client are a noise sweep's")
+        return _vary(scenario, vary, points, seed, jobs, out)
     if shards is None:
         shards = 1 if client is None else 4 * max(1, len(client.scheduler_info().get("workers", {})))
     shards = max(1, min(int(shards), int(runs)))

@@ -116,6 +116,7 @@ fn sanitize(s: &str) -> String {
 /// The longest name a plot's file name carries.
 const NAME_IN_FILE: usize = 64;
 
+// one job: the plot views of a recording, one arm per view in the order `plot` writes them.
 fn views(r: &Recording, s: Option<&Scenario>, observers: &[String]) -> Vec<View> {
     let named = |path: &str| {
         signals::named(s, path).unwrap_or_else(|| Named {

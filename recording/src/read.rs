@@ -71,6 +71,8 @@ pub struct ReadError {
 /// allocated beyond what the file holds ([`frames`], [`payload`]) and a panic inside Rerun's
 /// decoder is caught ([`unwind`]): any damage gives [`Integrity::Damaged`] for a file its
 /// writer finished, or an incomplete recording of what was read for one it did not.
+// one job: one .rrd decoded end to end, its bounds checked where its bytes come, and one verdict on
+// its integrity.
 pub fn read(path: &Path) -> Result<Recording, ReadError> {
     let err = |reason: String| ReadError {
         path: path.display().to_string(),

@@ -33,6 +33,7 @@ struct Channel {
 }
 
 /// Reads the MCAP log the parameters name.
+// one job: one MCAP log read end to end, its bounds checked where its bytes come.
 pub fn load(p: &Params) -> Result<Table, String> {
     let file = p.file();
     let bytes = std::fs::read(&p.path).map_err(|e| format!("{file}: {e}"))?;

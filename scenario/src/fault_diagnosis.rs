@@ -121,6 +121,8 @@ fn on_sample(field: &str, t: f64, dt: f64) -> Result<f64, Bad> {
 }
 
 /// `[[fault]]`.
+// one job: `[[fault]]` validated field by field in the order the docs list them; splitting would
+// scatter one section's rules.
 pub(crate) fn faults(
     raw: &[RawFault],
     model: &Model,

@@ -41,6 +41,7 @@ impl Request {
 }
 
 /// Reads what `uio-launcher linearize` needs from the scenario at `path`.
+// one job: the fields `linearize` needs, validated in the scenario's order.
 pub fn request(path: &Path) -> Result<Request, ScenarioError> {
     let err = |Bad { field, reason }: Bad| ScenarioError {
         file: path.to_path_buf(),

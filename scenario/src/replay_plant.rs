@@ -21,6 +21,7 @@ pub const REPLAY_PLANT_PROGRAM: &str = lockstep::programs::REPLAY_PLANT;
 /// The replayed plant as the process that runs it, and the data file's absolute path.
 /// `r` is the number of columns of D (the replayed v is zero: D v is in the recorded y).
 /// `u_op`: the operating point's known inputs, the u of a log without input columns (else 0).
+// one job: `[plant.replay]` validated field by field in the order the docs list them.
 pub(crate) fn plant_replay(
     raw: &Option<RawReplay>,
     dir: Option<&Path>,

@@ -201,6 +201,8 @@ pub fn design(
 }
 
 /// [`design`] on every column of Γ_B.
+// one job: the sampled state feedback of one specification (the pair designed on, the gain, the
+// closed loop's check, the prefilter), steps sharing the pair and its sizes.
 fn design_commanded(
     model: Option<&Model>,
     dm: &Discrete,

@@ -121,6 +121,7 @@ pub const MAX_ENTRIES: usize = 10_000;
 /// link (a link at the library's path would load a host file) and no setuid/setgid mode, and
 /// the bytes the entries actually inflate to — counted, not their declared sizes — at most
 /// [`MAX_UNPACKED`].
+// one job: one FMU archive read with its bounds, each checked where its bytes come.
 pub fn read(path: &Path) -> Result<Fmu, String> {
     let at = |why: String| format!("{}: {why}", path.display());
     let file = std::fs::File::open(path).map_err(|e| at(format!("cannot open: {e}")))?;

@@ -30,7 +30,10 @@ pub fn command(a: SweepArgs, scenario: &Path) -> Result<ExitCode, LaunchError> {
         );
     }
     if a.mode != ModeArg::InProcess {
-        return refuse("--mode", "--vary runs its points in-process");
+        return refuse(
+            "--mode",
+            "--vary runs a built-in plant's points in-process and an FMU's as processes",
+        );
     }
     if !(1..=launcher::vary::MAX_POINTS).contains(&a.points) {
         return refuse("--points", &format!("1 … {}", launcher::vary::MAX_POINTS));
@@ -48,29 +51,20 @@ pub fn command(a: SweepArgs, scenario: &Path) -> Result<ExitCode, LaunchError> {
     };
     interrupt::install();
     let outcomes = launcher::vary::vary(&s, &p, &opts)?;
-    let jobs = jobs.clamp(1, outcomes.len());
+    let jobs = launcher::vary::mode_of(&s, jobs).1.clamp(1, outcomes.len());
     print!(
         "{}",
         report::table(&s.name, &opts.varies, s.seed, jobs, &outcomes)
     );
-    let csv = a.out.join(format!("{}.vary.csv", s.name));
-    outputs::write_bytes(&csv, report::csv(&opts.varies, &outcomes).as_bytes())
-        .map_err(LaunchError::Component)?;
-    let json = a.out.join(format!("{}.vary.json", s.name));
-    let text =
-        serde_json::to_string_pretty(&report::json(&s.name, &opts.varies, s.seed, &outcomes))
-            .expect("serialises");
-    outputs::write_bytes(&json, (text + "\n").as_bytes()).map_err(LaunchError::Component)?;
-    let (pngs, skipped) =
-        report::plots(&a.out, &s.name, &opts.varies, &outcomes).map_err(LaunchError::Component)?;
-    for line in skipped {
+    let written = launcher::vary::report::write(&a.out, &s, &opts.varies, &outcomes)?;
+    for line in &written.skipped {
         println!("  {line}");
     }
     println!(
         "vary: {} and {} ({} plot(s) in {})",
-        csv.display(),
-        json.display(),
-        pngs.len(),
+        written.csv.display(),
+        written.json.display(),
+        written.pngs,
         a.out.display()
     );
     Ok(ExitCode::SUCCESS)

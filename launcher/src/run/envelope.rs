@@ -171,6 +171,8 @@ fn observer_launches(s: &Scenario, cfg: &Configs) -> Vec<ObserverLaunch> {
 }
 
 /// Every component of the run, in start order: plant, observer processes, controller.
+// one job: the launch envelopes of a run's components in start order, one arm per kind of component
+// over the same layout.
 pub fn envelopes(s: &Scenario, cfg: &Configs, space: &RunSpace, wait: Wait) -> Vec<Launchable> {
     let lay = cfg.layout;
     let m = &s.model;

@@ -1,6 +1,7 @@
 //! Running a scenario: output checks, the chosen mode, the recording, the summary.
 
 pub mod budget;
+mod channels;
 mod configs;
 mod envelope;
 mod in_process;
@@ -17,11 +18,12 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+pub use channels::hop_entity;
 pub use configs::{Configs, configs};
 pub use envelope::{Launchable, Program, bridge_path, envelopes};
 pub use options::{Mode, Options, Stop};
 pub(crate) use processes::placement::{pin_self, ring_cpus};
-pub use session::{Finished, RealtimeFigures, Session, hop_entity, hop_names};
+pub use session::{Finished, RealtimeFigures, Session, hop_names};
 
 use crate::error::LaunchError;
 use crate::plan::Plan;
@@ -110,6 +112,8 @@ fn external_component(s: &Scenario) -> Option<String> {
 }
 
 /// Runs a designed scenario.
+// one job: a run's life in order (pre-flight, outputs, session, the mode's loop) and the one path
+// that ends every run consistently; the stages share the outputs they must clean up.
 pub fn run(s: &Scenario, plan: &Plan, opts: &Options) -> Result<Outcome, LaunchError> {
     if let Some(fb) = &plan.feedback
         && let Some(why) = fb.instability()

@@ -4,55 +4,17 @@ use std::path::Path;
 
 use lockstep::PlantLayout;
 
+use super::channels::{self, Channels};
 use super::progress::Progress;
 use crate::error::LaunchError;
 use diagnosis::{Diagnosis, FaultInfo, Judge, Monitor};
 use observer::design::InputEstimator;
 
 use crate::plan::Plan;
-use recording::palette;
 use recording::signals as sig;
 use recording::write::Selection;
-use recording::write::{Latency, Metrics, RrdSink, SeriesId, StepRow, blueprint};
+use recording::write::{Latency, Metrics, RrdSink, SeriesId, StepRow};
 use scenario::Scenario;
-
-/// Series of one observer.
-struct ObserverChannels {
-    xhat: Vec<SeriesId>,
-    error: Vec<SeriesId>,
-    residual: Vec<SeriesId>,
-    /// log10 max_i |e_i| (see [`sig::log_error`]).
-    log_error: SeriesId,
-    /// ŵ, for an observer that estimates the unknown inputs (recorded one row late, at t_{k−1}).
-    what: Vec<SeriesId>,
-}
-
-/// The recording's series, in groups by time stamp: the signals of step k, and the latencies of
-/// step k − 1, which complete with row k (the step time and the controller→plant hop; the
-/// other hops of step k − 1 wait for them, so that all latencies of a step are one row).
-struct Channels {
-    signals: usize,
-    /// ŵ_{k−1}, completed by row k (a group only when some observer estimates w).
-    estimates_late: Option<usize>,
-    latency: usize,
-    x: Vec<SeriesId>,
-    y: Vec<SeriesId>,
-    w: Vec<SeriesId>,
-    v: Vec<SeriesId>,
-    r: Vec<SeriesId>,
-    u: Vec<SeriesId>,
-    /// None for a bank member (recorded under `/diagnoser`).
-    observers: Vec<Option<ObserverChannels>>,
-    /// Per bank: per member, its residual's outputs.
-    members: Vec<Vec<Vec<SeriesId>>>,
-    /// Per bank: (evaluation, threshold, alarm) per member, and the isolation.
-    decisions: Vec<(Vec<[SeriesId; 3]>, SeriesId)>,
-    /// Per fault: (active, value).
-    faults: Vec<[SeriesId; 2]>,
-    step_latency: SeriesId,
-    /// One per hop; the last is controller→plant (late) when there is a controller.
-    hops: Vec<SeriesId>,
-}
 
 /// The recording side of a run.
 pub struct Session {
@@ -193,6 +155,34 @@ fn fault_infos(s: &Scenario) -> Vec<FaultInfo> {
 /// A recording's digest: entity → 16 hex digits.
 pub type Digest = std::collections::BTreeMap<String, String>;
 
+/// The figures' accumulator of a run: residuals about the operating point's output, false
+/// alarms counted until the first fault, ŵ compared where an observer estimates w.
+fn metrics_for(
+    s: &Scenario,
+    layout: PlantLayout,
+    estimates: &[Option<&InputEstimator>],
+) -> Metrics {
+    let mut metrics = Metrics::new(layout, s.model.c.clone(), s.observers.len(), s.steps);
+    if let Some(op) = &s.operating_point {
+        metrics.residual_offset(op.output_offset(&s.model.c));
+    }
+    if let Some(first) = s
+        .faults
+        .iter()
+        .flat_map(|f| f.active_steps(s.dt))
+        .map(|(on, _)| on)
+        .min()
+    {
+        metrics.fault_free_until(first, s.dt);
+    }
+    for (o, e) in estimates.iter().enumerate() {
+        if let Some(e) = e {
+            metrics.estimate_inputs(o, e.w.clone(), &e.w_c_phi, &e.w_c_gamma_b, e.offset.clone());
+        }
+    }
+    metrics
+}
+
 /// Hop names of a run, in the order [`Session`] records them.
 pub fn hop_names(s: &Scenario) -> Vec<String> {
     let mut hops: Vec<String> = s
@@ -205,11 +195,6 @@ pub fn hop_names(s: &Scenario) -> Vec<String> {
         hops.push("controller->plant".into());
     }
     hops
-}
-
-/// The entity path of a hop: "plant->observer/uio" becomes "/latency/plant_to_observer_uio".
-pub fn hop_entity(hop: &str) -> String {
-    format!("/latency/{}", hop.replace("->", "_to_").replace('/', "_"))
 }
 
 impl Session {
@@ -247,7 +232,6 @@ impl Session {
             max_late_ns: 0,
             last_end: 0,
         });
-        let mut overrun = None;
         let monitors: Vec<Monitor> = banks
             .iter()
             .map(|b| {
@@ -271,271 +255,22 @@ impl Session {
             .as_ref()
             .and_then(|c| s.observers.iter().position(|o| o.name == c.observer));
         let hops = hop_names(s);
-        let sink = match rrd {
+        let (sink, overrun) = match rrd {
             Some(path) => {
-                let scenario = s.clone();
-                let mut sink = RrdSink::create(
-                    path,
-                    &s.name,
-                    move |layout| blueprint(&scenario, layout),
-                    &s.source,
-                    select.clone(),
-                )
-                .map_err(LaunchError::BadInput)?;
-                let (signals, latency) = (sink.group("signals"), sink.group("latency"));
-                let estimates_late = estimates
-                    .iter()
-                    .any(Option::is_some)
-                    .then(|| sink.group("what"));
-                let overrun_group = pace.is_some().then(|| sink.group("overrun"));
-                let names = &s.names;
-                let observer_names: Vec<String> =
-                    s.observers.iter().map(|o| o.name.clone()).collect();
-                let mut paths: Vec<String> = Vec::new();
-                // Colours and widths by the palette's rule, which the PNG plots follow too.
-                let mut series = |g: usize, path: String, legend: String| {
-                    paths.push(path.clone());
-                    let line = palette::line(&path, &observer_names);
-                    sink.series(
-                        g,
-                        &path,
-                        &legend,
-                        line.color,
-                        palette::viewer_width(&path, &observer_names),
-                    )
+                let want = channels::Wanted {
+                    layout,
+                    banks,
+                    estimates: &estimates,
+                    select,
+                    hops: if measures_hops { &hops } else { &[] },
+                    paced: pace.is_some(),
                 };
-                let x = (0..layout.n)
-                    .map(|i| {
-                        series(
-                            signals,
-                            sig::state(i),
-                            format!("{} (true)", names.state[i].name),
-                        )
-                    })
-                    .collect();
-                let y = (0..layout.p)
-                    .map(|j| series(signals, sig::output(j), names.output[j].name.clone()))
-                    .collect();
-                let w = (0..layout.q)
-                    .map(|k| {
-                        series(
-                            signals,
-                            sig::disturbance(k),
-                            names.disturbance[k].name.clone(),
-                        )
-                    })
-                    .collect();
-                let v = (0..layout.r)
-                    .map(|k| {
-                        series(
-                            signals,
-                            sig::measurement_disturbance(k),
-                            names.measurement_disturbance[k].name.clone(),
-                        )
-                    })
-                    .collect();
-                let r = (0..layout.l)
-                    .map(|k| series(signals, sig::input(k), names.input[k].name.clone()))
-                    .collect();
-                let u = if s.controller.is_some() {
-                    (0..layout.l)
-                        .map(|k| series(signals, sig::control(k), sig::control_name(s, k)))
-                        .collect()
-                } else {
-                    Vec::new()
-                };
-                let observers = s
-                    .observers
-                    .iter()
-                    .enumerate()
-                    .map(|(i, o)| {
-                        let name = &o.name;
-                        o.member.is_none().then(|| ObserverChannels {
-                            xhat: (0..layout.n)
-                                .map(|i| {
-                                    series(
-                                        signals,
-                                        sig::estimate(name, i),
-                                        format!("{} ({name})", names.state[i].name),
-                                    )
-                                })
-                                .collect(),
-                            error: (0..layout.n)
-                                .map(|i| {
-                                    series(
-                                        signals,
-                                        sig::error(name, i),
-                                        format!("e{} ({name})", i + 1),
-                                    )
-                                })
-                                .collect(),
-                            residual: (0..layout.p)
-                                .map(|j| {
-                                    series(
-                                        signals,
-                                        sig::residual(name, j),
-                                        format!("r{} ({name})", j + 1),
-                                    )
-                                })
-                                .collect(),
-                            log_error: series(
-                                signals,
-                                sig::log_error(name),
-                                format!("log10 max|e| ({name})"),
-                            ),
-                            what: match (estimates[i], estimates_late) {
-                                (Some(_), Some(g)) => (0..layout.q)
-                                    .map(|k| {
-                                        series(
-                                            g,
-                                            sig::input_estimate(name, k),
-                                            format!(
-                                                "{} estimate ({name})",
-                                                names.disturbance[k].name
-                                            ),
-                                        )
-                                    })
-                                    .collect(),
-                                _ => Vec::new(),
-                            },
-                        })
-                    })
-                    .collect();
-                let members = banks
-                    .iter()
-                    .map(|b| {
-                        let d = &b.spec.name;
-                        b.members
-                            .iter()
-                            .enumerate()
-                            .map(|(i, mb)| {
-                                mb.outputs
-                                    .iter()
-                                    .map(|&j| {
-                                        series(
-                                            signals,
-                                            sig::member_residual(d, i, j),
-                                            format!("r{} {} ({d})", i + 1, names.output[j].name),
-                                        )
-                                    })
-                                    .collect()
-                            })
-                            .collect()
-                    })
-                    .collect();
-                let decisions = banks
-                    .iter()
-                    .map(|b| {
-                        let d = &b.spec.name;
-                        let per = (0..b.members.len())
-                            .map(|i| {
-                                [
-                                    series(
-                                        signals,
-                                        sig::evaluation(d, i),
-                                        format!("J{} ({d})", i + 1),
-                                    ),
-                                    series(
-                                        signals,
-                                        sig::threshold(d, i),
-                                        format!("threshold {} ({d})", i + 1),
-                                    ),
-                                    series(
-                                        signals,
-                                        sig::alarm(d, i),
-                                        format!("alarm {} ({d})", i + 1),
-                                    ),
-                                ]
-                            })
-                            .collect();
-                        (
-                            per,
-                            series(signals, sig::isolated(d), format!("isolated channel ({d})")),
-                        )
-                    })
-                    .collect();
-                let faults = s
-                    .faults
-                    .iter()
-                    .map(|f| {
-                        [
-                            series(
-                                signals,
-                                sig::fault_active(&f.name),
-                                format!("{} active", f.name),
-                            ),
-                            series(
-                                signals,
-                                sig::fault_value(&f.name),
-                                format!("{} value", f.name),
-                            ),
-                        ]
-                    })
-                    .collect();
-                let step_latency = series(latency, "/latency/step".into(), "step".into());
-                if let Some(g) = overrun_group {
-                    overrun = Some((g, series(g, "/latency/overrun".into(), "overrun".into())));
-                }
-                let hop_ids = if measures_hops {
-                    hops.iter()
-                        .map(|h| series(latency, hop_entity(h), h.clone()))
-                        .collect()
-                } else {
-                    Vec::new()
-                };
-                for p in select.unmatched(paths.iter().map(String::as_str)) {
-                    eprintln!(
-                        "warning: --record {}: matches no signal of this run, so records nothing",
-                        scenario::quoted(&p)
-                    );
-                }
-                Some((
-                    sink,
-                    Channels {
-                        signals,
-                        estimates_late,
-                        latency,
-                        x,
-                        y,
-                        w,
-                        v,
-                        r,
-                        u,
-                        observers,
-                        members,
-                        decisions,
-                        faults,
-                        step_latency,
-                        hops: hop_ids,
-                    },
-                ))
+                let opened = channels::open(path, s, &want)?;
+                (Some((opened.sink, opened.channels)), opened.overrun)
             }
-            None => None,
+            None => (None, None),
         };
-        let mut metrics = Metrics::new(layout, s.model.c.clone(), s.observers.len(), s.steps);
-        if let Some(op) = &s.operating_point {
-            metrics.residual_offset(op.output_offset(&s.model.c));
-        }
-        if let Some(first) = s
-            .faults
-            .iter()
-            .flat_map(|f| f.active_steps(s.dt))
-            .map(|(on, _)| on)
-            .min()
-        {
-            metrics.fault_free_until(first, s.dt);
-        }
-        for (o, e) in estimates.iter().enumerate() {
-            if let Some(e) = e {
-                metrics.estimate_inputs(
-                    o,
-                    e.w.clone(),
-                    &e.w_c_phi,
-                    &e.w_c_gamma_b,
-                    e.offset.clone(),
-                );
-            }
-        }
+        let metrics = metrics_for(s, layout, &estimates);
         Ok(Session {
             layout,
             metrics,

@@ -1,5 +1,9 @@
 //! `uio-launcher sweep --vary`: how far the observers hold when the plant is not the model.
 //!
+//! The plant varied is the built-in one (its matrices), an FMU or a kit component (their
+//! parameters; the points then run as processes, one at a time, as such a plant only runs in
+//! its own process).
+//!
 //! The observers, banks, thresholds and controller are designed once, on the scenario's model
 //! (the nominal plan); each point of the variation runs the same scenario with the simulated
 //! plant's matrices changed as its `--vary`s say ([`spec`]), at the same seed (common random
@@ -24,7 +28,7 @@ use crate::plan::Plan;
 use crate::run::{self, Mode, Options, Stop};
 use figures::Figures;
 use scenario::Scenario;
-use spec::{Matrix, Op, Values, Vary};
+use spec::{Matrix, Op, Place, Values, Vary};
 
 /// Most points of one variation (each a whole run).
 pub const MAX_POINTS: usize = 100_000;
@@ -90,42 +94,98 @@ fn matrix_ref(s: &Scenario, m: Matrix) -> &lti::Mat {
     }
 }
 
-/// Checks the `--vary`s against the scenario: a built-in plant, entries inside their matrices.
+/// The parameter map a place names: the FMU plant's `parameters`, or a process plant's `params`.
+fn parameters<'s>(
+    s: &'s Scenario,
+    place: &Place,
+) -> Option<&'s serde_json::Map<String, serde_json::Value>> {
+    let params = &s.plant_process.as_ref()?.params;
+    match place {
+        Place::FmuParameter(_) => params.get("parameters")?.as_object(),
+        Place::ProcessParameter(_) => params.as_object(),
+        Place::Matrix(..) => None,
+    }
+}
+
+/// The number `s` gives the parameter a place names, if any.
+fn parameter(s: &Scenario, place: &Place) -> Option<f64> {
+    let name = match place {
+        Place::FmuParameter(n) | Place::ProcessParameter(n) => n,
+        Place::Matrix(..) => return None,
+    };
+    parameters(s, place)?.get(name)?.as_f64()
+}
+
+/// Checks the `--vary`s against the scenario: matrices of a built-in plant, entries inside
+/// them; parameters of an FMU plant whose nominal value the scenario gives.
 pub fn check(s: &Scenario, varies: &[Vary]) -> Result<(), LaunchError> {
-    let what = if s.plant_fmu.is_some() {
+    let other = if s.plant_fmu.is_some() {
         Some("an FMU")
-    } else if s.plant_process.is_some() {
-        Some("an external process")
     } else if s.plant_replay.is_some() {
         Some("replayed data")
+    } else if s.plant_process.is_some() {
+        Some("an external process")
     } else {
         None
     };
-    if let Some(what) = what {
-        return Err(LaunchError::BadInput(format!(
-            "--vary: {}'s plant is {what}; --vary changes the built-in plant's matrices",
-            s.name
-        )));
-    }
+    let bad = |v: &Vary, why: String| LaunchError::BadInput(format!("--vary '{}': {why}", v.text));
+    let kit = s.plant_process.is_some() && s.plant_fmu.is_none() && s.plant_replay.is_none();
     for v in varies {
-        let (r, c) = matrix_ref(s, v.matrix).shape();
-        if let Some((i, j)) = v.entry
-            && (i >= r || j >= c)
-        {
-            return Err(LaunchError::BadInput(format!(
-                "--vary '{}': {} is {r}×{c}, it has no entry [{},{}]",
-                v.text,
-                v.matrix.name(),
-                i + 1,
-                j + 1
-            )));
-        }
-        if r * c == 0 {
-            return Err(LaunchError::BadInput(format!(
-                "--vary '{}': {} is empty in this scenario",
-                v.text,
-                v.matrix.name()
-            )));
+        match &v.place {
+            Place::Matrix(..) if other.is_some() => {
+                return Err(bad(
+                    v,
+                    format!(
+                        "{}'s plant is {}; a matrix is varied in the built-in plant (an FMU's parameters as {}NAME, a process's as {}NAME)",
+                        s.name,
+                        other.unwrap_or_default(),
+                        spec::FMU_PARAMETERS,
+                        spec::PROCESS_PARAMS
+                    ),
+                ));
+            }
+            Place::Matrix(m, entry) => {
+                let (r, c) = matrix_ref(s, *m).shape();
+                if r * c == 0 {
+                    return Err(bad(v, format!("{} is empty in this scenario", m.name())));
+                }
+                if let Some((i, j)) = *entry
+                    && (i >= r || j >= c)
+                {
+                    return Err(bad(
+                        v,
+                        format!(
+                            "{} is {r}×{c}, it has no entry [{},{}]",
+                            m.name(),
+                            i + 1,
+                            j + 1
+                        ),
+                    ));
+                }
+            }
+            Place::FmuParameter(_) if s.plant_fmu.is_none() => {
+                return Err(bad(v, format!("{}'s plant is not an FMU", s.name)));
+            }
+            Place::ProcessParameter(_) if !kit => {
+                return Err(bad(
+                    v,
+                    format!("{}'s plant is not an external process", s.name),
+                ));
+            }
+            Place::FmuParameter(name) | Place::ProcessParameter(name) => {
+                if parameter(s, &v.place).is_none() {
+                    let table = match v.place {
+                        Place::FmuParameter(_) => "[plant.fmu] parameters",
+                        _ => "[plant.process] params",
+                    };
+                    return Err(bad(
+                        v,
+                        format!(
+                            "the scenario gives no number for {name} in {table}: give its nominal value (the one the model stands for)"
+                        ),
+                    ));
+                }
+            }
         }
     }
     Ok(())
@@ -133,9 +193,10 @@ pub fn check(s: &Scenario, varies: &[Vary]) -> Result<(), LaunchError> {
 
 /// The value of `v` at the nominal model: a scaling of 1, or the entry's own value.
 fn nominal_value(s: &Scenario, v: &Vary) -> f64 {
-    match (v.op, v.entry) {
-        (Op::Set, Some((i, j))) => matrix_ref(s, v.matrix)[(i, j)],
-        _ => 1.0,
+    match (v.op, &v.place) {
+        (Op::Scale, _) | (Op::Set, Place::Matrix(_, None)) => 1.0,
+        (Op::Set, Place::Matrix(m, Some((i, j)))) => matrix_ref(s, *m)[(*i, *j)],
+        (Op::Set, place) => parameter(s, place).unwrap_or(f64::NAN),
     }
 }
 
@@ -209,19 +270,51 @@ pub fn points(s: &Scenario, opts: &VaryOptions) -> Result<Vec<Point>, LaunchErro
     Ok(out)
 }
 
-/// `s` with the point's plant: each `--vary` applied to the model's matrices.
+/// `s` with the point's plant: each `--vary` applied to the model's matrices or the FMU's
+/// parameters. The nominal point is the scenario itself.
 pub fn apply(s: &Scenario, varies: &[Vary], point: &Point) -> Scenario {
     let mut s = s.clone();
+    if point.nominal {
+        return s;
+    }
     for (v, &x) in varies.iter().zip(&point.values) {
-        let m = matrix(&mut s, v.matrix);
-        match (v.op, v.entry) {
-            (Op::Scale, Some((i, j))) => m[(i, j)] *= x,
-            (Op::Scale, None) => *m *= x,
-            (Op::Set, Some((i, j))) => m[(i, j)] = x,
-            (Op::Set, None) => unreachable!("a whole matrix is only scaled (spec.rs)"),
+        match &v.place {
+            Place::Matrix(m, entry) => {
+                let m = matrix(&mut s, *m);
+                match (v.op, entry) {
+                    (Op::Scale, Some((i, j))) => m[(*i, *j)] *= x,
+                    (Op::Scale, None) => *m *= x,
+                    (Op::Set, Some((i, j))) => m[(*i, *j)] = x,
+                    (Op::Set, None) => unreachable!("a whole matrix is only scaled (spec.rs)"),
+                }
+            }
+            Place::FmuParameter(name) | Place::ProcessParameter(name) => {
+                let value = match v.op {
+                    Op::Scale => parameter(&s, &v.place).unwrap_or(f64::NAN) * x,
+                    Op::Set => x,
+                };
+                let params = s.plant_process.as_mut().map(|p| &mut p.params);
+                let map = match (&v.place, params) {
+                    (Place::FmuParameter(_), Some(p)) => p.get_mut("parameters"),
+                    (_, p) => p,
+                };
+                if let Some(map) = map.and_then(|m| m.as_object_mut()) {
+                    map.insert(name.clone(), serde_json::json!(value));
+                }
+            }
         }
     }
     s
+}
+
+/// How the points run: in one process, or — an FMU or kit component plant, which runs only in
+/// its own process — as processes, one point at a time.
+pub fn mode_of(s: &Scenario, jobs: usize) -> (Mode, usize) {
+    if s.plant_process.is_some() {
+        (Mode::Processes, 1)
+    } else {
+        (Mode::InProcess, jobs)
+    }
 }
 
 /// Runs every point (in-process, `jobs` at a time), in point order.
@@ -229,7 +322,7 @@ pub fn vary(s: &Scenario, plan: &Plan, opts: &VaryOptions) -> Result<Vec<Outcome
     check(s, &opts.varies)?;
     crate::limits::jobs(opts.jobs)?;
     let points = points(s, opts)?;
-    let jobs = opts.jobs.clamp(1, points.len());
+    let jobs = mode_of(s, opts.jobs).1.clamp(1, points.len());
     run::budget::check_memory(s, plan, jobs as u64)?;
     run::create_output_dir(&opts.out)?;
     let mut base = s.clone();
@@ -269,7 +362,7 @@ fn one(
     let o = run::run(
         &varied,
         plan,
-        &Options::quiet(&opts.out, Mode::InProcess, opts.wait, false),
+        &Options::quiet(&opts.out, mode_of(s, opts.jobs).0, opts.wait, false),
     )?;
     let (status, reason) = match &o.stop {
         Stop::Completed => ("completed", None),

@@ -11,6 +11,8 @@ use recording::plot::{Curve, Figure, Scale};
 use super::figures::larger_is_worse;
 use super::spec::Vary;
 use super::{Outcome, Point};
+use crate::error::LaunchError;
+use scenario::Scenario;
 
 /// Most curves in one plot: more combinations of the other parameters are not drawn.
 const MAX_CURVES: usize = 8;
@@ -334,4 +336,44 @@ pub fn plots(
         }
     }
     Ok((written, skipped))
+}
+
+/// What [`write`] wrote.
+pub struct Written {
+    /// `<name>.vary.csv`.
+    pub csv: PathBuf,
+    /// `<name>.vary.json`.
+    pub json: PathBuf,
+    /// Its text.
+    pub json_text: String,
+    /// How many PNGs.
+    pub pngs: usize,
+    /// Plots not drawn, and why.
+    pub skipped: Vec<String>,
+}
+
+/// Writes a variation's CSV, JSON and plots into `out` (the launcher's `sweep --vary` and the
+/// Python package's `sweep(vary=…)`).
+pub fn write(
+    out: &Path,
+    s: &Scenario,
+    varies: &[Vary],
+    outcomes: &[Outcome],
+) -> Result<Written, LaunchError> {
+    let csv_path = out.join(format!("{}.vary.csv", s.name));
+    outputs::write_bytes(&csv_path, csv(varies, outcomes).as_bytes())
+        .map_err(LaunchError::Component)?;
+    let json_path = out.join(format!("{}.vary.json", s.name));
+    let json_text =
+        serde_json::to_string_pretty(&json(&s.name, varies, s.seed, outcomes)).expect("serialises");
+    outputs::write_bytes(&json_path, (json_text.clone() + "\n").as_bytes())
+        .map_err(LaunchError::Component)?;
+    let (pngs, skipped) = plots(out, &s.name, varies, outcomes).map_err(LaunchError::Component)?;
+    Ok(Written {
+        csv: csv_path,
+        json: json_path,
+        json_text,
+        pngs: pngs.len(),
+        skipped,
+    })
 }

@@ -1,12 +1,15 @@
 //! What a `--vary` names: one entry (or a whole matrix) of the built-in plant's A, B, C, E or D,
-//! how it differs from the design model, and over which values.
+//! or a parameter of an FMU plant or of a kit component plant; how it differs from the design model, and over which values.
 //!
 //! ```text
-//! A[2,3] *= 0.8..1.2:5        a scaling on a grid: 5 points from 0.8 to 1.2 (linspace)
-//! A[2,3] *= [0.5, 1, 2]       a scaling on the listed values
-//! A[2,3] = U(-3.5, -2.5)      a value drawn uniformly (`--points` draws, seeded)
-//! B *= N(1, 0.05)             every entry of B scaled by one normal draw
-//! E[1,1] *= LogU(0.1, 10)     log-uniform: uniform in log10
+//! A[2,3] *= 0.8..1.2:5              a scaling on a grid: 5 points from 0.8 to 1.2 (linspace)
+//! A[2,3] *= [0.5, 1, 2]             a scaling on the listed values
+//! A[2,3] = U(-3.5, -2.5)            a value drawn uniformly (`--points` draws, seeded)
+//! B *= N(1, 0.05)                   every entry of B scaled by one normal draw
+//! E[1,1] *= LogU(0.1, 10)           log-uniform: uniform in log10
+//! plant.fmu.parameters.J *= 0.5..2:4   the FMU's start value of J scaled (as the scenario gives it)
+//! plant.fmu.parameters.b = [0.05, 0.1, 0.2]   the FMU's parameter b set
+//! plant.process.params.pole_mass *= U(0.8, 1.2)   a kit component plant's parameter scaled
 //! ```
 //!
 //! Indices are 1-based (row, column), as the papers and MATLAB write them. A scaling of 1 (or
@@ -57,17 +60,31 @@ pub enum Values {
     LogUniform(f64, f64),
 }
 
+/// What a `--vary` changes in the simulated plant.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Place {
+    /// An entry (0-based) of a matrix of the built-in plant, or the whole matrix.
+    Matrix(Matrix, Option<(usize, usize)>),
+    /// A parameter of the FMU plant (its start value, `plant.fmu.parameters.NAME`).
+    FmuParameter(String),
+    /// A parameter of an external-process plant (a kit component's `plant.process.params.NAME`).
+    ProcessParameter(String),
+}
+
+/// The prefix of an FMU parameter's place.
+pub const FMU_PARAMETERS: &str = "plant.fmu.parameters.";
+/// The prefix of a process plant's parameter's place.
+pub const PROCESS_PARAMS: &str = "plant.process.params.";
+
 /// One `--vary`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Vary {
     /// As given (trimmed): the column name in the outputs.
     pub text: String,
-    /// What it names, as written: "A[2,3]", "B".
+    /// What it names, as written: "A[2,3]", "B", "plant.fmu.parameters.J".
     pub target: String,
-    /// The matrix.
-    pub matrix: Matrix,
-    /// The entry (0-based), or the whole matrix.
-    pub entry: Option<(usize, usize)>,
+    /// What it changes.
+    pub place: Place,
     /// Scale or set.
     pub op: Op,
     /// Over which values.
@@ -184,6 +201,32 @@ impl FromStr for Vary {
         };
         let target = target.trim().to_string();
         let target = target.as_str();
+        let values = values(rest, whole)?;
+        for (prefix, what) in [
+            (FMU_PARAMETERS, "FMU variable"),
+            (PROCESS_PARAMS, "parameter"),
+        ] {
+            let Some(name) = target.strip_prefix(prefix) else {
+                continue;
+            };
+            if name.is_empty() || name.contains(|c: char| c.is_whitespace() || c == '.') {
+                return Err(format!(
+                    "'{whole}': {prefix}NAME names one {what}, e.g. {prefix}J"
+                ));
+            }
+            let place = if prefix == FMU_PARAMETERS {
+                Place::FmuParameter(name.to_string())
+            } else {
+                Place::ProcessParameter(name.to_string())
+            };
+            return Ok(Vary {
+                target: target.to_string(),
+                place,
+                op,
+                values,
+                text,
+            });
+        }
         let (name, index) = match target.split_once('[') {
             Some((m, idx)) => (m.trim(), Some(idx)),
             None => (target, None),
@@ -196,7 +239,7 @@ impl FromStr for Vary {
             "D" => Matrix::D,
             other => {
                 return Err(format!(
-                    "'{whole}': '{other}' is not one of the plant's matrices A, B, C, E, D"
+                    "'{whole}': '{other}' is not one of the plant's matrices A, B, C, E, D, nor {FMU_PARAMETERS}NAME or {PROCESS_PARAMS}NAME"
                 ));
             }
         };
@@ -226,10 +269,9 @@ impl FromStr for Vary {
         }
         Ok(Vary {
             target: target.to_string(),
-            matrix,
-            entry,
+            place: Place::Matrix(matrix, entry),
             op,
-            values: values(rest, whole)?,
+            values,
             text,
         })
     }
@@ -243,8 +285,8 @@ mod tests {
     fn grids_lists_and_distributions_parse_as_written() {
         let v: Vary = "A[2,3] *= 0.8..1.2:5".parse().unwrap();
         assert_eq!(
-            (v.matrix, v.entry, v.op),
-            (Matrix::A, Some((1, 2)), Op::Scale)
+            (&v.place, v.op),
+            (&Place::Matrix(Matrix::A, Some((1, 2))), Op::Scale)
         );
         let Values::Grid(g) = &v.values else {
             panic!("{v:?}")
@@ -254,9 +296,27 @@ mod tests {
         assert!((g[2] - 1.0).abs() < 1e-15);
         let v: Vary = "E *= [0.5, 1, 2]".parse().unwrap();
         assert_eq!(
-            (v.entry, v.values),
-            (None, Values::Grid(vec![0.5, 1.0, 2.0]))
+            (v.place, v.values),
+            (
+                Place::Matrix(Matrix::E, None),
+                Values::Grid(vec![0.5, 1.0, 2.0])
+            )
         );
+        let v: Vary = "plant.fmu.parameters.tau_c = [0, 0.01, 0.05]"
+            .parse()
+            .unwrap();
+        assert_eq!(
+            (v.place, v.op, v.target.as_str()),
+            (
+                Place::FmuParameter("tau_c".into()),
+                Op::Set,
+                "plant.fmu.parameters.tau_c"
+            )
+        );
+        let v: Vary = "plant.process.params.pole_mass *= [0.8, 1.2]"
+            .parse()
+            .unwrap();
+        assert_eq!(v.place, Place::ProcessParameter("pole_mass".into()));
         let v: Vary = "A[1,1] = U(-3.5, -2.5)".parse().unwrap();
         assert_eq!((v.op, v.values), (Op::Set, Values::Uniform(-3.5, -2.5)));
         assert_eq!(
@@ -282,6 +342,9 @@ mod tests {
             ("A[1,1] *= N(1, 0)", "sd > 0"),
             ("A[1,1] *= [1, nan]", "not finite"),
             ("A[1,1]", "expected TARGET"),
+            ("plant.fmu.parameters. *= [1]", "names one FMU variable"),
+            ("plant.fmu.J *= [1]", "nor plant.fmu.parameters.NAME"),
+            ("plant.process.params.a.b *= [1]", "names one parameter"),
         ] {
             let e = bad.parse::<Vary>().unwrap_err();
             assert!(e.contains(says), "{bad}: {e}");

@@ -83,6 +83,8 @@ pub fn place_observer(
     Ok(p)
 }
 
+// one job: one placement: the checks of the pair and the poles, the method's gain, and the achieved
+// poles verified, in that order.
 fn place_pair(
     a: &DMatrix<f64>,
     b: &DMatrix<f64>,

@@ -63,6 +63,8 @@ pub(super) struct Core {
     pub notes: Vec<String>,
 }
 
+// one job: Das & Ghosal's reduced-order design in the paper's order (the basis, the existence
+// conditions, the gain, eq. 23's matrices), each step using the last.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn core(
     a: &Mat,

@@ -185,6 +185,8 @@ fn discrete_certificate(acl_d: &Mat, decay: f64, dt: f64) -> Result<(f64, f64), 
     Ok((rho, lhs.symmetric_eigen().eigenvalues.max()))
 }
 
+// one job: Hui & Żak's design in the paper's order (the projection, the LMI or the placement, the
+// certificate), each step using the last.
 pub(super) fn design(
     model: Option<&Model>,
     dm: &Discrete,

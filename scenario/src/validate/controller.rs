@@ -12,6 +12,7 @@ use crate::raw::RawController;
 use crate::untrusted::quoted;
 use crate::{ControllerEntry, Named};
 
+// one job: `[controller]` validated field by field in the order the docs list them.
 pub(super) fn controller_entry(
     c: &RawController,
     model: &Model,

@@ -151,6 +151,7 @@ pub(super) fn observer_cap(
     ))
 }
 
+// one job: one `[[observer]]` validated field by field, one arm per kind.
 pub(super) fn observer_spec(
     f: &str,
     o: &RawObserver,

@@ -22,6 +22,8 @@ pub(super) struct Plant {
     pub ff: Mat,
 }
 
+// one job: `[plant]` validated field by field in the order the docs list them (continuous or
+// discrete model, names, signals).
 pub(super) fn plant(raw: &RawScenario) -> Result<Plant, Bad> {
     // Plant: continuous (A, B, E) or, for an identified model, discrete (Φ, Γ_B, Γ_E per step).
     let p = &raw.plant;

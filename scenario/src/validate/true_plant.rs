@@ -17,6 +17,8 @@ pub(super) struct TruePlant {
     pub operating_point: Option<lti::OperatingPoint>,
 }
 
+// one job: who simulates the true plant (built-in, process, FMU or replay), validated with the
+// operating point they share.
 pub(super) fn true_plant(
     raw: &RawScenario,
     plant: &super::plant::Plant,

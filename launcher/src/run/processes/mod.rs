@@ -235,6 +235,8 @@ fn closed_before_ready(p: &mut Proc) -> LaunchError {
     ))
 }
 
+// one job: the launcher's lockstep loop across processes: samples in, figures and recording out,
+// each component's end or failure judged where it is seen, over state every arm shares.
 fn supervise(
     cfg: &Configs,
     session: &mut Session,
