@@ -169,10 +169,10 @@ case "$case_name" in
     kill -0 "$run_pid" 2>/dev/null || fail "the run ended before the fault"
     t0="$(now)"
     case "$case_name" in
-      kill-component) pkill -KILL -f "^$bin/plant --run" || fail "no plant on B" ;;
+      kill-component) pkill -KILL -f "^$bin/uio-plant --run" || fail "no plant on B" ;;
       kill-agent) kill -KILL "$agent_pid"; agent_pid="" ;;
       cut-link) ip -n "$nsa" link set "$va" down ;;
-      kill-local) pkill -KILL -f "^$bin/controller --run" || fail "no controller on A" ;;
+      kill-local) pkill -KILL -f "^$bin/uio-controller --run" || fail "no controller on A" ;;
     esac
     rc=0; wait "$run_pid" || rc=$?
     t1="$(now)"
