@@ -19,6 +19,7 @@ use observer::{Designed, Spec, design};
 
 use crate::covariance::residual_covariance;
 use crate::evaluate::threshold_for;
+use crate::glr::GlrDesign;
 use crate::spec::{Channels, DiagnoserSpec, MemberKind, Scheme};
 use crate::structure::{BLIND, FaultInput, SteadyState, reacts};
 
@@ -39,6 +40,8 @@ pub struct Member {
     pub threshold: f64,
     /// Degrees of freedom of its χ² statistic (the rank of Σ_r), for `evaluation = "chi2"`.
     pub dof: usize,
+    /// Its GLR test, when the bank asks for one ([`crate::glr`]).
+    pub glr: Option<GlrDesign>,
 }
 
 /// A designed bank.
@@ -211,6 +214,7 @@ pub fn design_bank(
             covariance: None,
             threshold: 0.0,
             dof: 0,
+            glr: None,
         });
     }
     // The structure, from the designs: residual i against a fault on watched channel j.
@@ -264,6 +268,35 @@ pub fn design_bank(
             })?;
         mb.threshold = threshold;
         mb.dof = dof;
+        if let Some(glr) = spec.glr {
+            let noise = noise.ok_or_else(|| BankError {
+                member: None,
+                key: "glr",
+                reason: "a GLR test whitens the residual by its noise: the scenario has no [noise]"
+                    .into(),
+            })?;
+            // It tries the channels the residual reacts to: its row of the structure matrix.
+            let tested = (0..inputs.len())
+                .filter(|&j| structure[i][j] == 1)
+                .collect();
+            let design = GlrDesign::new(
+                &dm.a,
+                &dm.c,
+                &mb.designed.runtime,
+                &mb.outputs,
+                &inputs,
+                tested,
+                noise,
+                glr,
+                dt,
+            )
+            .map_err(|reason| BankError {
+                member: Some(i),
+                key: "glr",
+                reason,
+            })?;
+            mb.glr = Some(design);
+        }
     }
     Ok(Bank {
         spec: spec.clone(),

@@ -5,9 +5,15 @@
 //! the columns of the structure matrix: channel j is isolated when a equals column j, and the
 //! fault is "unknown" when a matches no column (or several). Before `ignore_before` nothing is
 //! decided: the observers start from zero and their start-up transient is no fault.
+//!
+//! With a GLR test ([`crate::glr`]) beside the evaluation, a member's alarm is either test's
+//! (the GLR confirms a change after the same persistence and holds it until its end is seen or
+//! its onset leaves the window), and each decision says which test made it: the evaluation's
+//! alarms alone, the GLR's alone, each alone (both), or only the two together.
 
 use crate::bank::Bank;
 use crate::evaluate::Evaluator;
+use crate::glr::Glr;
 
 /// The decision of one step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -28,6 +34,28 @@ impl Isolation {
             Isolation::Channel(j) => (j + 1) as f64,
             Isolation::Unknown => -1.0,
         }
+    }
+}
+
+/// Which test's alarms made a step's isolation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DecidedBy {
+    /// No alarm.
+    None,
+    /// The evaluation's alarms alone give it (and the GLR's alone do not).
+    Evaluation,
+    /// The GLR's alarms alone give it (and the evaluation's alone do not).
+    Glr,
+    /// Each test's alarms alone give it.
+    Both,
+    /// Only the two tests' alarms together give it.
+    Combined,
+}
+
+impl DecidedBy {
+    /// As recorded: 0 none, 1 evaluation, 2 GLR, 3 both, 4 combined.
+    pub fn code(self) -> f64 {
+        self as u8 as f64
     }
 }
 
@@ -66,6 +94,18 @@ pub struct Monitor {
     pub alarms: Vec<bool>,
     /// This step's isolation.
     pub isolation: Isolation,
+    /// Per member, its GLR test, if the bank has one.
+    glr: Vec<Option<Glr>>,
+    /// This step's GLR statistic g per member (0 without a GLR test).
+    pub glr_stats: Vec<f64>,
+    /// The GLR thresholds per member (∞ without a GLR test).
+    pub glr_thresholds: Vec<f64>,
+    /// The evaluation's alarm per member, this step.
+    pub evaluation_alarms: Vec<bool>,
+    /// The GLR's alarm per member, this step.
+    pub glr_alarms: Vec<bool>,
+    /// Which test made this step's isolation.
+    pub decided_by: DecidedBy,
 }
 
 impl Monitor {
@@ -103,7 +143,31 @@ impl Monitor {
             exceed: vec![false; m],
             alarms: vec![false; m],
             isolation: Isolation::None,
+            glr_thresholds: bank
+                .members
+                .iter()
+                .map(|mb| mb.glr.as_ref().map_or(f64::INFINITY, |g| g.threshold))
+                .collect(),
+            glr: bank
+                .members
+                .iter()
+                .map(|mb| {
+                    let first = lti::signal::first_sample_from(bank.spec.ignore_before, dt);
+                    mb.glr
+                        .clone()
+                        .map(|g| Glr::new(g, first, bank.spec.persistence))
+                })
+                .collect(),
+            glr_stats: vec![0.0; m],
+            evaluation_alarms: vec![false; m],
+            glr_alarms: vec![false; m],
+            decided_by: DecidedBy::None,
         }
+    }
+
+    /// Whether the bank runs a GLR test beside its evaluation.
+    pub fn has_glr(&self) -> bool {
+        self.glr.iter().any(Option::is_some)
     }
 
     /// Step k, from every observer's residual y_k − Cx̂_k (as the run's figures computed them):
@@ -123,9 +187,26 @@ impl Monitor {
             } else {
                 0
             };
-            self.alarms[i] = self.counts[i] >= self.persistence;
+            self.evaluation_alarms[i] = self.counts[i] >= self.persistence;
+            if let Some(glr) = &mut self.glr[i] {
+                self.glr_stats[i] = glr.push(k, &self.residuals[i]);
+                self.glr_alarms[i] = glr.alarm();
+            }
+            self.alarms[i] = self.evaluation_alarms[i] || self.glr_alarms[i];
         }
-        self.isolation = self.isolate();
+        self.isolation = self.isolate(&self.alarms);
+        self.decided_by = if self.isolation == Isolation::None {
+            DecidedBy::None
+        } else {
+            let by_evaluation = self.isolate(&self.evaluation_alarms) == self.isolation;
+            let by_glr = self.isolate(&self.glr_alarms) == self.isolation;
+            match (by_evaluation, by_glr) {
+                (true, true) => DecidedBy::Both,
+                (true, false) => DecidedBy::Evaluation,
+                (false, true) => DecidedBy::Glr,
+                (false, false) => DecidedBy::Combined,
+            }
+        };
     }
 
     /// The label of channel `channel` (index in the class), if the bank watches it.
@@ -136,8 +217,9 @@ impl Monitor {
             .map(|j| self.labels[j].as_str())
     }
 
-    fn isolate(&self) -> Isolation {
-        if !self.alarms.iter().any(|&a| a) {
+    /// The isolation an alarm pattern gives.
+    fn isolate(&self, alarms: &[bool]) -> Isolation {
+        if !alarms.iter().any(|&a| a) {
             return Isolation::None;
         }
         let m = self.labels.len();
@@ -145,7 +227,7 @@ impl Monitor {
             .filter(|&j| {
                 self.structure
                     .iter()
-                    .zip(&self.alarms)
+                    .zip(alarms)
                     .all(|(row, &a)| (row[j] == 1) == a)
             })
             .collect();

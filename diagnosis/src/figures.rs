@@ -11,6 +11,9 @@
 //!   the correct share of its active time reaches the scenario's `isolated_fraction` (0.9 by
 //!   default): a residual that returns to zero under a bias (a UIO's, in steady state) leaves the
 //!   fault unisolated for most of its time, however right its first alarm was.
+//! * With a GLR test beside the evaluation, the correctly isolated time is split by the test whose
+//!   alarms made the decision ([`crate::DecidedBy`]): the evaluation's alone, the GLR's alone,
+//!   each alone (both), or only the two together.
 //! * Fault-free steps are those before the first fault starts (all of them in a run without
 //!   faults) from the bank's first decided step on. An alarm there is false; `false_alarms` counts
 //!   the episodes (an alarm switching on), `false_alarm_steps` the steps.
@@ -19,7 +22,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::decide::{Isolation, Monitor};
+use crate::decide::{DecidedBy, Isolation, Monitor};
 use crate::spec::Channels;
 
 /// An injected fault, as the figures need it.
@@ -68,6 +71,22 @@ pub struct FaultFigure {
     pub isolated_fraction: Option<f64>,
     /// Whether isolated_fraction reached the scenario's `isolated_fraction`.
     pub correct: bool,
+    /// With a GLR test: the correctly isolated time by the test that made the decisions.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub isolated_by: Option<IsolatedBy>,
+}
+
+/// A correctly isolated time split by the test whose alarms made each decision, s.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Default)]
+pub struct IsolatedBy {
+    /// The evaluation's alarms alone.
+    pub evaluation: f64,
+    /// The GLR's alarms alone.
+    pub glr: f64,
+    /// Each test's alarms alone.
+    pub both: f64,
+    /// Only the two together.
+    pub combined: f64,
 }
 
 /// One residual's behaviour without faults.
@@ -123,6 +142,9 @@ pub struct Judge {
     fraction: f64,
     /// Per fault: steps counted as [correct, otherwise, unknown, no alarm].
     verdicts: Vec<[u64; 4]>,
+    /// Per fault: correct steps decided by [evaluation, GLR, both, combined]; `None` without a
+    /// GLR test in the run.
+    decided: Option<Vec<[u64; 4]>>,
     faults: Vec<FaultInfo>,
     /// [start, end) step of each fault's window.
     windows: Vec<(u64, u64)>,
@@ -178,12 +200,17 @@ impl Judge {
                 no_alarm_time: 0.0,
                 isolated_fraction: None,
                 correct: false,
+                isolated_by: None,
             })
             .collect();
         Judge {
             dt,
             fraction,
             verdicts: vec![[0; 4]; faults.len()],
+            decided: monitors
+                .iter()
+                .any(Monitor::has_glr)
+                .then(|| vec![[0; 4]; faults.len()]),
             first_fault: starts.first().copied().unwrap_or(u64::MAX),
             faults,
             windows,
@@ -274,16 +301,28 @@ impl Judge {
             // Isolation over the fault's active, decided time: the best any bank of its class says.
             let decided = ours().any(|m| k >= m.start_step);
             if decided && f.active.iter().any(|&(on, off)| k >= on && k < off) {
-                let verdict = ours()
-                    .map(|m| match m.isolation {
-                        Isolation::Channel(j) if j == f.channel => Verdict::Correct,
-                        Isolation::Channel(_) => Verdict::Otherwise,
-                        Isolation::Unknown => Verdict::Unknown,
-                        Isolation::None => Verdict::NoAlarm,
+                let (verdict, by) = ours()
+                    .map(|m| {
+                        let v = match m.isolation {
+                            Isolation::Channel(j) if j == f.channel => Verdict::Correct,
+                            Isolation::Channel(_) => Verdict::Otherwise,
+                            Isolation::Unknown => Verdict::Unknown,
+                            Isolation::None => Verdict::NoAlarm,
+                        };
+                        (v, m.decided_by)
                     })
-                    .min_by_key(|v| *v as u8)
-                    .unwrap_or(Verdict::NoAlarm);
+                    .min_by_key(|(v, _)| *v as u8)
+                    .unwrap_or((Verdict::NoAlarm, DecidedBy::None));
                 self.verdicts[i][verdict as usize] += 1;
+                if let (Some(decided), Verdict::Correct) = (&mut self.decided, verdict) {
+                    match by {
+                        DecidedBy::Evaluation => decided[i][0] += 1,
+                        DecidedBy::Glr => decided[i][1] += 1,
+                        DecidedBy::Both => decided[i][2] += 1,
+                        DecidedBy::Combined => decided[i][3] += 1,
+                        DecidedBy::None => {}
+                    }
+                }
             }
         }
     }
@@ -319,6 +358,16 @@ impl Judge {
             fig.no_alarm_time = v[3] as f64 * self.dt;
             fig.isolated_fraction = (steps > 0).then(|| v[0] as f64 / steps as f64);
             fig.correct = fig.isolated_fraction.is_some_and(|x| x >= self.fraction);
+        }
+        if let Some(decided) = &self.decided {
+            for (fig, d) in faults.iter_mut().zip(decided) {
+                fig.isolated_by = Some(IsolatedBy {
+                    evaluation: d[0] as f64 * self.dt,
+                    glr: d[1] as f64 * self.dt,
+                    both: d[2] as f64 * self.dt,
+                    combined: d[3] as f64 * self.dt,
+                });
+            }
         }
         Diagnosis {
             false_alarms: self.false_alarms,

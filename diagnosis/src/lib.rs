@@ -8,6 +8,7 @@
 //! * [`residual`] — a member's residual in terms of its observer's state and the measurement;
 //! * [`covariance`] — the stationary covariance of a member's residual under the noise;
 //! * [`evaluate`] — residual evaluation signals and thresholds;
+//! * [`glr`] — a windowed GLR test on the residual whitened in time, for faults that persist;
 //! * [`decide`] — alarms and isolation per step ([`Monitor`]);
 //! * [`figures`] — detection times, isolation, false alarms of a run.
 
@@ -16,12 +17,14 @@ pub mod covariance;
 pub mod decide;
 pub mod evaluate;
 pub mod figures;
+pub mod glr;
 pub mod residual;
 pub mod spec;
 pub mod structure;
 
 pub use bank::BankError;
 pub use bank::{Bank, Member, design_bank};
-pub use decide::{Isolation, Monitor};
-pub use figures::{Diagnosis, FaultFigure, FaultInfo, Judge, ResidualFigure};
+pub use decide::{DecidedBy, Isolation, Monitor};
+pub use figures::{Diagnosis, FaultFigure, FaultInfo, IsolatedBy, Judge, ResidualFigure};
+pub use glr::GlrSpec;
 pub use spec::{Channels, DiagnoserSpec, Evaluation, MemberKind, Scheme, Threshold};

@@ -105,4 +105,6 @@ pub struct DiagnoserSpec {
     pub persistence: u32,
     /// No decision before this time, s (the observers' start-up transient).
     pub ignore_before: f64,
+    /// A windowed GLR test beside the evaluation ([`crate::glr`]), if asked for.
+    pub glr: Option<crate::glr::GlrSpec>,
 }

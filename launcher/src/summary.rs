@@ -499,6 +499,16 @@ impl Summary {
                         )
                     }
                 );
+                if let Some(by) = &f.isolated_by {
+                    t += &format!(
+                        "    {:<20} isolated correctly by the evaluation's alarms alone {}, the GLR's alone {}, each alone {}, only both together {}\n",
+                        "",
+                        pct(by.evaluation),
+                        pct(by.glr),
+                        pct(by.both),
+                        pct(by.combined),
+                    );
+                }
             }
         }
         for e in &self.expectations {

@@ -195,6 +195,22 @@ pub fn alarm(diagnoser: &str, i: usize) -> String {
     format!("/diagnosis/{diagnoser}/alarm/{}", i + 1)
 }
 
+/// `/diagnosis/<d>/glr/<i+1>`: g_i, residual i's GLR statistic (a bank with a GLR test).
+pub fn glr(diagnoser: &str, i: usize) -> String {
+    format!("/diagnosis/{diagnoser}/glr/{}", i + 1)
+}
+
+/// `/diagnosis/<d>/glr_threshold/<i+1>`: residual i's GLR threshold.
+pub fn glr_threshold(diagnoser: &str, i: usize) -> String {
+    format!("/diagnosis/{diagnoser}/glr_threshold/{}", i + 1)
+}
+
+/// `/diagnosis/<d>/decided_by`: which test's alarms made the isolation: 0 none, 1 the
+/// evaluation's, 2 the GLR's, 3 each alone, 4 only both together.
+pub fn decided_by(diagnoser: &str) -> String {
+    format!("/diagnosis/{diagnoser}/decided_by")
+}
+
 /// `/diagnosis/<d>/isolated`: the channel isolated (1-based), 0 without alarm, −1 unknown.
 pub fn isolated(diagnoser: &str) -> String {
     format!("/diagnosis/{diagnoser}/isolated")

@@ -315,11 +315,12 @@ pub(crate) fn diagnosers(
     model: &Model,
     ff: &Mat,
     noise: Option<&NoiseSpec>,
+    dt: f64,
     taken: &mut BTreeSet<String>,
 ) -> Result<Vec<DiagnoserSpec>, Bad> {
     raw.iter()
         .enumerate()
-        .map(|(i, d)| diagnoser(i, d, model, ff, noise, taken))
+        .map(|(i, d)| diagnoser(i, d, model, ff, noise, dt, taken))
         .collect()
 }
 
@@ -330,6 +331,7 @@ fn diagnoser(
     model: &Model,
     ff: &Mat,
     noise: Option<&NoiseSpec>,
+    dt: f64,
     taken: &mut BTreeSet<String>,
 ) -> Result<DiagnoserSpec, Bad> {
     let at = |key: &str| format!("diagnoser[{}].{key}", i + 1);
@@ -389,6 +391,7 @@ fn diagnoser(
         threshold,
         persistence: persistence.min(u32::MAX as i64) as u32,
         ignore_before,
+        glr: crate::glr::glr(i, d.glr.as_ref(), noise.is_some(), dt)?,
     })
 }
 

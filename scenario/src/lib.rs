@@ -7,6 +7,7 @@ mod check;
 mod checked;
 mod fault_diagnosis;
 mod fmu_plant;
+mod glr;
 mod hosts;
 pub mod limits;
 pub mod linearized;

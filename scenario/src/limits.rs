@@ -19,6 +19,10 @@ pub const MAX_FAULTS: usize = 64;
 /// (8 bytes each), in every realisation a sweep runs at once.
 pub const MAX_WINDOW: i64 = 1_000_000;
 
+/// Longest GLR window, in samples: each step a member extends the correlation of every onset in
+/// its window with every channel it tests (N·J·d multiply-adds; 10⁴ × 2 × 2 ≈ 40 µs a step).
+pub const MAX_GLR_WINDOW: f64 = 10_000.0;
+
 /// Most calibration realisations (`calibrate.runs`): each is a whole run of the scenario, made
 /// before the run itself starts.
 pub const MAX_CALIBRATION_RUNS: i64 = 10_000;

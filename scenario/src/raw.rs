@@ -134,6 +134,18 @@ pub struct RawDiagnoser {
     pub calibrate: Option<RawCalibrate>,
     pub persistence: Option<i64>,
     pub ignore_before: Option<f64>,
+    /// `glr = { window, false_alarm }`: a windowed GLR test beside the evaluation.
+    pub glr: Option<RawGlr>,
+}
+
+/// `glr = { window, false_alarm }` of a `[[diagnoser]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawGlr {
+    /// How long an onset is tried for, s.
+    pub window: f64,
+    /// The bound on the false-alarm probability per sample.
+    pub false_alarm: f64,
 }
 
 /// `[plant]`.

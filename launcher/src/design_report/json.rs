@@ -125,6 +125,12 @@ fn bank(b: &diagnosis::Bank, dt: f64) -> Value {
                 "discrete_poles": lti::re_im(&m.designed.report.discrete_poles),
                 "threshold": m.threshold, "dof": m.dof,
                 "residual_covariance": m.covariance.as_ref().map(rows),
+                "glr": m.glr.as_ref().map(|g| json!({
+                    "window": g.window, "threshold": g.threshold,
+                    "channels": g.channels.iter().map(|&j| &b.channels[j]).collect::<Vec<_>>(),
+                    "innovation_covariance": rows(&g.innovation),
+                    "predictor_gain": rows(&g.gain),
+                })),
                 "sampled": sampled(&m.designed.runtime, dt),
             })
         })

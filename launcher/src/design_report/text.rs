@@ -275,6 +275,20 @@ fn banks(banks: &Result<Vec<diagnosis::Bank>, String>) -> String {
                 m.designed.report.kind,
                 format_list(&m.designed.report.discrete_poles)
             );
+            if let Some(g) = &m.glr {
+                let tested: Vec<&str> =
+                    g.channels.iter().map(|&j| b.channels[j].as_str()).collect();
+                text += &format!(
+                    "    GLR over {} samples, onsets on {}: threshold {}\n",
+                    g.window,
+                    if tested.is_empty() {
+                        "no channel".to_string()
+                    } else {
+                        tested.join(", ")
+                    },
+                    sig(g.threshold)
+                );
+            }
         }
         text += &format!(
             "  structure, transient (rows: residuals, columns: {}):\n",

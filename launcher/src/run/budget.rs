@@ -62,6 +62,12 @@ pub fn recorded_paths(s: &Scenario, plan: &Plan, paced: bool) -> Vec<String> {
             ]);
         }
         p.push(sig::isolated(d));
+        if b.members.iter().any(|mb| mb.glr.is_some()) {
+            for i in 0..b.members.len() {
+                p.extend([sig::glr(d, i), sig::glr_threshold(d, i)]);
+            }
+            p.push(sig::decided_by(d));
+        }
     }
     for f in &s.faults {
         p.extend([sig::fault_active(&f.name), sig::fault_value(&f.name)]);
@@ -101,8 +107,8 @@ pub fn recording_bytes(s: &Scenario, plan: &Plan, opts: &Options) -> (u64, u64, 
     )
 }
 
-/// Memory one run's buffers take that grow with the scenario: each `rms` member's window and
-/// each observer's tail maxima (see `recording::write::tail`).
+/// Memory one run's buffers take that grow with the scenario: each `rms` member's window, each
+/// GLR test's signatures and sums, and each observer's tail maxima (see `recording::write::tail`).
 pub fn memory_bytes(s: &Scenario, plan: &Plan) -> u64 {
     let windows: u64 = plan
         .banks
@@ -112,11 +118,20 @@ pub fn memory_bytes(s: &Scenario, plan: &Plan) -> u64 {
             _ => 0,
         })
         .sum();
+    // A GLR test keeps, per tested channel, N signatures of d values, N information sums and
+    // N correlations.
+    let glr: u64 = plan
+        .banks
+        .iter()
+        .flat_map(|b| &b.members)
+        .filter_map(|mb| mb.glr.as_ref())
+        .map(|g| (g.window * g.channels.len() * (g.dim() + 2)) as u64 * 8)
+        .sum();
     let blocks = s
         .steps
         .div_ceil(recording::write::tail::block_len(s.steps))
         .max(1);
-    windows + s.observers.len() as u64 * 2 * blocks * 8
+    windows + glr + s.observers.len() as u64 * 2 * blocks * 8
 }
 
 /// Shared memory of a run across processes, about: every service's data segment, sized by

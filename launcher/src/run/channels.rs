@@ -45,6 +45,8 @@ pub(super) struct Channels {
     pub(super) members: Vec<Vec<Vec<SeriesId>>>,
     /// Per bank: (evaluation, threshold, alarm) per member, and the isolation.
     pub(super) decisions: Vec<(Vec<[SeriesId; 3]>, SeriesId)>,
+    /// Per bank with a GLR test: (g, threshold) per member, and which test decided.
+    pub(super) glr: Vec<Option<(Vec<[SeriesId; 2]>, SeriesId)>>,
     /// Per fault: (active, value).
     pub(super) faults: Vec<[SeriesId; 2]>,
     pub(super) step_latency: SeriesId,
@@ -121,6 +123,7 @@ pub(super) fn open(path: &Path, s: &Scenario, want: &Wanted) -> Result<Opened, L
     let [x, y, w, v, r, u] = plant_series(&mut namer, s, want.layout, signals);
     let observers = observer_series(&mut namer, s, want, signals, estimates_late);
     let (members, decisions) = bank_series(&mut namer, s, want.banks, signals);
+    let glr = glr_series(&mut namer, want.banks, signals);
     let faults = s
         .faults
         .iter()
@@ -173,6 +176,7 @@ pub(super) fn open(path: &Path, s: &Scenario, want: &Wanted) -> Result<Opened, L
         observers,
         members,
         decisions,
+        glr,
         faults,
         step_latency,
         hops,
@@ -316,4 +320,35 @@ fn bank_series(
         })
         .collect();
     (members, decisions)
+}
+
+/// Per diagnoser bank with a GLR test: (g, its threshold) per member, and which test decided.
+fn glr_series(
+    namer: &mut Namer,
+    banks: &[Bank],
+    g: usize,
+) -> Vec<Option<(Vec<[SeriesId; 2]>, SeriesId)>> {
+    banks
+        .iter()
+        .map(|b| {
+            if b.members.iter().all(|mb| mb.glr.is_none()) {
+                return None;
+            }
+            let d = &b.spec.name;
+            let per = (0..b.members.len())
+                .map(|i| {
+                    [
+                        namer.series(g, sig::glr(d, i), format!("GLR g{} ({d})", i + 1)),
+                        namer.series(
+                            g,
+                            sig::glr_threshold(d, i),
+                            format!("GLR threshold {} ({d})", i + 1),
+                        ),
+                    ]
+                })
+                .collect();
+            let by = namer.series(g, sig::decided_by(d), format!("decided by ({d})"));
+            Some((per, by))
+        })
+        .collect()
 }

@@ -501,6 +501,15 @@ impl Session {
             }
             sink.push(*isolated, m.isolation.code());
         }
+        for (m, glr) in self.monitors.iter().zip(&ch.glr) {
+            if let Some((per, by)) = glr {
+                for (i, [g, th]) in per.iter().enumerate() {
+                    sink.push(*g, m.glr_stats[i]);
+                    sink.push(*th, m.glr_thresholds[i]);
+                }
+                sink.push(*by, m.decided_by.code());
+            }
+        }
         for (i, [active, value]) in ch.faults.iter().enumerate() {
             let f = &row.plant[lay.fault(i)];
             sink.push(*active, f[0]);

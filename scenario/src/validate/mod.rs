@@ -118,6 +118,7 @@ fn build(raw: RawScenario, dir: Option<&Path>) -> Result<Scenario, Bad> {
         &plant.model,
         &plant.ff,
         truth.noise.as_ref(),
+        dt,
         &mut taken,
     )?;
     observers::bank_members(&diagnosers, &plant.model, &plant.ff, &mut observers);
