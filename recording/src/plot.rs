@@ -5,6 +5,7 @@
 //! backend and an embedded font (DejaVu Sans), so nothing but this binary is needed.
 
 mod figure;
+mod map;
 mod raster;
 mod select;
 
@@ -15,6 +16,7 @@ use plotters::style::FontStyle;
 use scenario::{Named, Scenario};
 
 pub use figure::{Curve, Figure, SIZE, Scale};
+pub use map::{Map, draw_map};
 pub use select::{Matcher, PlotSelection};
 
 use crate::palette;

@@ -335,7 +335,80 @@ pub fn plots(
             }
         }
     }
+    maps(dir, name, varies, outcomes, &mut written, &mut skipped)?;
     Ok((written, skipped))
+}
+
+/// A 2-D map per figure and pair of varied parameters whose other parameters take one value
+/// among the points (two varied: every pair; more: the pairs the others do not vary within):
+/// `<name>.vary_<figure>__<p>__<q>.png`, the nominal point ringed and the worst crossed.
+fn maps(
+    dir: &Path,
+    name: &str,
+    varies: &[Vary],
+    outcomes: &[Outcome],
+    written: &mut Vec<PathBuf>,
+    skipped: &mut Vec<String>,
+) -> Result<(), String> {
+    let varied: Vec<&Outcome> = outcomes.iter().filter(|o| !o.point.nominal).collect();
+    let nominal = outcomes.iter().find(|o| o.point.nominal);
+    for a in 0..varies.len() {
+        for b in a + 1..varies.len() {
+            let rest = |p: &Point| -> Vec<f64> {
+                p.values
+                    .iter()
+                    .enumerate()
+                    .filter(|(j, _)| *j != a && *j != b)
+                    .map(|(_, x)| *x)
+                    .collect()
+            };
+            let mut combos: Vec<Vec<f64>> = Vec::new();
+            for o in &varied {
+                let r = rest(&o.point);
+                if !combos.iter().any(|c| same(c, &r)) {
+                    combos.push(r);
+                }
+            }
+            if combos.len() > 1 {
+                skipped.push(format!(
+                    "no map of {} against {}: the other parameters take {} values among the points",
+                    varies[a].text,
+                    varies[b].text,
+                    combos.len()
+                ));
+                continue;
+            }
+            for c in columns(outcomes) {
+                let at = |o: &Outcome| (o.point.values[a], o.point.values[b]);
+                let map = recording::plot::Map {
+                    title: format!(
+                        "{name}: {c} over {} and {}",
+                        varies[a].text, varies[b].text
+                    ),
+                    x_label: varies[a].text.clone(),
+                    y_label: varies[b].text.clone(),
+                    value_label: c.clone(),
+                    points: varied
+                        .iter()
+                        .filter(|o| o.status == "completed")
+                        .filter_map(|o| o.figures.get(&c).map(|v| (at(o).0, at(o).1, v)))
+                        .collect(),
+                    nominal: nominal.map(at),
+                    worst: worst(outcomes, &c).map(|(i, _)| at(&outcomes[i])),
+                };
+                let path = dir.join(format!(
+                    "{name}.vary_{}__{}__{}.png",
+                    sanitize(&c),
+                    sanitize(&varies[a].text),
+                    sanitize(&varies[b].text)
+                ));
+                if recording::plot::draw_map(&path, &map)? {
+                    written.push(path);
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 /// What [`write`] wrote.

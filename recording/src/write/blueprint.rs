@@ -96,8 +96,9 @@ fn state_title(i: usize, x: &Named) -> String {
     }
 }
 
-/// Per bank: its residuals, their evaluations against the thresholds, the alarms and the
-/// isolated channel; and the injected faults for reference.
+/// Per bank: its residuals, their evaluations against the thresholds (and its GLR statistics
+/// against theirs), the alarms, the isolated channel (and which test decided); and the injected
+/// faults for reference.
 fn diagnosis_views(s: &Scenario, layout: &Layout) -> Vec<ContainerLike> {
     let mut views: Vec<ContainerLike> = Vec::new();
     for d in &s.diagnosers {
@@ -115,9 +116,23 @@ fn diagnosis_views(s: &Scenario, layout: &Layout) -> Vec<ContainerLike> {
             ],
             layout,
         ));
+        if d.glr.is_some() {
+            views.push(plot(
+                format!("GLR statistics g and thresholds ({n})"),
+                &[
+                    format!("/diagnosis/{n}/glr/**"),
+                    format!("/diagnosis/{n}/glr_threshold/**"),
+                ],
+                layout,
+            ));
+        }
+        let mut decisions = vec![format!("/diagnosis/{n}/alarm/**"), signals::isolated(n)];
+        if d.glr.is_some() {
+            decisions.push(signals::decided_by(n));
+        }
         views.push(plot(
             format!("alarms, isolated channel ({n})"),
-            &[format!("/diagnosis/{n}/alarm/**"), signals::isolated(n)],
+            &decisions,
             layout,
         ));
     }
