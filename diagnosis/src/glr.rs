@@ -49,9 +49,9 @@
 //!    predictor forgets a wrong ζ̂_0 only at the rate of F − LH, which can be far slower than F
 //!    (seed 003's members: |λ| = 0.9917 against 0.97). Until the first decided step the predictor
 //!    is the time-varying Kalman filter from a diffuse start, P_0 = κI with κ = 10⁶·max(1, ‖X‖):
-//!    L_k = (FP_kHᵀ + S_n)Σ_{e,k}⁻¹, P_{k+1} = (F − L_kH)P_k(F − L_kH)ᵀ + Q_n − L_kS_nᵀ − S_nL_kᵀ
-//!    + L_kR_nL_kᵀ (Joseph's form), which takes the start-up transient into ζ̂ within a few
-//!    samples; from then on the steady L. (On seed 003's recorded residuals: innovations of
+//!    L_k = (FP_kHᵀ + S_n)Σ_{e,k}⁻¹ and, in Joseph's form,
+//!    P_{k+1} = (F − L_kH)P_k(F − L_kH)ᵀ + Q_n − L_kS_nᵀ − S_nL_kᵀ + L_kR_nL_kᵀ,
+//!    which takes the start-up transient into ζ̂ within a few samples; from then on the steady L. (On seed 003's recorded residuals: innovations of
 //!    variance 1.04 and lag-1 correlation −0.02 from 3 s on, against 1.5–2.3 with the steady
 //!    predictor from ζ̂_0 = 0.)
 //!
@@ -66,16 +66,8 @@ use statrs::distribution::{ChiSquared, ContinuousCDF};
 use crate::covariance::tracked;
 use crate::evaluate::whitening;
 use crate::residual::Residual;
+use crate::spec::GlrSpec;
 use crate::structure::FaultInput;
-
-/// What a `glr = { window, false_alarm }` asks for.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct GlrSpec {
-    /// How long an onset is tried for, s (N = round(window/dt) samples).
-    pub window: f64,
-    /// The bound on the false-alarm probability per sample, α.
-    pub false_alarm: f64,
-}
 
 /// One member's GLR test, designed.
 #[derive(Debug, Clone)]

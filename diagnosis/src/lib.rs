@@ -26,5 +26,4 @@ pub use bank::BankError;
 pub use bank::{Bank, Member, design_bank};
 pub use decide::{DecidedBy, Isolation, Monitor};
 pub use figures::{Diagnosis, FaultFigure, FaultInfo, IsolatedBy, Judge, ResidualFigure};
-pub use glr::GlrSpec;
-pub use spec::{Channels, DiagnoserSpec, Evaluation, MemberKind, Scheme, Threshold};
+pub use spec::{Channels, DiagnoserSpec, Evaluation, GlrSpec, MemberKind, Scheme, Threshold};

@@ -106,5 +106,14 @@ pub struct DiagnoserSpec {
     /// No decision before this time, s (the observers' start-up transient).
     pub ignore_before: f64,
     /// A windowed GLR test beside the evaluation ([`crate::glr`]), if asked for.
-    pub glr: Option<crate::glr::GlrSpec>,
+    pub glr: Option<GlrSpec>,
+}
+
+/// What a `glr = { window, false_alarm }` asks for ([`crate::glr`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GlrSpec {
+    /// How long an onset is tried for, s (N = round(window/dt) samples).
+    pub window: f64,
+    /// The bound on the false-alarm probability per sample, α.
+    pub false_alarm: f64,
 }

@@ -117,7 +117,7 @@ fn bank(b: &diagnosis::Bank, dt: f64) -> Value {
         .iter()
         .enumerate()
         .map(|(i, m)| {
-            json!({
+            let mut member = json!({
                 "name": m.name, "role": diagnosis::bank::role(d, &b.channels, i),
                 "kind": m.designed.report.kind,
                 "outputs": m.outputs.iter().map(|j| j + 1).collect::<Vec<_>>(),
@@ -125,14 +125,18 @@ fn bank(b: &diagnosis::Bank, dt: f64) -> Value {
                 "discrete_poles": lti::re_im(&m.designed.report.discrete_poles),
                 "threshold": m.threshold, "dof": m.dof,
                 "residual_covariance": m.covariance.as_ref().map(rows),
-                "glr": m.glr.as_ref().map(|g| json!({
+                "sampled": sampled(&m.designed.runtime, dt),
+            });
+            // Only a bank with a GLR test has the key (the others' JSON as before).
+            if let Some(g) = &m.glr {
+                member["glr"] = json!({
                     "window": g.window, "threshold": g.threshold,
                     "channels": g.channels.iter().map(|&j| &b.channels[j]).collect::<Vec<_>>(),
                     "innovation_covariance": rows(&g.innovation),
                     "predictor_gain": rows(&g.gain),
-                })),
-                "sampled": sampled(&m.designed.runtime, dt),
-            })
+                });
+            }
+            member
         })
         .collect();
     json!({

@@ -381,10 +381,7 @@ fn maps(
             for c in columns(outcomes) {
                 let at = |o: &Outcome| (o.point.values[a], o.point.values[b]);
                 let map = recording::plot::Map {
-                    title: format!(
-                        "{name}: {c} over {} and {}",
-                        varies[a].text, varies[b].text
-                    ),
+                    title: format!("{name}: {c} over {} and {}", varies[a].text, varies[b].text),
                     x_label: varies[a].text.clone(),
                     y_label: varies[b].text.clone(),
                     value_label: c.clone(),

@@ -83,109 +83,8 @@ pub fn draw_map(path: &Path, map: &Map) -> Result<bool, String> {
     let (y0, y1) = pad(y0, y1, sy);
     let (w, h) = (SIZE.0 as usize, SIZE.1 as usize);
     let mut buf = vec![255u8; 3 * w * h];
-    {
-        let root = BitMapBackend::with_buffer(&mut buf, SIZE).into_drawing_area();
-        let (left, right) = root.split_horizontally(SIZE.0 - BAR_W);
-        let mut chart = ChartBuilder::on(&left)
-            .caption(&map.title, ("sans-serif", 22))
-            .margin(14)
-            .x_label_area_size(52)
-            .y_label_area_size(96)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(|e| e.to_string())?;
-        chart
-            .configure_mesh()
-            .x_desc(&map.x_label)
-            .y_desc(&map.y_label)
-            .label_style(("sans-serif", 15))
-            .axis_desc_style(("sans-serif", 16))
-            .disable_mesh()
-            .draw()
-            .map_err(|e| e.to_string())?;
-        let colour = |v: f64| {
-            let t = if v1 > v0 { (v - v0) / (v1 - v0) } else { 0.5 };
-            ViridisRGB.get_color(t as f32)
-        };
-        let area = chart.plotting_area();
-        for &(x, y, v) in &points {
-            if let (true, Some(cx), Some(cy)) = (grid, sx, sy) {
-                area.draw(&Rectangle::new(
-                    [(x - cx / 2.0, y - cy / 2.0), (x + cx / 2.0, y + cy / 2.0)],
-                    colour(v).filled(),
-                ))
-                .map_err(|e| e.to_string())?;
-            } else {
-                let (px, py) = chart.backend_coord(&(x, y));
-                root.draw(&Rectangle::new(
-                    [
-                        (px - MARKER / 2, py - MARKER / 2),
-                        (px + MARKER / 2, py + MARKER / 2),
-                    ],
-                    colour(v).filled(),
-                ))
-                .map_err(|e| e.to_string())?;
-            }
-        }
-        if let Some(n) = map.nominal {
-            let (px, py) = chart.backend_coord(&n);
-            for r in [11, 12] {
-                root.draw(&Circle::new((px, py), r, WHITE.stroke_width(2)))
-                    .map_err(|e| e.to_string())?;
-            }
-            root.draw(&Circle::new((px, py), 10, BLACK.stroke_width(2)))
-                .map_err(|e| e.to_string())?;
-        }
-        if let Some(wp) = map.worst {
-            let (px, py) = chart.backend_coord(&wp);
-            for (colour, width) in [(WHITE, 5), (RED, 2)] {
-                for d in [(-9, -9, 9, 9), (-9, 9, 9, -9)] {
-                    root.draw(&PathElement::new(
-                        vec![(px + d.0, py + d.1), (px + d.2, py + d.3)],
-                        colour.stroke_width(width),
-                    ))
-                    .map_err(|e| e.to_string())?;
-                }
-            }
-        }
-        // The colour bar: the figure's range bottom to top, its ends and middle labelled.
-        let bx = right.get_pixel_range().0.start;
-        let (top, bottom) = (80i32, SIZE.1 as i32 - 90);
-        let style = ("sans-serif", 15).into_font();
-        root.draw(&Text::new(
-            map.value_label.clone(),
-            (bx + 14, top - 40),
-            style.clone(),
-        ))
-        .map_err(|e| e.to_string())?;
-        for row in top..=bottom {
-            let t = (bottom - row) as f64 / (bottom - top) as f64;
-            root.draw(&PathElement::new(
-                vec![(bx + 14, row), (bx + 44, row)],
-                colour(v0 + t * (v1 - v0)).stroke_width(1),
-            ))
-            .map_err(|e| e.to_string())?;
-        }
-        for (t, v) in [(0.0, v0), (0.5, 0.5 * (v0 + v1)), (1.0, v1)] {
-            let row = bottom - (t * (bottom - top) as f64) as i32;
-            root.draw(&Text::new(
-                lti::eig::sig(v),
-                (bx + 52, row - 8),
-                style.clone(),
-            ))
-            .map_err(|e| e.to_string())?;
-        }
-        let mut y = bottom + 24;
-        if map.nominal.is_some() {
-            root.draw(&Text::new("○ nominal", (bx + 14, y), style.clone()))
-                .map_err(|e| e.to_string())?;
-            y += 22;
-        }
-        if map.worst.is_some() {
-            root.draw(&Text::new("✕ worst", (bx + 14, y), style.color(&RED)))
-                .map_err(|e| e.to_string())?;
-        }
-        root.present().map_err(|e| e.to_string())?;
-    }
+    let cells = sx.zip(sy).filter(|_| grid);
+    paint(&mut buf, map, &points, cells, (x0, x1, y0, y1), (v0, v1))?;
     // Written staged (`outputs`), as the line plots are.
     outputs::write(path, |w| {
         use image::ImageEncoder;
@@ -194,4 +93,132 @@ pub fn draw_map(path: &Path, map: &Map) -> Result<bool, String> {
             .map_err(|e| e.to_string())
     })?;
     Ok(true)
+}
+
+/// The figure's colour at value v of the range [v0, v1].
+fn viridis(v: f64, v0: f64, v1: f64) -> RGBColor {
+    let t = if v1 > v0 { (v - v0) / (v1 - v0) } else { 0.5 };
+    ViridisRGB.get_color(t as f32)
+}
+
+/// Axes, cells (of the grid's `cells` size, else squares), the nominal and worst marks and the
+/// colour bar, into `buf`.
+fn paint(
+    buf: &mut [u8],
+    map: &Map,
+    points: &[(f64, f64, f64)],
+    cells: Option<(f64, f64)>,
+    (x0, x1, y0, y1): (f64, f64, f64, f64),
+    (v0, v1): (f64, f64),
+) -> Result<(), String> {
+    let root = BitMapBackend::with_buffer(buf, SIZE).into_drawing_area();
+    let (left, right) = root.split_horizontally(SIZE.0 - BAR_W);
+    let mut chart = ChartBuilder::on(&left)
+        .caption(&map.title, ("sans-serif", 22))
+        .margin(14)
+        .x_label_area_size(52)
+        .y_label_area_size(96)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(|e| e.to_string())?;
+    chart
+        .configure_mesh()
+        .x_desc(&map.x_label)
+        .y_desc(&map.y_label)
+        .label_style(("sans-serif", 15))
+        .axis_desc_style(("sans-serif", 16))
+        .disable_mesh()
+        .draw()
+        .map_err(|e| e.to_string())?;
+    let colour = |v: f64| viridis(v, v0, v1);
+    let area = chart.plotting_area();
+    for &(x, y, v) in points {
+        if let Some((cx, cy)) = cells {
+            area.draw(&Rectangle::new(
+                [(x - cx / 2.0, y - cy / 2.0), (x + cx / 2.0, y + cy / 2.0)],
+                colour(v).filled(),
+            ))
+            .map_err(|e| e.to_string())?;
+        } else {
+            let (px, py) = chart.backend_coord(&(x, y));
+            root.draw(&Rectangle::new(
+                [
+                    (px - MARKER / 2, py - MARKER / 2),
+                    (px + MARKER / 2, py + MARKER / 2),
+                ],
+                colour(v).filled(),
+            ))
+            .map_err(|e| e.to_string())?;
+        }
+    }
+    if let Some(n) = map.nominal {
+        let (px, py) = chart.backend_coord(&n);
+        for r in [11, 12] {
+            root.draw(&Circle::new((px, py), r, WHITE.stroke_width(2)))
+                .map_err(|e| e.to_string())?;
+        }
+        root.draw(&Circle::new((px, py), 10, BLACK.stroke_width(2)))
+            .map_err(|e| e.to_string())?;
+    }
+    if let Some(wp) = map.worst {
+        let (px, py) = chart.backend_coord(&wp);
+        for (colour, width) in [(WHITE, 5), (RED, 2)] {
+            for d in [(-9, -9, 9, 9), (-9, 9, 9, -9)] {
+                root.draw(&PathElement::new(
+                    vec![(px + d.0, py + d.1), (px + d.2, py + d.3)],
+                    colour.stroke_width(width),
+                ))
+                .map_err(|e| e.to_string())?;
+            }
+        }
+    }
+    colour_bar(&root, right.get_pixel_range().0.start, map, (v0, v1))?;
+    root.present().map_err(|e| e.to_string())?;
+    Ok(())
+}
+
+/// The colour bar right of the map at pixel column `bx`: the figure's range bottom to top, its
+/// ends and middle labelled, and the marks' legend below it.
+fn colour_bar(
+    root: &DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>,
+    bx: i32,
+    map: &Map,
+    (v0, v1): (f64, f64),
+) -> Result<(), String> {
+    let colour = |v: f64| viridis(v, v0, v1);
+    let (top, bottom) = (80i32, SIZE.1 as i32 - 90);
+    let style = ("sans-serif", 15).into_font();
+    root.draw(&Text::new(
+        map.value_label.clone(),
+        (bx + 14, top - 40),
+        style.clone(),
+    ))
+    .map_err(|e| e.to_string())?;
+    for row in top..=bottom {
+        let t = (bottom - row) as f64 / (bottom - top) as f64;
+        root.draw(&PathElement::new(
+            vec![(bx + 14, row), (bx + 44, row)],
+            colour(v0 + t * (v1 - v0)).stroke_width(1),
+        ))
+        .map_err(|e| e.to_string())?;
+    }
+    for (t, v) in [(0.0, v0), (0.5, 0.5 * (v0 + v1)), (1.0, v1)] {
+        let row = bottom - (t * (bottom - top) as f64) as i32;
+        root.draw(&Text::new(
+            lti::eig::sig(v),
+            (bx + 52, row - 8),
+            style.clone(),
+        ))
+        .map_err(|e| e.to_string())?;
+    }
+    let mut y = bottom + 24;
+    if map.nominal.is_some() {
+        root.draw(&Text::new("○ nominal", (bx + 14, y), style.clone()))
+            .map_err(|e| e.to_string())?;
+        y += 22;
+    }
+    if map.worst.is_some() {
+        root.draw(&Text::new("✕ worst", (bx + 14, y), style.color(&RED)))
+            .map_err(|e| e.to_string())?;
+    }
+    Ok(())
 }

@@ -361,14 +361,15 @@ fn monte_carlo_of_200_runs_detects_isolates_and_keeps_the_asked_false_alarm_prob
             assert_eq!(f["first_isolation_correct"], 200, "{name}: {f}");
             // `isolation_accuracy` counts the realisations isolated for ≥ 90 % of the fault's
             // time: the actuator bank holds its isolation; the sensor bank's Luenberger residuals
-            // settle under the χ² threshold, so its faults are isolated right but only briefly.
+            // settle under the χ² threshold, and its GLR test holds the isolation instead — the
+            // bias in every realisation, the drift (which must first grow) in ≥ 95 % of them.
             let share = &f["isolated_fraction"];
-            if name == "seed002-actuator-faults" {
-                assert_eq!(f["isolation_accuracy"], 1.0, "{name}: {f}");
-                assert!(share["min"].as_f64().unwrap() >= 0.9, "{name}: {f}");
+            let accuracy = f["isolation_accuracy"].as_f64().unwrap();
+            if f["name"] == "airspeed-drift" {
+                assert!(accuracy >= 0.95, "{name}: {f}");
             } else {
-                assert_eq!(f["isolation_accuracy"], 0.0, "{name}: {f}");
-                assert!(share["max"].as_f64().unwrap() < 0.9, "{name}: {f}");
+                assert_eq!(accuracy, 1.0, "{name}: {f}");
+                assert!(share["min"].as_f64().unwrap() >= 0.9, "{name}: {f}");
             }
         }
         assert!(sw["false_alarm_rate_per_hour"].is_number(), "{name}");
