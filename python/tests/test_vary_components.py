@@ -94,7 +94,8 @@ def test_every_point_is_the_single_run_of_its_parameters_bit_for_bit(motor, tmp_
         assert (e >= 4 * what[0]) if tau_c > TAU_C else (e <= what[0]), (r, what)
     summary = json.loads((out / "dc-motor-fmu.vary.json").read_text())
     pngs = sorted(out.glob("dc-motor-fmu.vary_*.png"))
-    assert len(pngs) == len(summary["columns"]) * 2, pngs
+    # A plot per figure and parameter, and a 2-D map per figure over the two parameters.
+    assert len(pngs) == len(summary["columns"]) * 3, pngs
     assert all(p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for p in pngs)
 
 

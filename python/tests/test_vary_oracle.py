@@ -140,9 +140,9 @@ def test_every_points_tail_errors_follow_an_independent_simulation(scenario, tmp
     summary = json.loads((out / "mismatch.vary.json").read_text())
     assert summary["worst"]["tail max|e| luenberger"]["value"] == max(seen["luenberger"])
     assert "worst at" in done.stdout
-    # One PNG per figure and varied parameter.
     pngs = sorted(p.name for p in out.glob("mismatch.vary_*.png"))
-    assert len(pngs) == len(summary["columns"]) * 2, pngs
+    # A plot per figure and parameter, and a 2-D map per figure over the two parameters.
+    assert len(pngs) == len(summary["columns"]) * 3, pngs
     for p in pngs:
         assert (out / p).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
