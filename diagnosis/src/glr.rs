@@ -414,13 +414,9 @@ fn sym(m: &Mat) -> Mat {
 mod tests {
     use super::*;
 
-    /// A residual that is its measurement noise (r = ν, σ = 2: F = 0.2 with no input, so the
-    /// observer's state stays 0): the innovations are the residual itself, a step on the output
-    /// has the flat signature ±1/σ, and a step of 2σ from step 3 on gives g_k = 4(k − 2).
-    #[test]
-    fn a_white_residual_is_its_own_innovation_and_a_step_accumulates_linearly() {
-        let phi = Mat::from_row_slice(1, 1, &[0.5]);
-        let c = Mat::from_row_slice(1, 1, &[1.0]);
+    /// The design for a residual that is its measurement noise (r = ν, σ = 2: F = 0.2 with no
+    /// input, so the observer's state stays 0), one tested output, dt = 1, α = 10⁻³.
+    fn white_residual(window: f64) -> GlrDesign {
         let obs = LinearObserver {
             f: (&Mat::from_row_slice(1, 1, &[0.2])).into(),
             g: (&Mat::zeros(1, 0)).into(),
@@ -430,24 +426,29 @@ mod tests {
             xhat0: None,
             offset: None,
         };
-        let qd = Mat::from_row_slice(1, 1, &[0.0]);
-        let r = Mat::from_row_slice(1, 1, &[4.0]);
         let spec = GlrSpec {
-            window: 5.0,
+            window,
             false_alarm: 1e-3,
         };
-        let g = GlrDesign::new(
-            &phi,
-            &c,
+        GlrDesign::new(
+            &Mat::from_row_slice(1, 1, &[0.5]),
+            &Mat::from_row_slice(1, 1, &[1.0]),
             &obs,
             &[0],
             &[FaultInput::Output(0)],
             vec![0],
-            (&qd, &r),
+            (&Mat::zeros(1, 1), &Mat::from_row_slice(1, 1, &[4.0])),
             spec,
             1.0,
         )
-        .unwrap();
+        .unwrap()
+    }
+
+    /// A white residual: the innovations are the residual itself, a step on the output has the
+    /// flat signature ±1/σ, and a step of 2σ from step 3 on gives g_k = 4(k − 2).
+    #[test]
+    fn a_white_residual_is_its_own_innovation_and_a_step_accumulates_linearly() {
+        let g = white_residual(5.0);
         assert!((g.innovation[(0, 0)] - 4.0).abs() < 1e-12);
         assert_eq!(g.window, 5);
         for i in 0..5 {
@@ -478,26 +479,7 @@ mod tests {
     /// after it.
     #[test]
     fn a_step_is_held_until_the_step_back_is_seen() {
-        let phi = Mat::from_row_slice(1, 1, &[0.5]);
-        let c = Mat::from_row_slice(1, 1, &[1.0]);
-        let obs = LinearObserver {
-            f: (&Mat::from_row_slice(1, 1, &[0.2])).into(),
-            g: (&Mat::zeros(1, 0)).into(),
-            k: (&Mat::zeros(1, 1)).into(),
-            p: (&Mat::from_row_slice(1, 1, &[1.0])).into(),
-            q: (&Mat::zeros(1, 1)).into(),
-            xhat0: None,
-            offset: None,
-        };
-        let (qd, r) = (Mat::zeros(1, 1), Mat::from_row_slice(1, 1, &[4.0]));
-        let spec = GlrSpec {
-            window: 20.0,
-            false_alarm: 1e-3,
-        };
-        let inputs = [FaultInput::Output(0)];
-        let g =
-            GlrDesign::new(&phi, &c, &obs, &[0], &inputs, vec![0], (&qd, &r), spec, 1.0).unwrap();
-        let mut t = Glr::new(g, 0, 1);
+        let mut t = Glr::new(white_residual(20.0), 0, 1);
         let alarms: Vec<bool> = (0..22u64)
             .map(|k| {
                 let r = if (3..13).contains(&k) { 4.0 } else { 0.0 };

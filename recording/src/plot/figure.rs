@@ -231,15 +231,19 @@ pub fn draw(path: &Path, fig: &Figure) -> Result<bool, String> {
             );
         }
     }
-    // Encoded here and written staged (`outputs`): plotters' file backend would create the path
-    // itself, through any link planted there.
+    write_png(path, &buf)?;
+    Ok(true)
+}
+
+/// An RGB buffer of [`SIZE`] as the PNG `path`: encoded here and written staged (`outputs`), as
+/// plotters' file backend would create the path itself, through any link planted there.
+pub(super) fn write_png(path: &Path, buf: &[u8]) -> Result<(), String> {
     outputs::write(path, |w| {
         use image::ImageEncoder;
         image::codecs::png::PngEncoder::new(w)
-            .write_image(&buf, SIZE.0, SIZE.1, image::ColorType::Rgb8)
+            .write_image(buf, SIZE.0, SIZE.1, image::ColorType::Rgb8)
             .map_err(|e| e.to_string())
-    })?;
-    Ok(true)
+    })
 }
 
 /// Title, grid, ticks, frame and legend text; returns the plot rectangle and where each

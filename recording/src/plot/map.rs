@@ -6,7 +6,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::figure::SIZE;
+use super::figure::{SIZE, write_png};
 
 /// Width of the colour bar's column.
 const BAR_W: u32 = 290;
@@ -85,13 +85,7 @@ pub fn draw_map(path: &Path, map: &Map) -> Result<bool, String> {
     let mut buf = vec![255u8; 3 * w * h];
     let cells = sx.zip(sy).filter(|_| grid);
     paint(&mut buf, map, &points, cells, (x0, x1, y0, y1), (v0, v1))?;
-    // Written staged (`outputs`), as the line plots are.
-    outputs::write(path, |w| {
-        use image::ImageEncoder;
-        image::codecs::png::PngEncoder::new(w)
-            .write_image(&buf, SIZE.0, SIZE.1, image::ColorType::Rgb8)
-            .map_err(|e| e.to_string())
-    })?;
+    write_png(path, &buf)?;
     Ok(true)
 }
 
