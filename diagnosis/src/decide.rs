@@ -96,6 +96,8 @@ pub struct Monitor {
     pub isolation: Isolation,
     /// Per member, its GLR test, if the bank has one.
     glr: Vec<Option<Glr>>,
+    /// Whether any member has one.
+    has_glr: bool,
     /// This step's GLR statistic g per member (0 without a GLR test).
     pub glr_stats: Vec<f64>,
     /// The GLR thresholds per member (∞ without a GLR test).
@@ -158,6 +160,7 @@ impl Monitor {
                         .map(|g| Glr::new(g, first, bank.spec.persistence))
                 })
                 .collect(),
+            has_glr: bank.members.iter().any(|mb| mb.glr.is_some()),
             glr_stats: vec![0.0; m],
             evaluation_alarms: vec![false; m],
             glr_alarms: vec![false; m],
@@ -167,7 +170,7 @@ impl Monitor {
 
     /// Whether the bank runs a GLR test beside its evaluation.
     pub fn has_glr(&self) -> bool {
-        self.glr.iter().any(Option::is_some)
+        self.has_glr
     }
 
     /// Step k, from every observer's residual y_k − Cx̂_k (as the run's figures computed them):
@@ -197,6 +200,8 @@ impl Monitor {
         self.isolation = self.isolate(&self.alarms);
         self.decided_by = if self.isolation == Isolation::None {
             DecidedBy::None
+        } else if !self.has_glr {
+            DecidedBy::Evaluation
         } else {
             let by_evaluation = self.isolate(&self.evaluation_alarms) == self.isolation;
             let by_glr = self.isolate(&self.glr_alarms) == self.isolation;
@@ -222,17 +227,15 @@ impl Monitor {
         if !alarms.iter().any(|&a| a) {
             return Isolation::None;
         }
-        let m = self.labels.len();
-        let matches: Vec<usize> = (0..m)
-            .filter(|&j| {
-                self.structure
-                    .iter()
-                    .zip(alarms)
-                    .all(|(row, &a)| (row[j] == 1) == a)
-            })
-            .collect();
-        match matches.as_slice() {
-            [j] => Isolation::Channel(self.ids[*j]),
+        // The columns the pattern equals, counted without a list (this runs every step).
+        let mut matches = (0..self.labels.len()).filter(|&j| {
+            self.structure
+                .iter()
+                .zip(alarms)
+                .all(|(row, &a)| (row[j] == 1) == a)
+        });
+        match (matches.next(), matches.next()) {
+            (Some(j), None) => Isolation::Channel(self.ids[j]),
             _ => Isolation::Unknown,
         }
     }

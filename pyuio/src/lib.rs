@@ -31,6 +31,17 @@ fn scenario(path: &str, text: Option<&str>) -> Result<Scenario, LaunchError> {
     })
 }
 
+/// The scenario at `path` (its seed replaced by `seed`, if given), designed and calibrated once:
+/// what every realisation of a sweep or point of a variation shares.
+fn planned(path: &str, seed: Option<u64>) -> PyResult<(Scenario, launcher::plan::Plan)> {
+    let mut s = scenario(path, None).map_err(raise)?;
+    if let Some(seed) = seed {
+        s.seed = seed;
+    }
+    let p = launcher::calibrate::planned(&s).map_err(raise)?;
+    Ok((s, p))
+}
+
 /// `uio-launcher design --json`: (every design holds, the JSON report, the text report).
 #[pyfunction]
 #[pyo3(signature = (path, text=None))]
@@ -102,12 +113,8 @@ fn sweep_shard(
     launcher::limits::sharded_runs(runs, sh.range(runs).len())
         .and_then(|_| launcher::limits::jobs(jobs))
         .map_err(raise)?;
-    let mut s = scenario(path, None).map_err(raise)?;
-    if let Some(seed) = seed {
-        s.seed = seed;
-    }
     // One calibration for every realisation, from the first seed: every shard's the same.
-    let p = launcher::calibrate::planned(&s).map_err(raise)?;
+    let (s, p) = planned(path, seed)?;
     let opts = launcher::sweep::SweepOptions {
         runs,
         jobs,
@@ -175,12 +182,8 @@ fn vary(
         )));
     }
     launcher::limits::jobs(jobs).map_err(raise)?;
-    let mut s = scenario(path, None).map_err(raise)?;
-    if let Some(seed) = seed {
-        s.seed = seed;
-    }
     // Designed (and calibrated) once, on the nominal model, as the launcher does.
-    let p = launcher::calibrate::planned(&s).map_err(raise)?;
+    let (s, p) = planned(path, seed)?;
     let opts = launcher::vary::VaryOptions {
         varies,
         draws: points,

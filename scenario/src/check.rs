@@ -53,6 +53,19 @@ pub(crate) fn finite(field: &str, v: f64) -> Result<f64, Bad> {
     }
 }
 
+/// A false-alarm probability per sample: finite, in (0, 0.5).
+pub(crate) fn false_alarm(field: &str, a: f64) -> Result<f64, Bad> {
+    let a = finite(field, a)?;
+    if a > 0.0 && a < 0.5 {
+        Ok(a)
+    } else {
+        Err(bad(
+            field,
+            format!("{a}: a false-alarm probability per sample is between 0 and 0.5"),
+        ))
+    }
+}
+
 /// A matrix from rows: not empty, not ragged, finite, and of the required shape.
 pub(crate) fn matrix(
     field: &str,

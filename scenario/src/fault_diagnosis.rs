@@ -11,7 +11,9 @@ use plant::fault::{Fault, Kind, Profile, Target};
 use super::limits::{MAX_CALIBRATION_RUNS, MAX_WINDOW};
 use super::raw::{RawDiagnoser, RawFault, RawNoise};
 use super::untrusted::quoted;
-use crate::check::{Bad, bad, check_name, definite, finite, matrix, one_of, placement, poles};
+use crate::check::{
+    Bad, bad, check_name, definite, false_alarm, finite, matrix, one_of, placement, poles,
+};
 
 /// The run's noise: the per-step covariances the plant draws from and the Kalman filter uses.
 #[derive(Debug, Clone, PartialEq)]
@@ -694,13 +696,7 @@ fn threshold(
             Threshold::Fixed(t)
         }
         (None, Some(a)) => {
-            let a = finite(&at("false_alarm"), a)?;
-            if !(a > 0.0 && a < 0.5) {
-                return Err(bad(
-                    at("false_alarm"),
-                    format!("{a}: a false-alarm probability per sample is between 0 and 0.5"),
-                ));
-            }
+            let a = false_alarm(&at("false_alarm"), a)?;
             if *evaluation != Evaluation::Chi2 {
                 return Err(bad(
                     at("false_alarm"),

@@ -5,7 +5,7 @@ use diagnosis::GlrSpec;
 
 use super::limits::MAX_GLR_WINDOW;
 use super::raw::RawGlr;
-use crate::check::{Bad, bad, finite};
+use crate::check::{self, Bad, bad, finite};
 
 /// The GLR test of the `i`-th (0-based) diagnoser, if it asks for one.
 pub(crate) fn glr(
@@ -34,13 +34,7 @@ pub(crate) fn glr(
             ),
         ));
     }
-    let false_alarm = finite(&at("false_alarm"), raw.false_alarm)?;
-    if !(false_alarm > 0.0 && false_alarm < 0.5) {
-        return Err(bad(
-            at("false_alarm"),
-            format!("{false_alarm}: a false-alarm probability per sample is between 0 and 0.5"),
-        ));
-    }
+    let false_alarm = check::false_alarm(&at("false_alarm"), raw.false_alarm)?;
     if !noise {
         return Err(bad(
             format!("diagnoser[{}].glr", i + 1),
