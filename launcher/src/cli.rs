@@ -215,6 +215,8 @@ pub struct SweepArgs {
     /// Vary the simulated plant against the design model instead of the noise: an entry or a
     /// whole matrix of A, B, C, E, D scaled (*=) or set (=), over a list [a, b], a grid lo..hi:N
     /// or a distribution U(lo, hi), N(mean, sd), LogU(lo, hi); e.g. 'A[2,3] *= 0.8..1.2:5'.
+    /// Also plant.fmu.parameters.NAME, plant.process.params.NAME, the operating point
+    /// plant.operating_point.u[i] / w[i], the initial state x0[i] and the sampling interval dt.
     /// Repeat for more (grids make a product). Writes DIR/<name>.vary.csv, .vary.json and PNGs.
     #[arg(long, value_name = "SPEC")]
     pub vary: Vec<launcher::vary::spec::Vary>,

@@ -278,6 +278,45 @@ impl Signal {
         }
     }
 
+    /// s(t) + d for every t ≥ 0: the same signal about another level (a plant moved to another
+    /// operating point). A piecewise signal, 0 before its first time, holds d there from t = 0.
+    pub fn shifted(&self, d: f64) -> Signal {
+        match self.clone() {
+            Signal::Constant { value } => Signal::Constant { value: value + d },
+            Signal::Step {
+                time,
+                before,
+                after,
+            } => Signal::Step {
+                time,
+                before: before + d,
+                after: after + d,
+            },
+            Signal::Sine {
+                amplitude,
+                frequency_hz,
+                phase,
+                offset,
+            } => Signal::Sine {
+                amplitude,
+                frequency_hz,
+                phase,
+                offset: offset + d,
+            },
+            Signal::Piecewise {
+                mut times,
+                mut values,
+            } => {
+                values.iter_mut().for_each(|v| *v += d);
+                if times[0] > 0.0 && d != 0.0 {
+                    times.insert(0, 0.0);
+                    values.insert(0, d);
+                }
+                Signal::Piecewise { times, values }
+            }
+        }
+    }
+
     /// s(t).
     pub fn value(&self, t: f64) -> f64 {
         self.sine_at(t) + self.held(t)
@@ -490,6 +529,45 @@ mod tests {
         assert_eq!(decimal(0.001), (1, -3));
         assert_eq!(decimal(1234.5), (12345, -1));
         assert_eq!(decimal(0.30000000000000004), (30000000000000004, -17));
+    }
+
+    #[test]
+    fn a_shifted_signal_is_the_signal_plus_the_shift_at_every_sample() {
+        let dt = 0.1;
+        for s in [
+            Signal::Constant { value: 2.0 },
+            Signal::Step {
+                time: 0.35,
+                before: 1.0,
+                after: -3.0,
+            },
+            Signal::Sine {
+                amplitude: 1.5,
+                frequency_hz: 0.7,
+                phase: 0.2,
+                offset: 0.5,
+            },
+            Signal::Piecewise {
+                times: vec![0.3, 0.8],
+                values: vec![4.0, -1.0],
+            },
+            Signal::Piecewise {
+                times: vec![-1.0, 0.5],
+                values: vec![4.0, -1.0],
+            },
+        ] {
+            let shifted = s.shifted(0.25);
+            assert!(shifted.validate().is_ok());
+            for k in 0..20 {
+                // The sine's offset is added in another order: equal to an ulp of the sum.
+                let (a, b) = (shifted.sample_step(k, dt), s.sample_step(k, dt) + 0.25);
+                assert!(
+                    (a - b).abs() <= 4.0 * f64::EPSILON * a.abs(),
+                    "{s:?} at {k}: {a} {b}"
+                );
+            }
+            assert_eq!(s.shifted(0.0), s);
+        }
     }
 
     #[test]

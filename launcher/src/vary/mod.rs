@@ -2,7 +2,22 @@
 //!
 //! The plant varied is the built-in one (its matrices), an FMU or a kit component (their
 //! parameters; the points then run as processes, one at a time, as such a plant only runs in
-//! its own process).
+//! its own process). Any of them can also be run at another operating point, from another
+//! initial state, or sampled at another interval:
+//!
+//! - `plant.operating_point.u[i]` (`w[i]`): the plant's known (unknown) input i is moved by
+//!   u′_i − u_op,i at every sample — its `[[input]]` (`[[disturbance]]`) signal shifted — while
+//!   the observers and the controller keep the design's point and offsets. A nonlinear plant
+//!   then settles where its own dynamics put it, which the linear model at u_op only
+//!   approximates; the built-in linear plant settles at the model's new equilibrium, which the
+//!   observers follow exactly. In a closed loop the controller sets the commanded inputs: only a
+//!   measured disturbance's level can be moved this way.
+//! - `x0[i]`: the simulated plant's initial state (the observers keep their `xhat0`).
+//! - `dt`: the plant is sampled at dt′ — its exact sampling, the process noise's Q_d and the
+//!   schedules (inputs, faults, `ignore_before`) at t_k = k·dt′, round(duration/dt′) steps —
+//!   while every observer, bank and controller keeps the gains designed at dt (the controller's
+//!   integrator sums over the samples' dt′). Not for a plant given per step (`time =
+//!   "discrete"`) nor replayed data: their sampling is the data's.
 //!
 //! The observers, banks, thresholds and controller are designed once, on the scenario's model
 //! (the nominal plan); each point of the variation runs the same scenario with the simulated
@@ -28,7 +43,7 @@ use crate::plan::Plan;
 use crate::run::{self, Mode, Options, Stop};
 use figures::Figures;
 use scenario::Scenario;
-use spec::{Matrix, Op, Place, Values, Vary};
+use spec::{Matrix, Op, Place, PointSignal, Values, Vary};
 
 /// Most points of one variation (each a whole run).
 pub const MAX_POINTS: usize = 100_000;
@@ -103,7 +118,7 @@ fn parameters<'s>(
     match place {
         Place::FmuParameter(_) => params.get("parameters")?.as_object(),
         Place::ProcessParameter(_) => params.as_object(),
-        Place::Matrix(..) => None,
+        _ => None,
     }
 }
 
@@ -111,9 +126,96 @@ fn parameters<'s>(
 fn parameter(s: &Scenario, place: &Place) -> Option<f64> {
     let name = match place {
         Place::FmuParameter(n) | Place::ProcessParameter(n) => n,
-        Place::Matrix(..) => return None,
+        _ => return None,
     };
     parameters(s, place)?.get(name)?.as_f64()
+}
+
+/// u_op,i or w_op,i of the design's point (0 without `[plant.operating_point]`).
+fn point_value(s: &Scenario, which: PointSignal, i: usize) -> f64 {
+    s.operating_point.as_ref().map_or(0.0, |op| match which {
+        PointSignal::U => op.u[i],
+        PointSignal::W => op.w[i],
+    })
+}
+
+/// The scenario's value of a vector or scalar place (`None` for a matrix or a parameter).
+/// Precondition: an entry's index inside its vector ([`check`]).
+fn scalar(s: &Scenario, place: &Place) -> Option<f64> {
+    match *place {
+        Place::OperatingPoint(which, i) => Some(point_value(s, which, i)),
+        Place::InitialState(i) => Some(s.x0[i]),
+        Place::SamplePeriod => Some(s.dt),
+        _ => None,
+    }
+}
+
+/// Checks a variation of the operating point, the initial state or dt against the scenario.
+fn check_scalar(s: &Scenario, v: &Vary) -> Result<(), String> {
+    let (n, l, q) = (s.model.n(), s.model.l(), s.model.e.ncols());
+    if s.plant_replay.is_some() {
+        return Err(format!(
+            "{}'s plant is replayed data: its inputs, states and samples are the recording's",
+            s.name
+        ));
+    }
+    let (count, what) = match v.place {
+        Place::OperatingPoint(PointSignal::U, i) => (Some((i, l)), "known inputs"),
+        Place::OperatingPoint(PointSignal::W, i) => (Some((i, q)), "unknown inputs"),
+        Place::InitialState(i) => (Some((i, n)), "states"),
+        _ => (None, ""),
+    };
+    if let Some((i, count)) = count
+        && i >= count
+    {
+        return Err(format!(
+            "the plant has {count} {what}, there is no entry {}",
+            i + 1
+        ));
+    }
+    if let (Place::OperatingPoint(PointSignal::U, i), Some(c)) = (&v.place, &s.controller)
+        && !c.measured.contains(i)
+    {
+        return Err(format!(
+            "in {}'s closed loop the controller commands input {}: move its point by its reference ([[input]] {}) or vary a measured disturbance",
+            s.name,
+            i + 1,
+            i + 1
+        ));
+    }
+    if v.place == Place::SamplePeriod && s.discrete {
+        return Err(format!(
+            "{}'s plant is given per step (time = \"discrete\"): Φ is the sampling of its own dt",
+            s.name
+        ));
+    }
+    let nominal = scalar(s, &v.place).unwrap_or(f64::NAN);
+    if v.op == Op::Scale && nominal == 0.0 {
+        return Err(format!(
+            "{} is 0 in this scenario, a scaling keeps it 0: set it ({} = …)",
+            v.target, v.target
+        ));
+    }
+    if v.place == Place::SamplePeriod {
+        let positive = match &v.values {
+            Values::Grid(g) => g.iter().all(|&x| x > 0.0),
+            Values::Uniform(lo, _) => *lo > 0.0,
+            // Log-uniform draws are positive; a normal one is judged per point.
+            Values::LogUniform(..) | Values::Normal(..) => true,
+        };
+        if !positive {
+            return Err(format!(
+                "dt must stay > 0 (a {} of dt = {})",
+                if v.op == Op::Scale {
+                    "scaling"
+                } else {
+                    "value"
+                },
+                lti::eig::sig(s.dt)
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Checks the `--vary`s against the scenario: matrices of a built-in plant, entries inside
@@ -132,6 +234,9 @@ pub fn check(s: &Scenario, varies: &[Vary]) -> Result<(), LaunchError> {
     let kit = s.plant_process.is_some() && s.plant_fmu.is_none() && s.plant_replay.is_none();
     for v in varies {
         match &v.place {
+            Place::OperatingPoint(..) | Place::InitialState(_) | Place::SamplePeriod => {
+                check_scalar(s, v).map_err(|why| bad(v, why))?;
+            }
             Place::Matrix(..) if other.is_some() => {
                 return Err(bad(
                     v,
@@ -196,7 +301,9 @@ fn nominal_value(s: &Scenario, v: &Vary) -> f64 {
     match (v.op, &v.place) {
         (Op::Scale, _) | (Op::Set, Place::Matrix(_, None)) => 1.0,
         (Op::Set, Place::Matrix(m, Some((i, j)))) => matrix_ref(s, *m)[(*i, *j)],
-        (Op::Set, place) => parameter(s, place).unwrap_or(f64::NAN),
+        (Op::Set, place) => scalar(s, place)
+            .or_else(|| parameter(s, place))
+            .unwrap_or(f64::NAN),
     }
 }
 
@@ -270,14 +377,19 @@ pub fn points(s: &Scenario, opts: &VaryOptions) -> Result<Vec<Point>, LaunchErro
     Ok(out)
 }
 
-/// `s` with the point's plant: each `--vary` applied to the model's matrices or the FMU's
-/// parameters. The nominal point is the scenario itself.
-pub fn apply(s: &Scenario, varies: &[Vary], point: &Point) -> Scenario {
+/// `s` with the point's plant: each `--vary` applied to the model's matrices, the FMU's
+/// parameters, the plant's inputs, initial state or dt. The nominal point is the scenario
+/// itself. A drawn dt that is no sampling interval (≤ 0, or too many steps) is refused, naming it.
+pub fn apply(s: &Scenario, varies: &[Vary], point: &Point) -> Result<Scenario, String> {
     let mut s = s.clone();
     if point.nominal {
-        return s;
+        return Ok(s);
     }
     for (v, &x) in varies.iter().zip(&point.values) {
+        let value = |nominal: f64| match v.op {
+            Op::Scale => nominal * x,
+            Op::Set => x,
+        };
         match &v.place {
             Place::Matrix(m, entry) => {
                 let m = matrix(&mut s, *m);
@@ -289,10 +401,7 @@ pub fn apply(s: &Scenario, varies: &[Vary], point: &Point) -> Scenario {
                 }
             }
             Place::FmuParameter(name) | Place::ProcessParameter(name) => {
-                let value = match v.op {
-                    Op::Scale => parameter(&s, &v.place).unwrap_or(f64::NAN) * x,
-                    Op::Set => x,
-                };
+                let value = value(parameter(&s, &v.place).unwrap_or(f64::NAN));
                 let params = s.plant_process.as_mut().map(|p| &mut p.params);
                 let map = match (&v.place, params) {
                     (Place::FmuParameter(_), Some(p)) => p.get_mut("parameters"),
@@ -302,9 +411,34 @@ pub fn apply(s: &Scenario, varies: &[Vary], point: &Point) -> Scenario {
                     map.insert(name.clone(), serde_json::json!(value));
                 }
             }
+            &Place::OperatingPoint(which, i) => {
+                let nominal = point_value(&s, which, i);
+                let shift = value(nominal) - nominal;
+                let signal = match which {
+                    PointSignal::U => &mut s.inputs[i],
+                    PointSignal::W => &mut s.disturbances[i],
+                };
+                *signal = signal.shifted(shift);
+            }
+            &Place::InitialState(i) => s.x0[i] = value(s.x0[i]),
+            Place::SamplePeriod => {
+                let dt = value(s.dt);
+                let steps = (s.duration / dt).round();
+                let runs = (1.0..=scenario::limits::MAX_STEPS as f64).contains(&steps);
+                if !(dt > 0.0 && dt.is_finite() && runs) {
+                    return Err(format!(
+                        "dt = {} gives no run of {} s (1 … {} steps)",
+                        lti::eig::sig(dt),
+                        lti::eig::sig(s.duration),
+                        scenario::limits::MAX_STEPS
+                    ));
+                }
+                s.dt = dt;
+                s.steps = steps as u64;
+            }
         }
     }
-    s
+    Ok(s)
 }
 
 /// How the points run: in one process, or — an FMU or kit component plant, which runs only in
@@ -358,7 +492,17 @@ fn one(
     opts: &VaryOptions,
     point: &Point,
 ) -> Result<Outcome, LaunchError> {
-    let varied = apply(s, &opts.varies, point);
+    let varied = match apply(s, &opts.varies, point) {
+        Ok(v) => v,
+        Err(why) => {
+            return Ok(Outcome {
+                point: point.clone(),
+                status: "failed",
+                reason: Some(why),
+                figures: Figures::default(),
+            });
+        }
+    };
     let o = run::run(
         &varied,
         plan,

@@ -1,5 +1,7 @@
 //! What a `--vary` names: one entry (or a whole matrix) of the built-in plant's A, B, C, E or D,
-//! or a parameter of an FMU plant or of a kit component plant; how it differs from the design model, and over which values.
+//! a parameter of an FMU plant or of a kit component plant, the point the plant operates at, its
+//! initial state or its sampling interval; how it differs from the design model, and over which
+//! values.
 //!
 //! ```text
 //! A[2,3] *= 0.8..1.2:5              a scaling on a grid: 5 points from 0.8 to 1.2 (linspace)
@@ -10,6 +12,10 @@
 //! plant.fmu.parameters.J *= 0.5..2:4   the FMU's start value of J scaled (as the scenario gives it)
 //! plant.fmu.parameters.b = [0.05, 0.1, 0.2]   the FMU's parameter b set
 //! plant.process.params.pole_mass *= U(0.8, 1.2)   a kit component plant's parameter scaled
+//! plant.operating_point.u[1] *= 0.9..1.1:5   the plant run at another known input u_op
+//! plant.operating_point.w[1] = [0, 0.01]      … or another unknown input w_op
+//! x0[2] = N(0, 0.1)                 the simulated plant's initial state x0[2] set
+//! dt *= [0.9, 1, 1.1]               the plant sampled at another interval than the design's
 //! ```
 //!
 //! Indices are 1-based (row, column), as the papers and MATLAB write them. A scaling of 1 (or
@@ -69,12 +75,30 @@ pub enum Place {
     FmuParameter(String),
     /// A parameter of an external-process plant (a kit component's `plant.process.params.NAME`).
     ProcessParameter(String),
+    /// The point the simulated plant operates at (0-based entry of u_op or w_op): its known or
+    /// unknown inputs moved by the difference from the design's point.
+    OperatingPoint(PointSignal, usize),
+    /// An entry (0-based) of the simulated plant's initial state x0.
+    InitialState(usize),
+    /// The plant's sampling interval dt (every designed part keeps the design's).
+    SamplePeriod,
+}
+
+/// Which signal of the operating point a place names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PointSignal {
+    /// The known inputs u (columns of B).
+    U,
+    /// The unknown inputs w (columns of E).
+    W,
 }
 
 /// The prefix of an FMU parameter's place.
 pub const FMU_PARAMETERS: &str = "plant.fmu.parameters.";
 /// The prefix of a process plant's parameter's place.
 pub const PROCESS_PARAMS: &str = "plant.process.params.";
+/// The prefix of the operating point's places.
+pub const OPERATING_POINT: &str = "plant.operating_point.";
 
 /// One `--vary`.
 #[derive(Debug, Clone, PartialEq)]
@@ -185,6 +209,36 @@ fn values(v: &str, whole: &str) -> Result<Values, String> {
     ))
 }
 
+/// The place of `dt`, `x0[i]` or `plant.operating_point.u[i]` / `w[i]` (`None` for another name).
+fn scalar_place(name: &str, index: Option<&str>, whole: &str) -> Result<Option<Place>, String> {
+    let vector = |what: &str| -> Result<usize, String> {
+        let i = index
+            .and_then(|i| i.strip_suffix(']'))
+            .ok_or_else(|| format!("'{whole}': {what} names one entry, {name}[i], from 1"))?;
+        i.trim()
+            .parse::<usize>()
+            .ok()
+            .filter(|&k| k >= 1)
+            .map(|k| k - 1)
+            .ok_or_else(|| format!("'{whole}': entries count from 1"))
+    };
+    Ok(match name {
+        "dt" if index.is_none() => Some(Place::SamplePeriod),
+        "dt" => return Err(format!("'{whole}': dt is one number, it has no entries")),
+        "x0" => Some(Place::InitialState(vector("x0")?)),
+        _ => match name.strip_prefix(OPERATING_POINT) {
+            Some("u") => Some(Place::OperatingPoint(PointSignal::U, vector("u_op")?)),
+            Some("w") => Some(Place::OperatingPoint(PointSignal::W, vector("w_op")?)),
+            Some(_) => {
+                return Err(format!(
+                    "'{whole}': the plant's operating point is varied as {OPERATING_POINT}u[i] (a known input) or {OPERATING_POINT}w[i] (an unknown input)"
+                ));
+            }
+            None => None,
+        },
+    })
+}
+
 impl FromStr for Vary {
     type Err = String;
 
@@ -231,6 +285,16 @@ impl FromStr for Vary {
             Some((m, idx)) => (m.trim(), Some(idx)),
             None => (target, None),
         };
+        let place = scalar_place(name, index, whole)?;
+        if let Some(place) = place {
+            return Ok(Vary {
+                target: target.to_string(),
+                place,
+                op,
+                values,
+                text,
+            });
+        }
         let matrix = match name {
             "A" => Matrix::A,
             "B" => Matrix::B,
@@ -239,7 +303,7 @@ impl FromStr for Vary {
             "D" => Matrix::D,
             other => {
                 return Err(format!(
-                    "'{whole}': '{other}' is not one of the plant's matrices A, B, C, E, D, nor {FMU_PARAMETERS}NAME or {PROCESS_PARAMS}NAME"
+                    "'{whole}': '{other}' is not one of the plant's matrices A, B, C, E, D, nor {FMU_PARAMETERS}NAME, {PROCESS_PARAMS}NAME, {OPERATING_POINT}u[i] or w[i], x0[i], dt"
                 ));
             }
         };
@@ -317,6 +381,20 @@ mod tests {
             .parse()
             .unwrap();
         assert_eq!(v.place, Place::ProcessParameter("pole_mass".into()));
+        for (text, place) in [
+            (
+                "plant.operating_point.u[2] *= [0.9, 1.1]",
+                Place::OperatingPoint(PointSignal::U, 1),
+            ),
+            (
+                "plant.operating_point.w[1] = [0, 1]",
+                Place::OperatingPoint(PointSignal::W, 0),
+            ),
+            ("x0[3] = [0, 1]", Place::InitialState(2)),
+            ("dt *= [0.9, 1.1]", Place::SamplePeriod),
+        ] {
+            assert_eq!(text.parse::<Vary>().unwrap().place, place, "{text}");
+        }
         let v: Vary = "A[1,1] = U(-3.5, -2.5)".parse().unwrap();
         assert_eq!((v.op, v.values), (Op::Set, Values::Uniform(-3.5, -2.5)));
         assert_eq!(
@@ -345,6 +423,10 @@ mod tests {
             ("plant.fmu.parameters. *= [1]", "names one FMU variable"),
             ("plant.fmu.J *= [1]", "nor plant.fmu.parameters.NAME"),
             ("plant.process.params.a.b *= [1]", "names one parameter"),
+            ("plant.operating_point.x[1] *= [1]", "u[i] (a known input)"),
+            ("plant.operating_point.u *= [1]", "names one entry"),
+            ("x0[0] = [1]", "entries count from 1"),
+            ("dt[1] *= [1]", "no entries"),
         ] {
             let e = bad.parse::<Vary>().unwrap_err();
             assert!(e.contains(says), "{bad}: {e}");
