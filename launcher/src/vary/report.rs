@@ -246,8 +246,12 @@ fn curves(
 ) -> Vec<Curve> {
     let mut curves = Vec::new();
     for (n, combo) in combos.iter().enumerate() {
+        // The nominal point on the curve of its other parameters' values, so that a curve
+        // through it passes through it (the dashed line below marks where it is).
         let mut pts: Vec<(f64, f64)> = varied
             .iter()
+            .copied()
+            .chain(nominal)
             .filter(|o| o.status == "completed" && same(&others(&o.point, k), combo))
             .filter_map(|o| o.figures.get(c).map(|y| (o.point.values[k], y)))
             .collect();
