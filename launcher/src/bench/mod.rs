@@ -2,8 +2,11 @@
 //! in one process and across processes, with and without recording — and, in the same session,
 //! its floor: a bare ring of three processes over the same transport ([`floor`]), against which
 //! the multi-process figures are given as ratios. Every repetition runs the floor and then each
-//! configuration, so that the machine's drift falls on both sides of a ratio alike.
+//! configuration, so that the machine's drift falls on both sides of a ratio alike. With
+//! recording, each repetition also measures the disk's own write rate into the recordings'
+//! folder ([`disk`]), and each recorded run its bytes per step and write rate against it.
 
+pub mod disk;
 pub mod floor;
 pub mod states;
 
@@ -31,6 +34,11 @@ pub struct BenchRun {
     pub steps_per_s: f64,
     /// Full-step latency, ns.
     pub step_ns: Percentiles,
+    /// A recorded run: the recording's bytes per step.
+    pub bytes_per_step: Option<f64>,
+    /// A recorded run: its recording's bytes over the run's whole time (the recording closed);
+    /// the "disk" row: what a `dd`-like write into the same folder makes.
+    pub write_bytes_per_s: Option<f64>,
 }
 
 /// Runs the benchmark on `scenario` (seed002-sine) for `steps` steps, `repeat` times over.
@@ -60,17 +68,39 @@ pub fn bench(
                 steps,
                 steps_per_s: f.steps_per_s,
                 step_ns: f.inner.step_ns,
+                bytes_per_step: None,
+                write_bytes_per_s: None,
+            });
+        }
+        if recording.contains(&true) {
+            out.push(BenchRun {
+                mode: "disk".into(),
+                recording: false,
+                steps: 0,
+                steps_per_s: 0.0,
+                step_ns: Percentiles::default(),
+                bytes_per_step: None,
+                write_bytes_per_s: Some(disk::write_rate(&tmp)?),
             });
         }
         for &mode in modes {
             for &record in recording {
+                let start = std::time::Instant::now();
                 let o = measure(&s, &p, &tmp, mode, wait, record, pin)?;
+                let whole = start.elapsed().as_secs_f64();
+                let bytes = o
+                    .rrd
+                    .as_ref()
+                    .and_then(|r| std::fs::metadata(r).ok())
+                    .map(|m| m.len() as f64);
                 out.push(BenchRun {
                     mode: mode.name().into(),
                     recording: record,
                     steps: o.summary.steps,
                     steps_per_s: o.summary.steps_per_s,
                     step_ns: o.summary.latency_ns.step,
+                    bytes_per_step: bytes.map(|b| b / o.summary.steps.max(1) as f64),
+                    write_bytes_per_s: bytes.map(|b| b / whole.max(1e-9)),
                 });
             }
         }
@@ -110,13 +140,42 @@ pub fn table(runs: &[BenchRun], wait: Wait) -> String {
         "seed002 closed loop (plant, 2 observers, controller), wait = {wait}; floor: bare 3-process ring, same transport and payloads\n"
     );
     t += &format!(
-        "{:<12} {:<10} {:>10} {:>14} {:>9} {:>9} {:>9} {:>9} {:>9}\n",
-        "mode", "recording", "steps", "steps/s", "p50 µs", "p90 µs", "p99 µs", "p99.9 µs", "max µs"
+        "{:<12} {:<10} {:>10} {:>14} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>8}\n",
+        "mode",
+        "recording",
+        "steps",
+        "steps/s",
+        "p50 µs",
+        "p90 µs",
+        "p99 µs",
+        "p99.9 µs",
+        "max µs",
+        "MB/s",
+        "B/step"
     );
     for r in runs {
         let us = |ns: u64| format!("{:.2}", ns as f64 / 1000.0);
+        let opt =
+            |v: Option<f64>, scale: f64| v.map_or("—".into(), |v| format!("{:.0}", v / scale));
+        if r.mode == "disk" {
+            t += &format!(
+                "{:<12} {:<10} {:>10} {:>14} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>8}\n",
+                "disk (dd)",
+                "—",
+                "—",
+                "—",
+                "—",
+                "—",
+                "—",
+                "—",
+                "—",
+                opt(r.write_bytes_per_s, 1e6),
+                "—"
+            );
+            continue;
+        }
         t += &format!(
-            "{:<12} {:<10} {:>10} {:>14.0} {:>9} {:>9} {:>9} {:>9} {:>9}\n",
+            "{:<12} {:<10} {:>10} {:>14.0} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>8}\n",
             r.mode,
             r.recording,
             r.steps,
@@ -125,7 +184,9 @@ pub fn table(runs: &[BenchRun], wait: Wait) -> String {
             us(r.step_ns.p90),
             us(r.step_ns.p99),
             us(r.step_ns.p999),
-            us(r.step_ns.max)
+            us(r.step_ns.max),
+            opt(r.write_bytes_per_s, 1e6),
+            opt(r.bytes_per_step, 1.0)
         );
     }
     for (name, v) in ratios(runs) {
@@ -186,6 +247,37 @@ fn sentence(name: &str, (min, median, max, n): (f64, f64, f64, usize)) -> String
                 pct(median)
             )
         }
+        "processes (no recording) / floor, step p99.9"
+        | "processes (recording) / floor, step p99.9" => {
+            let with = name.contains("(recording)");
+            format!(
+                "across processes {}, a step's p99.9 is {median:.2}× the floor's {times}\n",
+                rec(with)
+            )
+        }
+        "in-process (recording): write rate / disk's"
+        | "processes (recording): write rate / disk's" => {
+            let m = if name.starts_with("in-process") {
+                "in one process"
+            } else {
+                "across processes"
+            };
+            format!(
+                "{m}, the recording is written at {} of the rate a dd-like write makes into the same folder {over}\n",
+                pct(median)
+            )
+        }
+        "in-process (recording): GB per 10^7 steps"
+        | "processes (recording): GB per 10^7 steps" => {
+            let m = if name.starts_with("in-process") {
+                "in one process"
+            } else {
+                "across processes"
+            };
+            format!(
+                "{m}, a 10⁷-step run of this loop writes {median:.2} GB at this run's bytes per step (median of {n} repetition(s); range {min:.2} – {max:.2} GB)\n"
+            )
+        }
         _ => format!("{name}: median {median:.3} [{min:.3} – {max:.3}] over {n} repetition(s)\n"),
     }
 }
@@ -226,6 +318,10 @@ pub fn ratios(runs: &[BenchRun]) -> Vec<(String, (f64, f64, f64, usize))> {
                         format!("processes ({what}) / floor, step p50"),
                         p.step_ns.p50 as f64 / f.step_ns.p50.max(1) as f64,
                     );
+                    add(
+                        format!("processes ({what}) / floor, step p99.9"),
+                        p.step_ns.p999 as f64 / f.step_ns.p999.max(1) as f64,
+                    );
                 }
             }
         }
@@ -234,6 +330,19 @@ pub fn ratios(runs: &[BenchRun]) -> Vec<(String, (f64, f64, f64, usize))> {
                 "processes / in-process, steps/s (no recording)".into(),
                 p.steps_per_s / i.steps_per_s,
             );
+        }
+        let disk = rep
+            .iter()
+            .find(|r| r.mode == "disk")
+            .and_then(|d| d.write_bytes_per_s);
+        for m in ["in-process", "processes"] {
+            let Some(r) = get(m, true) else { continue };
+            if let (Some(w), Some(d)) = (r.write_bytes_per_s, disk) {
+                add(format!("{m} (recording): write rate / disk's"), w / d);
+            }
+            if let Some(b) = r.bytes_per_step {
+                add(format!("{m} (recording): GB per 10^7 steps"), b * 1e7 / 1e9);
+            }
         }
         for m in ["in-process", "processes"] {
             if let (Some(a), Some(b)) = (get(m, true), get(m, false)) {

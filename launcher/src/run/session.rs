@@ -428,7 +428,13 @@ impl Session {
         hops: &[(usize, u64)],
     ) -> Result<(), LaunchError> {
         self.metrics.push(row);
-        if self.diverged.is_none() {
+        // The metrics hold each observer's max |x − x̂| of this step (NaN for a non-finite x̂):
+        // the estimates are looked at only when one of those is not within the bound.
+        let suspect = (0..self.observer_names.len()).any(|o| {
+            let e = self.metrics.last_max_abs_error(o);
+            e.is_nan() || e > self.state_bound
+        });
+        if suspect && self.diverged.is_none() {
             self.diverged = estimate_divergence(
                 row,
                 &row.plant[self.layout.x()],

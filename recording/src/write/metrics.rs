@@ -185,52 +185,54 @@ impl Metrics {
         let lay = self.layout;
         let (x, y) = (&row.plant[lay.x()], &row.plant[lay.y()]);
         let in_tail = k >= self.planned_tail;
-        // When step k is in the fault-free stretch [0, F): whether in its last quarter, and each
-        // observer's maxima there.
-        let mut fault_free = match &mut self.fault_free {
-            Some((first, _, ff)) if k < *first => Some((k >= *first - *first / 4, ff.iter_mut())),
+        // When step k is in the fault-free stretch [0, F): whether in its last quarter.
+        let fault_free = match &self.fault_free {
+            Some((first, _, _)) if k < *first => Some(k >= *first - *first / 4),
             _ => None,
         };
-        let per_observer = row
-            .xhat
-            .iter()
-            .zip(&mut self.error)
-            .zip(&mut self.residual)
-            .zip(&mut self.what)
-            .zip(&mut self.observers)
-            .zip(&mut self.blocks)
-            .zip(&mut self.exact);
-        for ((((((xhat, error), res), what), f), [be, br]), exact) in per_observer {
-            let mut emax: f64 = 0.0;
-            for ((e, &xi), &xh) in error.iter_mut().zip(x).zip(xhat) {
-                *e = xi - xh;
-                emax = nan_max(emax, e.abs());
+        for o in 0..self.observers.len() {
+            let xhat = &row.xhat[o][..x.len()];
+            let error = &mut self.error[o][..x.len()];
+            let mut emax = 0.0;
+            for i in 0..x.len() {
+                error[i] = x[i] - xhat[i];
+                emax = nan_max(emax, error[i].abs());
             }
-            let mut rmax: f64 = 0.0;
+            let res = &mut self.residual[o][..y.len()];
             mul_into(res, &self.c, xhat);
             // One pass: r = y − Cx̂ (− c_r at a point whose output map is not linear).
-            for (j, (r, &yj)) in res.iter_mut().zip(y).enumerate() {
-                *r = yj - *r;
-                if let Some(c_r) = &self.c_r {
-                    *r -= c_r[j];
+            let mut rmax = 0.0;
+            match &self.c_r {
+                None => {
+                    for j in 0..y.len() {
+                        res[j] = y[j] - res[j];
+                        rmax = nan_max(rmax, res[j].abs());
+                    }
                 }
-                rmax = nan_max(rmax, r.abs());
+                Some(c_r) => {
+                    for j in 0..y.len() {
+                        res[j] = y[j] - res[j] - c_r[j];
+                        rmax = nan_max(rmax, res[j].abs());
+                    }
+                }
             }
-            if let Some(what) = what {
+            if let Some(what) = &mut self.what[o] {
                 what.push(k, y, &row.plant[lay.u_prev()], &row.plant[lay.w()], xhat);
             }
+            let f = &mut self.observers[o];
             f.max_abs_error = nan_max(f.max_abs_error, emax);
             f.final_abs_error = emax;
+            let [be, br] = &mut self.blocks[o];
             be.push(k, emax);
             br.push(k, rmax);
             if in_tail {
+                let exact = &mut self.exact[o];
                 exact[0] = nan_max(exact[0], emax);
                 exact[1] = nan_max(exact[1], rmax);
             }
-            if let Some((last_quarter, ff)) = &mut fault_free
-                && let Some(m) = ff.next()
-            {
-                if *last_quarter {
+            if let (Some(last_quarter), Some((_, _, ff))) = (fault_free, &mut self.fault_free) {
+                let m = &mut ff[o];
+                if last_quarter {
                     m[0] = nan_max(m[0], emax);
                     m[1] = nan_max(m[1], rmax);
                 }
@@ -243,6 +245,12 @@ impl Metrics {
             }
         }
         self.steps += 1;
+    }
+
+    /// max_i |x_i − x̂_i| of observer `o` at the last step (NaN when x̂ is not finite).
+    #[inline]
+    pub fn last_max_abs_error(&self, o: usize) -> f64 {
+        self.observers[o].final_abs_error
     }
 
     /// max |x̂_a − x̂_b| for observers a and b.

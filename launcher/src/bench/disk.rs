@@ -1,0 +1,41 @@
+//! The disk's own write rate, in the same session as the recorded runs: what `dd if=/dev/zero
+//! of=FILE bs=1M count=64` does — 64 blocks of 1 MiB written to a new file in the folder the
+//! recordings go to, no `fsync` (the recorder does not sync either: both rates are those of the
+//! page cache and the writeback behind it) — so that a recording's rate is given as a share of
+//! what the same folder takes at the same moment.
+
+use std::fs;
+use std::io::Write;
+use std::path::Path;
+use std::time::Instant;
+
+use crate::error::LaunchError;
+
+/// Blocks written, of [`BLOCK`] bytes: 64 MiB, more than a 100 000-step recording (≈ 44 MB).
+pub const BLOCKS: usize = 64;
+/// One block, as `dd bs=1M`.
+pub const BLOCK: usize = 1 << 20;
+
+/// Bytes per second written to a new file in `dir` (removed afterwards).
+pub fn write_rate(dir: &Path) -> Result<f64, LaunchError> {
+    fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
+    let path = dir.join(format!("dd-{}.bin", std::process::id()));
+    // A pattern, not zeros: nothing on the way may treat the blocks as holes.
+    let block: Vec<u8> = (0..BLOCK).map(|i| (i % 251) as u8).collect();
+    let start = Instant::now();
+    let written = (|| {
+        let mut f = fs::File::create(&path)?;
+        for _ in 0..BLOCKS {
+            f.write_all(&block)?;
+        }
+        f.flush()
+    })();
+    let s = start.elapsed().as_secs_f64();
+    let _ = fs::remove_file(&path);
+    written.map_err(|e| io(&path, e))?;
+    Ok((BLOCKS * BLOCK) as f64 / s.max(1e-9))
+}
+
+fn io(p: &Path, e: std::io::Error) -> LaunchError {
+    LaunchError::BadInput(format!("{}: the disk's write rate: {e}", p.display()))
+}
