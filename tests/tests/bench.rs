@@ -92,3 +92,59 @@ fn bench_states_measures_each_size() {
         .unwrap();
     assert_eq!(bad.status.code(), Some(2), "{:?}", text(&bad));
 }
+
+/// With recording, every repetition measures the disk's own synced write rate into the
+/// recordings' folder, and each recorded run its bytes per step and its rate as a share of it.
+#[test]
+fn bench_gives_a_recordings_write_rate_against_the_disks_in_the_same_run() {
+    let s = Scratch::new("bench-disk");
+    let tmp = s.join("tmp");
+    std::fs::create_dir_all(&tmp).unwrap();
+    let out = launcher(&s)
+        .env("TMPDIR", &tmp)
+        .args([
+            "bench",
+            "--steps",
+            "3000",
+            "--mode",
+            "in-process",
+            "--recording",
+            "on",
+            "--repeat",
+            "2",
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{:?}", text(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let runs = v["runs"].as_array().unwrap();
+    let disks: Vec<f64> = runs
+        .iter()
+        .filter(|r| r["mode"] == "disk")
+        .map(|r| r["write_bytes_per_s"].as_f64().unwrap())
+        .collect();
+    let recorded: Vec<&serde_json::Value> =
+        runs.iter().filter(|r| r["mode"] == "in-process").collect();
+    assert_eq!((disks.len(), recorded.len()), (2, 2), "{runs:?}");
+    // A disk takes more than 1 MB/s and less than 100 GB/s.
+    assert!(disks.iter().all(|&d| d > 1e6 && d < 1e11), "{disks:?}");
+    let shares: Vec<f64> = recorded
+        .iter()
+        .zip(&disks)
+        .map(|(r, d)| {
+            // A step of seed 002 records tens of values of 8 bytes: 100 … 10 000 bytes.
+            let b = r["bytes_per_step"].as_f64().unwrap();
+            assert!(b > 100.0 && b < 10_000.0, "{r}");
+            r["write_bytes_per_s"].as_f64().unwrap() / d
+        })
+        .collect();
+    let ratio = &v["ratios"]["in-process (recording): write rate / disk's"];
+    assert_eq!(ratio["repetitions"], 2, "{v}");
+    let (lo, hi) = (shares[0].min(shares[1]), shares[0].max(shares[1]));
+    assert_eq!(ratio["min"].as_f64().unwrap(), lo);
+    assert_eq!(ratio["max"].as_f64().unwrap(), hi);
+    // The recordings and the disk's test file went with the bench's folder.
+    let left: Vec<_> = std::fs::read_dir(&tmp).unwrap().flatten().collect();
+    assert!(left.is_empty(), "left behind: {left:?}");
+}

@@ -36,8 +36,8 @@ pub struct BenchRun {
     pub step_ns: Percentiles,
     /// A recorded run: the recording's bytes per step.
     pub bytes_per_step: Option<f64>,
-    /// A recorded run: its recording's bytes over the run's whole time (the recording closed);
-    /// the "disk" row: what a `dd`-like write into the same folder makes.
+    /// A recorded run: its recording's bytes over the run's whole time, the recording closed and
+    /// synced; the "disk" row: what a synced `dd`-like write into the same folder makes.
     pub write_bytes_per_s: Option<f64>,
 }
 
@@ -87,6 +87,9 @@ pub fn bench(
             for &record in recording {
                 let start = std::time::Instant::now();
                 let o = measure(&s, &p, &tmp, mode, wait, record, pin)?;
+                if let Some(rrd) = &o.rrd {
+                    disk::sync(rrd)?;
+                }
                 let whole = start.elapsed().as_secs_f64();
                 let bytes = o
                     .rrd
@@ -282,16 +285,22 @@ fn sentence(name: &str, (min, median, max, n): (f64, f64, f64, usize)) -> String
     }
 }
 
-/// Ratios per repetition (a repetition starts at each floor run, or is the whole list without
-/// one), as (name, (min, median, max, count)).
+/// Ratios per repetition (a repetition starts at each floor run — without one at each disk run —
+/// or is the whole list), as (name, (min, median, max, count)).
 pub fn ratios(runs: &[BenchRun]) -> Vec<(String, (f64, f64, f64, usize))> {
     let mut reps: Vec<&[BenchRun]> = Vec::new();
-    let starts: Vec<usize> = runs
-        .iter()
-        .enumerate()
-        .filter(|(_, r)| r.mode == "floor")
-        .map(|(i, _)| i)
-        .collect();
+    // A repetition opens with its floor run, or (one mode in one process) its disk run.
+    let opening = |mode: &str| -> Vec<usize> {
+        runs.iter()
+            .enumerate()
+            .filter(|(_, r)| r.mode == mode)
+            .map(|(i, _)| i)
+            .collect()
+    };
+    let mut starts = opening("floor");
+    if starts.is_empty() {
+        starts = opening("disk");
+    }
     if starts.is_empty() {
         reps.push(runs);
     } else {
@@ -364,7 +373,47 @@ pub fn ratios(runs: &[BenchRun]) -> Vec<(String, (f64, f64, f64, usize))> {
 
 #[cfg(test)]
 mod sentence_tests {
-    use super::sentence;
+    use super::{BenchRun, Percentiles, ratios, sentence};
+
+    fn run(mode: &str, recording: bool, steps_per_s: f64, write: Option<f64>) -> BenchRun {
+        BenchRun {
+            mode: mode.into(),
+            recording,
+            steps: 100,
+            steps_per_s,
+            step_ns: Percentiles::default(),
+            bytes_per_step: recording.then_some(400.0),
+            write_bytes_per_s: write,
+        }
+    }
+
+    /// In one mode without a floor, each disk run opens a repetition: the write rates are
+    /// shares of their own repetition's disk rate, the size is bytes per step × 10⁷.
+    #[test]
+    fn a_recordings_write_rate_is_a_share_of_its_own_repetitions_disk_rate() {
+        let runs = [
+            run("disk", false, 0.0, Some(1000.0)),
+            run("in-process", false, 10.0, None),
+            run("in-process", true, 5.0, Some(300.0)),
+            run("disk", false, 0.0, Some(2000.0)),
+            run("in-process", false, 10.0, None),
+            run("in-process", true, 5.0, Some(400.0)),
+        ];
+        let r = ratios(&runs);
+        let get = |name: &str| r.iter().find(|(n, _)| n == name).unwrap().1;
+        assert_eq!(
+            get("in-process (recording): write rate / disk's"),
+            (0.2, 0.2, 0.3, 2)
+        );
+        assert_eq!(
+            get("in-process (recording): GB per 10^7 steps"),
+            (4.0, 4.0, 4.0, 2)
+        );
+        assert_eq!(
+            get("in-process: share of steps/s recording costs"),
+            (0.5, 0.5, 0.5, 2)
+        );
+    }
 
     /// Each ratio reads as a sentence with its median and range, not as an algebraic name.
     #[test]
