@@ -140,7 +140,7 @@ pub fn named(s: Option<&Scenario>, path: &str) -> Option<Named> {
         // ŵ_k is named after w_k, as x̂_i after x_i: its group tells them apart.
         "/disturbance" | "what" => get(&n.disturbance),
         "/measurement_disturbance" => get(&n.measurement_disturbance),
-        "/input" => get(&n.input),
+        "/input" => (i < n.input.len()).then(|| reference_named(s, i)),
         "/controller/u" => n.input.get(i).map(|r| Named {
             name: control_name(s, i),
             unit: r.unit.clone(),
@@ -154,6 +154,48 @@ pub fn named(s: Option<&Scenario>, path: &str) -> Option<Named> {
             unit: y.unit.clone(),
         }),
         _ => None,
+    }
+}
+
+/// What `[[input]]` k is and its unit. Open loop, and for a measured disturbance, the known
+/// input itself. In a closed loop the other inputs' signals are references: with `track`, the
+/// setpoint of the tracked z_j = C_t[j]·x (j counting the commanded inputs), named and measured
+/// as the state or output that row picks ("T1 ref [°C]"; "z2 ref" for another combination);
+/// without it, u = r − G x̂ and r is a reference in the input's own unit ("Qh1 ref [kW]").
+pub fn reference_named(s: &Scenario, k: usize) -> Named {
+    let n = &s.names;
+    let own = n.input.get(k).cloned().unwrap_or_default();
+    let Some(c) = s.controller.as_ref().filter(|c| !c.measured.contains(&k)) else {
+        return own;
+    };
+    let reference = |m: &Named| Named {
+        name: format!("{} ref", m.name),
+        unit: m.unit.clone(),
+    };
+    let Some(track) = &c.track else {
+        return reference(&own);
+    };
+    let j = (0..k).filter(|i| !c.measured.contains(i)).count();
+    if j >= track.nrows() {
+        return reference(&own);
+    }
+    let row = track.row(j);
+    let unit_vector = row.iter().filter(|&&v| v != 0.0).count() == 1;
+    if let Some(m) = row.iter().position(|&v| v == 1.0).filter(|_| unit_vector)
+        && let Some(x) = n.state.get(m)
+    {
+        return reference(x);
+    }
+    let c_rows = s.model.c.nrows();
+    if let Some(y) = (0..c_rows)
+        .find(|&q| s.model.c.row(q) == row)
+        .and_then(|q| n.output.get(q))
+    {
+        return reference(y);
+    }
+    Named {
+        name: format!("z{} ref", j + 1),
+        unit: String::new(),
     }
 }
 

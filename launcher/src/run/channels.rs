@@ -212,7 +212,7 @@ fn plant_series(
         })
         .collect();
     let r = (0..layout.l)
-        .map(|k| namer.series(g, sig::input(k), names.input[k].name.clone()))
+        .map(|k| namer.series(g, sig::input(k), sig::reference_named(s, k).name))
         .collect();
     let u = if s.controller.is_some() {
         (0..layout.l)

@@ -352,7 +352,12 @@ fn names_and_units_label_plots_and_csv_headers() {
         header("observer_luenberger_residual.csv"),
         "step,sim_time,r1 [m],r2 [V]"
     );
-    assert_eq!(header("input.csv"), "step,sim_time,force [N],supply [V]");
+    // Closed loop without `track`: u = r − G x̂, r a reference in the input's own unit.
+    assert_eq!(
+        header("input.csv"),
+        "step,sim_time,force ref [N],supply ref [V]"
+    );
+    assert_eq!(header("observer_uio_what.csv"), "step,sim_time,gust [N]");
     assert_eq!(
         header("controller_u.csv"),
         "step,sim_time,force (u) [N],supply (u) [V]"
@@ -376,6 +381,56 @@ fn names_and_units_label_plots_and_csv_headers() {
     let outputs = &figs.iter().find(|(f, _)| f == "outputs.png").unwrap().1;
     let labels: Vec<&str> = outputs.curves.iter().map(|c| c.label.as_str()).collect();
     assert_eq!(labels, ["pos_meas [m]", "volt_meas [V]"]);
+    let inputs = &figs.iter().find(|(f, _)| f == "inputs.png").unwrap().1;
+    let labels: Vec<&str> = inputs.curves.iter().map(|c| c.label.as_str()).collect();
+    assert_eq!(
+        labels,
+        [
+            "force ref [N]",
+            "supply ref [V]",
+            "force (u) [N]",
+            "supply (u) [V]"
+        ]
+    );
+    // With `track`, each reference is the setpoint of what its row picks: a state by a unit
+    // row, an output by a row of C, else z_j without a unit.
+    for (track, want) in [
+        (
+            "[[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]",
+            "step,sim_time,pos ref [m],volt ref [V]",
+        ),
+        (
+            "[[0.0, 1.0, 0.0], [1.0, 0.0, 1.0]]",
+            "step,sim_time,vel ref [m/s],z2 ref",
+        ),
+    ] {
+        let tracked = std::fs::read_to_string(&path).unwrap().replacen(
+            "[controller]",
+            &format!("[controller]\ntrack = {track}"),
+            1,
+        );
+        let t = s.join("tracked.toml");
+        std::fs::write(&t, tracked).unwrap();
+        let out = launcher(&s)
+            .arg("run")
+            .arg(&t)
+            .args(["--mode", "in-process", "--force", "--out"])
+            .arg(s.join("tracked"))
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{track}: {:?}", text(&out));
+        let out = launcher(&s)
+            .arg("export")
+            .arg(s.join("tracked/seed002-sine.rrd"))
+            .arg("--csv")
+            .arg(s.join("tracked-csv"))
+            .arg("--force")
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{:?}", text(&out));
+        let got = std::fs::read_to_string(s.join("tracked-csv/input.csv")).unwrap();
+        assert_eq!(got.lines().next().unwrap(), want, "{track}");
+    }
     // A names list of the wrong length is bad input, named by file and field.
     let bad = std::fs::read_to_string(&path).unwrap().replace(
         "output_names = [\"pos_meas\", \"volt_meas\"]",
