@@ -34,6 +34,10 @@ pub struct ObserverFigures {
     pub tail_max_abs_error: Option<f64>,
     /// max |y − Cx̂| over the same tail.
     pub tail_max_abs_residual: Option<f64>,
+    /// max_k max_j |ŵ_j − w_j| over the same tail, each ŵ_k against the w_k recorded at its
+    /// step (`None` for an observer that records no ŵ, or without a tail).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tail_max_abs_input_error: Option<f64>,
 }
 
 /// Latency percentiles recomputed from the recording, ns.
@@ -138,11 +142,31 @@ pub fn inspect(file: &str, r: &Recording) -> Inspection {
                 .fold(0.0, nan_max),
         )
     };
+    let input_error = |n: &str| -> Option<f64> {
+        let start = tail_start?;
+        let mut worst: Option<f64> = None;
+        for (j, what) in (1..).map_while(|j| {
+            r.series
+                .get(&crate::signals::input_estimate(n, j - 1))
+                .map(|s| (j, s))
+        }) {
+            let w = r.series.get(&crate::signals::disturbance(j - 1))?;
+            for (k, &v) in what.steps.iter().zip(&what.values) {
+                if *k < start {
+                    continue;
+                }
+                let i = w.steps.binary_search(k).ok()?;
+                worst = Some(nan_max(worst.unwrap_or(0.0), (v - w.values[i]).abs()));
+            }
+        }
+        worst
+    };
     let observers = crate::signals::observers_of(r.series.keys(), scenario.as_ref())
         .into_iter()
         .map(|n| ObserverFigures {
             tail_max_abs_error: tail_max(&format!("/observer/{n}/error/")),
             tail_max_abs_residual: tail_max(&format!("/observer/{n}/residual/")),
+            tail_max_abs_input_error: input_error(&n),
             name: n,
         })
         .collect();
@@ -223,15 +247,16 @@ impl Inspection {
             );
         }
         t += &format!(
-            "  {:<14} {:>14} {:>14}\n",
-            "observer", "tail max|e|", "tail max|r|"
+            "  {:<14} {:>14} {:>14} {:>14}\n",
+            "observer", "tail max|e|", "tail max|r|", "tail max|ŵ−w|"
         );
         for o in &self.observers {
             t += &format!(
-                "  {:<14} {:>14} {:>14}\n",
+                "  {:<14} {:>14} {:>14} {:>14}\n",
                 o.name,
                 figure(o.tail_max_abs_error),
-                figure(o.tail_max_abs_residual)
+                figure(o.tail_max_abs_residual),
+                figure(o.tail_max_abs_input_error)
             );
         }
         let p = &self.latency_ns.step;

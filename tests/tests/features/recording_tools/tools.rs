@@ -47,6 +47,28 @@ fn inspect_recomputes_the_summary() {
     }
     assert_eq!(sum["latency_ns"]["step"], ins["latency_ns"]["step"]);
     assert_eq!(sum["latency_ns"]["hops"], ins["latency_ns"]["hops"]);
+    // ŵ's figure too, from the recorded ŵ and w at the same steps: the same numbers, bit for
+    // bit, for every observer that estimates w and none for the others.
+    for name in ["seed002-sine", "dc-motor-load-torque"] {
+        if name != "seed002-sine" {
+            assert!(run(&s, &scenario(name), &[]).status.success());
+        }
+        let sum = summary(&s, name);
+        let (ins, _) = inspect_json(&s, &s.join(&format!("out/{name}.rrd")));
+        let mut estimated = 0;
+        for o in sum["observers"].as_array().unwrap() {
+            let i = ins["observers"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|x| x["name"] == o["name"])
+                .unwrap();
+            let f = "tail_max_abs_input_error";
+            assert_eq!(o[f].as_f64(), i[f].as_f64(), "{name} {}", o["name"]);
+            estimated += usize::from(o[f].is_f64());
+        }
+        assert!(estimated >= 1, "{name}: no observer estimates w");
+    }
     let entities = ins["entities"].as_array().unwrap();
     let x0 = entities.iter().find(|e| e["path"] == "/plant/x/1").unwrap();
     assert_eq!(x0["rows"], 20_000);
