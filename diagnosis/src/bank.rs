@@ -61,6 +61,8 @@ pub struct Bank {
     pub channels: Vec<String>,
     /// Their indices in their class (0-based): column j of the structure is channel `ids[j]`.
     pub ids: Vec<usize>,
+    /// How a fault on each watched channel enters the sampled plant (column j: channel `ids[j]`).
+    pub inputs: Vec<FaultInput>,
 }
 
 /// Why a bank cannot be had: the member (0-based) when one is to blame, and the reason.
@@ -305,6 +307,7 @@ pub fn design_bank(
         steady,
         channels: labels,
         ids,
+        inputs,
     })
 }
 

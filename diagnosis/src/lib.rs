@@ -17,6 +17,7 @@ pub mod covariance;
 pub mod decide;
 pub mod evaluate;
 pub mod figures;
+pub mod freq;
 pub mod glr;
 pub mod residual;
 pub mod spec;

@@ -252,6 +252,13 @@ pub struct DesignArgs {
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Also the frequency responses of every observer and bank member: σ of w → e, v → e,
+    /// w → r, v → r and f → r over 0 … Nyquist, with H∞ norms, DC gains and fault-to-noise ratios.
+    #[arg(long)]
+    pub freq: bool,
+    /// With --freq: write a σ plot per observer and member into this folder.
+    #[arg(long, value_name = "DIR", requires = "freq")]
+    pub out: Option<PathBuf>,
 }
 
 // The arguments of `uio-launcher bench`.

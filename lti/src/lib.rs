@@ -22,6 +22,7 @@ pub mod discretize;
 pub mod eig;
 pub mod error;
 pub mod expm;
+pub mod freq;
 pub mod householder;
 pub mod input_estimate;
 pub mod kernel;

@@ -142,31 +142,12 @@ pub fn inspect(file: &str, r: &Recording) -> Inspection {
                 .fold(0.0, nan_max),
         )
     };
-    let input_error = |n: &str| -> Option<f64> {
-        let start = tail_start?;
-        let mut worst: Option<f64> = None;
-        for (j, what) in (1..).map_while(|j| {
-            r.series
-                .get(&crate::signals::input_estimate(n, j - 1))
-                .map(|s| (j, s))
-        }) {
-            let w = r.series.get(&crate::signals::disturbance(j - 1))?;
-            for (k, &v) in what.steps.iter().zip(&what.values) {
-                if *k < start {
-                    continue;
-                }
-                let i = w.steps.binary_search(k).ok()?;
-                worst = Some(nan_max(worst.unwrap_or(0.0), (v - w.values[i]).abs()));
-            }
-        }
-        worst
-    };
     let observers = crate::signals::observers_of(r.series.keys(), scenario.as_ref())
         .into_iter()
         .map(|n| ObserverFigures {
             tail_max_abs_error: tail_max(&format!("/observer/{n}/error/")),
             tail_max_abs_residual: tail_max(&format!("/observer/{n}/residual/")),
-            tail_max_abs_input_error: input_error(&n),
+            tail_max_abs_input_error: input_error(r, &n, tail_start),
             name: n,
         })
         .collect();
@@ -208,6 +189,28 @@ pub fn inspect(file: &str, r: &Recording) -> Inspection {
         },
         warnings,
     }
+}
+
+/// max_k max_j |ŵ_j − w_j| of observer `n` over the steps from `tail_start`, each ŵ_k against the
+/// w_k recorded at its step; `None` without ŵ, without a tail, or with a ŵ at a step w lacks.
+fn input_error(r: &Recording, n: &str, tail_start: Option<i64>) -> Option<f64> {
+    let start = tail_start?;
+    let mut worst: Option<f64> = None;
+    for (j, what) in (1..).map_while(|j| {
+        r.series
+            .get(&crate::signals::input_estimate(n, j - 1))
+            .map(|s| (j, s))
+    }) {
+        let w = r.series.get(&crate::signals::disturbance(j - 1))?;
+        for (k, &v) in what.steps.iter().zip(&what.values) {
+            if *k < start {
+                continue;
+            }
+            let i = w.steps.binary_search(k).ok()?;
+            worst = Some(nan_max(worst.unwrap_or(0.0), (v - w.values[i]).abs()));
+        }
+    }
+    worst
 }
 
 impl Inspection {

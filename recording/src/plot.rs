@@ -102,7 +102,7 @@ fn common_unit(what: &str, units: &[String]) -> String {
 /// characters (a file name holds at most 255 bytes: a 250-character state name made `plot`
 /// write nothing, "File name too long"). The files stay distinct by their index or by names
 /// that are distinct within their 64 first characters (observers' and diagnosers' are at most 64).
-fn sanitize(s: &str) -> String {
+pub fn sanitize(s: &str) -> String {
     s.chars()
         .take(NAME_IN_FILE)
         .map(|c| {
@@ -489,6 +489,7 @@ pub fn figures(r: &Recording, selection: &PlotSelection) -> Result<Vec<(String, 
                     y_label: view.y_label,
                     x_label: x_label.into(),
                     scale: view.scale,
+                    x_scale: Scale::Linear,
                     curves,
                 },
             ));

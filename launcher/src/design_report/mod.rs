@@ -5,6 +5,7 @@
 //! makes it) and rendered twice: [`DesignReport::text`] for people and
 //! [`DesignReport::json`] for programs; both show the same sections in the same order.
 
+pub mod freq;
 mod json;
 mod sections;
 mod text;

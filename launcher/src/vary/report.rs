@@ -327,6 +327,7 @@ pub fn plots(
                 y_label: c.clone(),
                 x_label: v.text.clone(),
                 scale: Scale::Linear,
+                x_scale: Scale::Linear,
                 curves: curves(c, k, varies, &combos, &varied, nominal),
             };
             let path = dir.join(format!(

@@ -20,6 +20,7 @@
 //! * [`product`] — blocked matrix products and LU solves for large matrices.
 
 pub mod balance;
+pub mod complex;
 pub mod evd;
 pub mod norm;
 pub mod product;

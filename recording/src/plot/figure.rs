@@ -89,6 +89,8 @@ pub struct Figure {
     pub x_label: String,
     /// y scale.
     pub scale: Scale,
+    /// x scale (the points' x already log10 for [`Scale::Log`]).
+    pub x_scale: Scale,
     /// Curves, drawn in order (the first underneath).
     pub curves: Vec<Curve>,
 }
@@ -280,7 +282,10 @@ fn frame(
         .bold_line_style(RGBColor(222, 222, 222))
         .light_line_style(RGBColor(245, 245, 245))
         .axis_style(BLACK)
-        .x_label_formatter(&|v| linear_label(*v, xstep, x_max))
+        .x_label_formatter(&|v| match fig.x_scale {
+            Scale::Linear => linear_label(*v, xstep, x_max),
+            Scale::Log => log_label(*v, xstep),
+        })
         .y_label_formatter(&ylab)
         .draw()
         .map_err(|e| e.to_string())?;
