@@ -19,8 +19,9 @@
 //! observer; they stay in A_a, which is why it is this form and not the observer-order one
 //! ζ = z − Mx (MΦ − FM = KC): that M does not exist when the observer shares a pole with the
 //! plant (seed 002's UIO and Luenberger observer place −1, −2, −3 where the plant has −1, −2, −2).
-//! At z = 1 a plant integrator (Φ with an eigenvalue at 1, a shaft angle) leaves A_a singular: the
-//! DC gain is then not given.
+//! At z = 1 a plant integrator (Φ with an eigenvalue at 1, a shaft angle) leaves A_a singular;
+//! where M exists and the observer is unbiased, the DC gain is that of the observer-order
+//! realisation (F, −MΓ_E, −P, 0) … in which the integrator is not a state, else it is not given.
 //!
 //! A UIO decouples w: its w → e is rounding. It is reported as decoupled when every Markov
 //! parameter C_a A_a^k B_w (and D) is below [`DECOUPLED`] of ‖C_a‖‖A_a^k‖‖B_w‖, the rule of the
@@ -30,6 +31,7 @@ use lti::Mat;
 use lti::freq::Sampled;
 use observer::LinearObserver;
 
+use crate::covariance::tracked;
 use crate::residual::Residual;
 use crate::structure::{BLIND, FaultInput};
 
@@ -50,6 +52,14 @@ pub struct ErrorSystems {
     pub v_r: Sampled,
     /// w does not reach e: every relative Markov parameter of w → e is below [`DECOUPLED`].
     pub w_decoupled: bool,
+    /// The state z tracks, M (MΦ − FM = KC), when it exists and the observer is unbiased
+    /// (PM + QC = I): the systems then have a realisation of the observer's order, ζ = z − Mx,
+    /// which gives their DC gain where the plant has an integrator.
+    m: Option<Mat>,
+    p: Mat,
+    q: Mat,
+    s_cp: Mat,
+    gamma_e: Mat,
     /// F (for the grid's lower end).
     f: Mat,
     /// A_a, C_r and S(I − CQ) of the residual, for faults.
@@ -106,7 +116,19 @@ impl ErrorSystems {
             (None, None)
         };
         let w_decoupled = q > 0 && markov_size(&a, &b_w, &c_e) <= DECOUPLED;
+        let m = tracked(phi, &res.f, &res.k, c).ok().filter(|m| {
+            let sylvester = (m * phi - &res.f * m - &res.k * c).norm();
+            let scale = m.norm() * (phi.norm() + res.f.norm()) + res.k.norm() * c.norm();
+            let unbiased = (&res.p * m + &res.q * c - Mat::identity(n, n)).norm();
+            sylvester <= 1e-10 * scale.max(f64::MIN_POSITIVE)
+                && unbiased <= 1e-8 * (1.0 + (&res.p * m).norm())
+        });
         ErrorSystems {
+            m,
+            p: res.p.clone(),
+            q: res.q.clone(),
+            s_cp: &res.s * &res.cp,
+            gamma_e: gamma_e.clone(),
             w_e,
             v_e: sys(&b_v, &c_e, -&res.q),
             w_r,
@@ -119,6 +141,50 @@ impl ErrorSystems {
             k: res.k,
             dt,
         }
+    }
+
+    /// The realisations of the observer's order (ζ = z − Mx) of w → e, v → e, w → r, v → r, when
+    /// M exists: the same transfers without the plant's modes, for their DC gains.
+    pub fn reduced(&self) -> Option<[Option<Sampled>; 4]> {
+        let m = self.m.as_ref()?;
+        let sys = |b: Mat, c: Mat, d: Mat| Sampled {
+            a: self.f.clone(),
+            b,
+            c,
+            d,
+            dt: self.dt,
+        };
+        let (n, q, ny) = (self.p.nrows(), self.gamma_e.ncols(), self.s_cp.nrows());
+        let w_in = -(m * &self.gamma_e);
+        let w = |c: Mat, rows: usize| (q > 0).then(|| sys(w_in.clone(), c, Mat::zeros(rows, q)));
+        Some([
+            w(-&self.p, n),
+            Some(sys(self.k.clone(), -&self.p, -&self.q)),
+            w(-&self.s_cp, ny),
+            Some(sys(self.k.clone(), -&self.s_cp, self.s_i_cq.clone())),
+        ])
+    }
+
+    /// [`ErrorSystems::fault`] in the observer's order, when M exists.
+    pub fn reduced_fault(&self, input: &FaultInput) -> Option<Sampled> {
+        let m = self.m.as_ref()?;
+        let (b, d) = match input {
+            FaultInput::State(g) => (
+                -(m * Mat::from_column_slice(g.len(), 1, g.as_slice())),
+                Mat::zeros(self.s_cp.nrows(), 1),
+            ),
+            FaultInput::Output(j) => (
+                self.k.columns(*j, 1).into_owned(),
+                self.s_i_cq.columns(*j, 1).into_owned(),
+            ),
+        };
+        Some(Sampled {
+            a: self.f.clone(),
+            b,
+            c: -&self.s_cp,
+            d,
+            dt: self.dt,
+        })
     }
 
     /// f → r for a fault entering as `input`.

@@ -110,11 +110,29 @@ impl Sampled {
         }
     }
 
+    /// G(1) = C(I − A)⁻¹B + D, or `None` when I − A is singular by the one rank rule (A has an
+    /// eigenvalue at 1: an integrator), whatever finite numbers an LU would return.
+    pub fn dc(&self) -> Option<Mat> {
+        let r = self.a.nrows();
+        let i_a = Mat::identity(r, r) - &self.a;
+        if r > 0 && crate::linalg::svd::rank(&i_a) < r {
+            return None;
+        }
+        self.at(C64::new(1.0, 0.0)).map(|g| g.map(|v| v.re))
+    }
+
     /// The response on `omega` (ascending, within 0 … π/Δt).
     pub fn response(&self, omega: &[f64]) -> Response {
+        self.response_with_dc(omega, None)
+    }
+
+    /// [`Sampled::response`], the DC gain from `same` when this realisation has none at z = 1: a
+    /// realisation of the same transfer without the pole at 1 that cancels from it (an observer's
+    /// error system in its own coordinates, where the plant's integrator is not a state).
+    pub fn response_with_dc(&self, omega: &[f64], same: Option<&Sampled>) -> Response {
         let (sigma_max, sigma_min): (Vec<f64>, Vec<f64>) =
             omega.iter().map(|&w| self.sigma(w)).unzip();
-        let dc = self.at(C64::new(1.0, 0.0)).map(|g| g.map(|v| v.re));
+        let dc = self.dc().or_else(|| same.and_then(Sampled::dc));
         let dc_sigma_max = dc.as_ref().map(|g| {
             crate::linalg::svd::singular_values(g)
                 .first()

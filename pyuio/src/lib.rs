@@ -42,16 +42,23 @@ fn planned(path: &str, seed: Option<u64>) -> PyResult<(Scenario, launcher::plan:
     Ok((s, p))
 }
 
-/// `uio-launcher design --json`: (every design holds, the JSON report, the text report).
+/// `uio-launcher design --json [--freq]`: (every design holds, the JSON report, the text report).
 #[pyfunction]
-#[pyo3(signature = (path, text=None))]
-fn design(path: &str, text: Option<&str>) -> PyResult<(bool, String, String)> {
+#[pyo3(signature = (path, text=None, freq=false))]
+fn design(path: &str, text: Option<&str>, freq: bool) -> PyResult<(bool, String, String)> {
     let s = scenario(path, text).map_err(raise)?;
     let r = design_report::report(&s);
+    let mut json = r.json();
+    let mut lines = r.text();
+    if freq {
+        let f = design_report::freq::freq(&s, &r);
+        json["freq"] = f.json();
+        lines += &f.text(r.dt);
+    }
     Ok((
         r.ok,
-        serde_json::to_string(&r.json()).expect("serialises"),
-        r.text(),
+        serde_json::to_string(&json).expect("serialises"),
+        lines,
     ))
 }
 

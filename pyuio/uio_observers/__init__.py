@@ -143,9 +143,10 @@ class Design:
     `poles`, `discrete_poles`, `fixed_modes` (complex arrays), `conditions` [(name, ok, detail)],
     `report` (the launcher's text) and `json` (its JSON, as `uio-launcher design --json` prints it)."""
 
-    def __init__(self, report, text):
+    def __init__(self, report, text, args=(), kw=None):
         self.json = report
         self.report = text
+        self._args, self._kw, self._freq = args, kw or {}, None
         o = report["observers"][0]
         self.kind = o["kind"]
         self.conditions = [(c["name"], c["ok"], c["detail"]) for c in o["conditions"]]
@@ -162,6 +163,32 @@ class Design:
 
         F, G, K, P, Q = (self.sampled[k] for k in "FGKPQ")
         return control.ss(F, np.hstack([G, K]), P, np.hstack([np.zeros((P.shape[0], G.shape[1])), Q]), self.dt)
+
+    def freq(self):
+        """The frequency responses of `uio-launcher design --freq` as NumPy arrays: `omega` (rad/s,
+        up to Nyquist) and per transfer "w_e", "v_e", "w_r", "v_r" (None without unknown inputs) a
+        dict of `sigma_max`, `sigma_min` (arrays over omega), `hinf`, `hinf_omega`, `dc` (the DC
+        gain matrix, None at a plant integrator the observer's own coordinates cannot remove) and
+        `decoupled` (w → e at rounding level: a UIO)."""
+        if self._freq is None:
+            with tempfile.TemporaryDirectory(prefix="uio-design-") as files:
+                text = design_scenario(*self._args, files=files, **self._kw)
+                _, report, _ = _native.design(os.path.join(files, "design.toml"), text, True)
+            self._freq = json.loads(report)["freq"]
+        f = self._freq
+        s = f["systems"][0]
+
+        def arrays(r, key):
+            if r is None:
+                return None
+            dc = None if r["dc"] is None else np.array(r["dc"], dtype=float)
+            return {"sigma_max": np.array(r["sigma_max"]), "sigma_min": np.array(r["sigma_min"]),
+                    "hinf": r["hinf"], "hinf_omega": r["hinf_omega"], "dc": dc,
+                    "decoupled": bool(s["w_decoupled"]) and key.startswith("w")}
+
+        out = {"omega": np.array(f["omega"])}
+        out.update({k: arrays(s[k], k) for k in ("w_e", "v_e", "w_r", "v_r")})
+        return out
 
     def __repr__(self):
         return f"Design({self.kind}, dt={self.dt}, discrete poles {np.round(self.discrete_poles, 6).tolist()})"
@@ -181,7 +208,7 @@ def design(A=None, B=None, C=None, E=None, **kw):
     if not ok:
         o = report["observers"][0]
         raise ValueError(o.get("error") or next((ln.strip() for ln in lines.splitlines() if "FAIL" in ln), lines.strip()))
-    return Design(report, lines)
+    return Design(report, lines, (A, B, C, E), kw)
 
 
 class Recording:

@@ -48,7 +48,12 @@ pub struct FreqReport {
 type Made = (
     String,
     ErrorSystems,
-    Vec<(String, lti::freq::Sampled, Option<f64>)>,
+    Vec<(
+        String,
+        lti::freq::Sampled,
+        Option<f64>,
+        diagnosis::structure::FaultInput,
+    )>,
 );
 
 /// The responses of every designed observer and bank member of `r` (made from `s`).
@@ -79,7 +84,7 @@ pub fn freq(s: &Scenario, r: &DesignReport) -> FreqReport {
                     .channels
                     .iter()
                     .zip(&b.inputs)
-                    .map(|(label, input)| (label.clone(), e.fault(input), noise))
+                    .map(|(label, input)| (label.clone(), e.fault(input), noise, input.clone()))
                     .collect();
                 made.push((m.name.clone(), e, faults));
             }
@@ -99,23 +104,29 @@ pub fn freq(s: &Scenario, r: &DesignReport) -> FreqReport {
     );
     let systems = made
         .into_iter()
-        .map(|(name, e, faults)| Responses {
-            name,
-            w_e: e.w_e.as_ref().map(|sys| sys.response(&omega)),
-            v_e: e.v_e.response(&omega),
-            w_r: e.w_r.as_ref().map(|sys| sys.response(&omega)),
-            v_r: e.v_r.response(&omega),
-            w_decoupled: e.w_decoupled,
-            faults: faults
-                .into_iter()
-                .map(|(label, sys, noise)| {
-                    let resp = sys.response(&omega);
-                    let fnr = noise
-                        .filter(|&n| n > 0.0)
-                        .and_then(|n| resp.dc_sigma_max.map(|d| d / n));
-                    (label, resp, fnr)
-                })
-                .collect(),
+        .map(|(name, e, faults)| {
+            let [rw_e, rv_e, rw_r, rv_r] = e.reduced().unwrap_or([None, None, None, None]);
+            let resp = |sys: &lti::freq::Sampled, same: &Option<lti::freq::Sampled>| {
+                sys.response_with_dc(&omega, same.as_ref())
+            };
+            Responses {
+                name,
+                w_e: e.w_e.as_ref().map(|sys| resp(sys, &rw_e)),
+                v_e: resp(&e.v_e, &rv_e),
+                w_r: e.w_r.as_ref().map(|sys| resp(sys, &rw_r)),
+                v_r: resp(&e.v_r, &rv_r),
+                w_decoupled: e.w_decoupled,
+                faults: faults
+                    .into_iter()
+                    .map(|(label, sys, noise, input)| {
+                        let resp = sys.response_with_dc(&omega, e.reduced_fault(&input).as_ref());
+                        let fnr = noise
+                            .filter(|&n| n > 0.0)
+                            .and_then(|n| resp.dc_sigma_max.map(|d| d / n));
+                        (label, resp, fnr)
+                    })
+                    .collect(),
+            }
         })
         .collect();
     FreqReport { omega, systems }
