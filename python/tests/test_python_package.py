@@ -68,9 +68,40 @@ def test_a_design_from_a_python_control_statespace():
     # As a python-control system from [u; y] to x̂, its poles are the design's discrete poles.
     obs = from_sys.statespace()
     assert obs.dt == 0.001 and obs.ninputs == 4 and obs.noutputs == 3
+    # Named as what they are: the known inputs, the measurements, and the estimates.
+    assert obs.input_labels == ["u1", "u2", "y1", "y2"] and obs.output_labels == ["xhat1", "xhat2", "xhat3"]
     assert np.allclose(np.sort_complex(obs.poles()), np.sort_complex(from_sys.discrete_poles), atol=1e-9)
-    with pytest.raises(ValueError, match="discrete-time StateSpace"):
+    # A discrete-time model runs at its own period: another dt is refused, naming both.
+    with pytest.raises(ValueError, match=r"^dt: 0.001 differs from sys.dt = 0.1"):
         uo.design(sys=control.ss(sys.A, sys.B, sys.C, sys.D, 0.1), E=SEED002["E"], **kw)
+    with pytest.raises(ValueError, match=r"^sys.dt is True"):
+        uo.design(sys=control.ss(sys.A, sys.B, sys.C, sys.D, True), E=SEED002["E"], kind="luenberger", poles=[-1.0])
+
+
+@pytest.mark.parametrize("kind", ["luenberger", "chen-patton-uio"])
+def test_a_discrete_time_model_designs_as_its_continuous_original_sampled(kind):
+    """An identified model is discrete: (Φ, Γ_B, C, Γ_E) as a StateSpace with its dt, or with
+    time="discrete". Sampled here by SciPy from seed 002's continuous model, its design equals the
+    continuous model's (sampled by the launcher) to 1e-9, and the two discrete spellings agree bit
+    for bit."""
+    from scipy.linalg import expm
+
+    dt = 0.01
+    a, b, e = (np.array(SEED002[k]) for k in "ABE")
+    big = np.zeros((6, 6))
+    big[:3, :3], big[:3, 3:5], big[:3, 5:] = a, b, e
+    m = expm(big * dt)
+    phi, gam_b, gam_e = m[:3, :3], m[:3, 3:5], m[:3, 5:]
+    kw = dict(kind=kind, poles=[-1.0, -2.0, -3.0])
+    from_sys = uo.design(sys=control.ss(phi, gam_b, SEED002["C"], np.zeros((2, 2)), dt), E=gam_e, **kw)
+    from_time = uo.design(A=phi, B=gam_b, C=SEED002["C"], E=gam_e, time="discrete", dt=dt, **kw)
+    continuous = uo.design(**SEED002, dt=dt, **kw)
+    assert from_sys.dt == dt
+    for k in "FGKPQ":
+        assert np.array_equal(from_sys.sampled[k], from_time.sampled[k]), k
+        scale = max(1.0, np.abs(continuous.sampled[k]).max())
+        assert np.abs(from_sys.sampled[k] - continuous.sampled[k]).max() <= 1e-9 * scale, k
+    assert 'time = "discrete"' in uo.design_scenario(sys=control.ss(phi, gam_b, SEED002["C"], 0, dt), E=gam_e, **kw)
 
 
 def test_a_design_that_cannot_exist_raises_the_launchers_reason(tmp_path):
@@ -82,8 +113,13 @@ def test_a_design_that_cannot_exist_raises_the_launchers_reason(tmp_path):
     done = cli_design(tmp_path, uo.design_scenario(**plant, **kw))
     assert done.returncode == 2
     assert str(e.value) in done.stdout, (str(e.value), done.stdout)
-    with pytest.raises(ValueError, match=r"plant\.C"):  # a scenario error: C of the wrong width
+    # A scenario error names the argument, not the generated file the caller never saw.
+    with pytest.raises(ValueError, match=r"^C: ") as e:  # C of the wrong width
         uo.design(**dict(SEED002, C=[[1.0, 0.0]]), **kw)
+    assert "design.toml" not in str(e.value), str(e.value)
+    with pytest.raises(ValueError, match=r"^poles") as e:  # one pole too few
+        uo.design(**SEED002, **dict(kw, poles=[-1.0, -2.0]))
+    assert "design.toml" not in str(e.value), str(e.value)
 
 
 def csv_table(path):

@@ -1,7 +1,8 @@
 """uio-observers from Python: the design library, runs and recordings as NumPy arrays.
 
     design(A, B, C, E, kind="chen-patton-uio", poles=[...] | gain="lqe", dt=0.001)
-    design(sys, E=E, ...)               # sys: a python-control StateSpace (its A, B, C)
+    design(sys, E=E, ...)               # sys: a python-control StateSpace (its A, B, C; with a dt, discrete)
+    design(Phi, Gamma_B, C, Gamma_E, time="discrete", dt=0.1, ...)   # an identified, per-step model
     run("seed002-sine")                 # a scenario file or a shipped scenario's name
     read("runs/seed002-sine.rrd")
     sweep("seed002-actuator-faults", runs=1000, client=dask_client)   # Monte Carlo, on Dask or here
@@ -77,25 +78,42 @@ def _checked(name, m):
     return m
 
 
-def _matrices(sys, A, B, C):
+def _matrices(sys, A, B, C, dt, time):
+    """(A, B, C, dt, discrete): a continuous model (A, B, C) sampled at dt, or a discrete one
+    (Φ, Γ_B, C) of one step of dt — a python-control StateSpace with a numeric dt (an identified
+    model, from n4sid or MATLAB's ssest), or time="discrete"."""
+    if time not in ("continuous", "discrete"):
+        raise ValueError(f'time: "continuous" or "discrete", not {time!r}')
+    discrete = time == "discrete"
     if sys is not None:
         if any(m is not None for m in (A, B, C)):
             raise ValueError("give the plant either as sys (a StateSpace) or as A, B, C, not both")
-        if getattr(sys, "dt", 0) not in (0, None):
-            raise ValueError("sys is a discrete-time StateSpace: design takes the continuous model and dt")
+        sys_dt = getattr(sys, "dt", 0)
+        if sys_dt is True:
+            raise ValueError("sys.dt is True (a discrete model of unspecified period): give it its sample period, "
+                             "control.ss(A, B, C, D, dt)")
+        if sys_dt not in (0, None):
+            if dt is not None and float(dt) != float(sys_dt):
+                raise ValueError(f"dt: {dt} differs from sys.dt = {sys_dt} (a discrete model runs at its own period)")
+            dt, discrete = float(sys_dt), True
         A, B, C = sys.A, sys.B, sys.C
     if A is None or B is None or C is None:
         raise ValueError("the plant needs A, B and C (or sys)")
-    return [np.atleast_2d(np.asarray(m, dtype=float)) for m in (A, B, C)]
+    if dt is None:
+        raise ValueError("dt: the sample period is needed (or a discrete-time sys, which carries its own)")
+    return [np.atleast_2d(np.asarray(m, dtype=float)) for m in (A, B, C)] + [dt, discrete]
 
 
 def design_scenario(A=None, B=None, C=None, E=None, *, sys=None, D=None, kind="chen-patton-uio", poles=None,
-                    gain=None, Q=None, R=None, placement=None, dt, x0=None, name="design", files=None, **keys):
+                    gain=None, Q=None, R=None, placement=None, dt=None, time="continuous", x0=None, name="design",
+                    files=None, **keys):
     """The scenario text `design` designs: the plant and one observer named `observer`; extra
     keyword arguments become keys of the `[[observer]]` table (e.g. decay=1.0, H=[[...]]).
+    A discrete-time plant (a StateSpace with a numeric dt, or time="discrete" with A, B, E the
+    per-step Φ, Γ_B, Γ_E) is written as such (`[plant] time = "discrete"`).
     With `files` (a folder), plant matrices of more than 256 entries are written there as
     `<name>.npy` and the text names them (as a scenario beside its matrix files does)."""
-    A, B, C = _matrices(sys, A, B, C)
+    A, B, C, dt, discrete = _matrices(sys, A, B, C, dt, time)
     column = lambda m: None if m is None else np.asarray(m, dtype=float).reshape(len(m), -1)  # noqa: E731 (a 1-D E is one column)
     E, D = column(E), column(D)
     plant = {k: _checked(k, m) for k, m in (("A", A), ("B", B), ("C", C), ("E", E), ("D", D)) if m is not None and (m.size or k in "ABC")}
@@ -108,7 +126,11 @@ def design_scenario(A=None, B=None, C=None, E=None, *, sys=None, D=None, kind="c
         return f"{k} = {_toml_matrix(k, m)}"
 
     lines = [f'name = "{name}"', f"dt = {_toml_number(dt)}", f"duration = {_toml_number(dt)}", "", "[plant]"]
-    lines += [entry(k, m) for k, m in plant.items()]
+    if discrete:
+        lines.append('time = "discrete"')
+    # A discrete plant's matrices are named as the scenario format names them: Φ, Γ_B, Γ_E.
+    key = {"A": "Phi", "B": "Gamma_B", "E": "Gamma_E"} if discrete else {}
+    lines += [entry(key.get(k, k), m) for k, m in plant.items()]
     lines.append(f"x0 = {_toml_list(np.zeros(n) if x0 is None else x0)}")
     # A design needs no signals, but a scenario names one per column of B, E and D.
     for table, m in (("input", B), ("disturbance", E), ("measurement_disturbance", D)):
@@ -158,11 +180,15 @@ class Design:
         self.poles, self.discrete_poles, self.fixed_modes = c(o["poles"]), c(o["discrete_poles"]), c(o["fixed_modes"])
 
     def statespace(self):
-        """The sampled observer as a python-control system from [u; y] to x̂ (dt = self.dt)."""
+        """The sampled observer as a python-control system from [u; y] to x̂ (dt = self.dt), its
+        inputs named u1 … u_l, y1 … y_p (the known inputs, then the measurements) and its outputs
+        xhat1 … xhat_n (the estimates)."""
         import control
 
         F, G, K, P, Q = (self.sampled[k] for k in "FGKPQ")
-        return control.ss(F, np.hstack([G, K]), P, np.hstack([np.zeros((P.shape[0], G.shape[1])), Q]), self.dt)
+        names = [f"u{i + 1}" for i in range(G.shape[1])] + [f"y{j + 1}" for j in range(K.shape[1])]
+        return control.ss(F, np.hstack([G, K]), P, np.hstack([np.zeros((P.shape[0], G.shape[1])), Q]), self.dt,
+                          inputs=names, outputs=[f"xhat{i + 1}" for i in range(P.shape[0])], name="observer")
 
     def freq(self):
         """The frequency responses of `uio-launcher design --freq` as NumPy arrays: `omega` (rad/s,
@@ -194,6 +220,23 @@ class Design:
         return f"Design({self.kind}, dt={self.dt}, discrete poles {np.round(self.discrete_poles, 6).tolist()})"
 
 
+def _argument_error(message):
+    """The launcher's message about the scenario `design` wrote, told in the arguments' terms:
+    "…/design.toml:36:8: observer[1].poles: …" becomes "poles: …", "plant.A: …" becomes "A: …" —
+    the file is a generated one the caller never saw."""
+    import re
+
+    m = re.match(r"^.*?design\.toml(?::\d+:\d+)?: (.*)$", message, re.S)
+    if not m:
+        return message
+    rest = m.group(1)
+    rest = re.sub(r"^observer\[1\]\.", "", rest)
+    rest = re.sub(r"^observer\[1\]: ", "", rest)
+    rest = re.sub(r"^plant\.", "", rest)
+    # A discrete plant's matrices are the arguments A, B and E.
+    return re.sub(r"^(Phi|Gamma_B|Gamma_E)\b", lambda k: {"Phi": "A", "Gamma_B": "B", "Gamma_E": "E"}[k.group(1)], rest)
+
+
 def design(A=None, B=None, C=None, E=None, **kw):
     """Designs one observer of `kind` for ẋ = Ax + Bu + Ew, y = Cx (+ Dv) sampled at `dt`; see
     `design_scenario` for the keywords. Raises ValueError, with the launcher's reason, when the
@@ -203,7 +246,10 @@ def design(A=None, B=None, C=None, E=None, **kw):
         if len(text.encode()) > MAX_SCENARIO_BYTES:
             raise ValueError(f"the design's scenario text is {len(text.encode())} bytes, more than the "
                              f"{MAX_SCENARIO_BYTES} a scenario may hold (its lists grow with the model's order)")
-        ok, report, lines = _native.design(os.path.join(files, "design.toml"), text)
+        try:
+            ok, report, lines = _native.design(os.path.join(files, "design.toml"), text)
+        except ValueError as e:
+            raise ValueError(_argument_error(str(e))) from None
     report = json.loads(report)
     if not ok:
         o = report["observers"][0]
