@@ -9,6 +9,11 @@ pub type Rgb = [u8; 3];
 /// The true state (and any reference signal an estimate is drawn over).
 pub const TRUE_STATE: Rgb = [140, 140, 140];
 
+/// The channel a bank isolated, over time: black, no member's colour.
+pub const ISOLATED: Rgb = [0, 0, 0];
+/// Which test decided: dark grey, apart from the true state's grey and every member's colour.
+pub const DECIDED_BY: Rgb = [85, 85, 85];
+
 /// Observers in scenario order; other signal groups (inputs, outputs, latency hops) take the
 /// same sequence by component.
 const PALETTE: [Rgb; 8] = [
@@ -125,6 +130,20 @@ pub fn line(path: &str, observers: &[String]) -> Line {
         // ŵ_k beside w_k (which has the palette's k-th colour): the observer's colour, darkened.
         ["observer", o, "what", _] => thin(shade(observer(o), 1 + k)),
         ["observer", o, ..] => thin(observer(o)),
+        // A bank's member i keeps the palette's i-th colour in every trace of it (its residual's
+        // components in shades of it); the decisions are black and dark grey, no member's.
+        ["diagnoser", _, "residual", i, _] => {
+            let i = i.parse::<usize>().map_or(0, |i| i.saturating_sub(1));
+            thin(shade(color(i), k))
+        }
+        [
+            "diagnosis",
+            _,
+            "evaluation" | "threshold" | "alarm" | "glr" | "glr_threshold",
+            _,
+        ] => thin(color(k)),
+        ["diagnosis", _, "isolated"] => thin(ISOLATED),
+        ["diagnosis", _, "decided_by"] => thin(DECIDED_BY),
         ["latency", "step"] => thin(TRUE_STATE),
         ["latency", hop] => {
             // plant_to_observer_<o>, observer_<o>_to_controller, controller_to_plant.
@@ -188,6 +207,45 @@ mod tests {
         assert_ne!(
             line("/input/1", &obs).color,
             line("/controller/u/1", &obs).color
+        );
+    }
+
+    /// Four bank members are four colours in every trace of theirs, and the decisions are none
+    /// of them.
+    #[test]
+    fn bank_members_and_decisions_have_colours_of_their_own() {
+        let obs: [String; 0] = [];
+        let members: Vec<Rgb> = (1..=4)
+            .map(|i| line(&format!("/diagnosis/gos/evaluation/{i}"), &obs).color)
+            .collect();
+        for (a, ca) in members.iter().enumerate() {
+            for cb in &members[a + 1..] {
+                assert_ne!(ca, cb);
+            }
+            let i = a + 1;
+            for what in ["threshold", "alarm", "glr", "glr_threshold"] {
+                assert_eq!(line(&format!("/diagnosis/gos/{what}/{i}"), &obs).color, *ca);
+            }
+            // Its residual's first component in its own colour, not output 1's of member 1.
+            assert_eq!(
+                line(&format!("/diagnoser/gos/residual/{i}/1"), &obs).color,
+                *ca
+            );
+            assert_ne!(
+                line(&format!("/diagnoser/gos/residual/{i}/2"), &obs).color,
+                *ca
+            );
+        }
+        for decision in ["/diagnosis/gos/isolated", "/diagnosis/gos/decided_by"] {
+            let c = line(decision, &obs).color;
+            assert!(
+                !PALETTE.contains(&c) && c != TRUE_STATE,
+                "{decision}: {c:?}"
+            );
+        }
+        assert_ne!(
+            line("/diagnosis/gos/isolated", &obs).color,
+            line("/diagnosis/gos/decided_by", &obs).color
         );
     }
 
