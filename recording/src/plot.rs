@@ -346,27 +346,41 @@ fn views(r: &Recording, s: Option<&Scenario>, observers: &[String]) -> Vec<View>
             series: faults,
         });
     }
-    let latency = r
-        .series
-        .keys()
-        .filter(|p| p.starts_with("/latency/"))
-        .map(|p| {
-            (
-                r.names
-                    .get(p)
-                    .cloned()
-                    .unwrap_or_else(|| p.trim_start_matches("/latency/").to_string()),
-                p.clone(),
-            )
-        })
-        .collect();
+    // The lockstep's own hops, and apart from them the followers' batch delays (milliseconds
+    // that would squash the hops' microseconds on one axis).
+    let latency = |followers: bool| -> Vec<(String, String)> {
+        r.series
+            .keys()
+            .filter(|p| p.starts_with("/latency/"))
+            .filter(|p| s.is_some_and(|s| signals::follower_hop(s, p)) == followers)
+            .map(|p| {
+                (
+                    r.names
+                        .get(p)
+                        .cloned()
+                        .unwrap_or_else(|| p.trim_start_matches("/latency/").to_string()),
+                    p.clone(),
+                )
+            })
+            .collect()
+    };
     out.push(View {
         file: "latency.png".into(),
         title: "lockstep latency, log scale".into(),
         y_label: "latency [µs]".into(),
         scale: Scale::Log,
-        series: latency,
+        series: latency(false),
     });
+    let followers = latency(true);
+    if !followers.is_empty() {
+        out.push(View {
+            file: "latency_followers.png".into(),
+            title: "followers' batch delay (observers off the lockstep ring), log scale".into(),
+            y_label: "delay [µs]".into(),
+            scale: Scale::Log,
+            series: followers,
+        });
+    }
     out
 }
 

@@ -199,6 +199,17 @@ pub fn reference_named(s: &Scenario, k: usize) -> Named {
     }
 }
 
+/// Whether the latency entity at `path` is a follower's: an observer the controller does not
+/// read trails the plant in batches (`lockstep::FOLLOWER_LAG`), so its "hop" is a batch delay
+/// of milliseconds, not a lockstep hop of microseconds, and is shown apart from them.
+pub fn follower_hop(s: &Scenario, path: &str) -> bool {
+    let Some(c) = &s.controller else {
+        return false;
+    };
+    path.strip_prefix("/latency/plant_to_observer_")
+        .is_some_and(|o| o != c.observer.replace('/', "_"))
+}
+
 /// u's name: `u<k>`, or "<input name> (u)" when the inputs are named.
 pub fn control_name(s: &Scenario, k: usize) -> String {
     match s.names.input.get(k) {

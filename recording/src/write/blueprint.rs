@@ -218,7 +218,20 @@ pub fn blueprint(s: &Scenario, layout: &Layout) -> Blueprint {
         &["/plant/y/**".to_string()],
         layout,
     ));
-    plant_signals.push(plot("latency [ns]", &["/latency/**".to_string()], layout));
+    // The lockstep's hops on their own axis; the followers' batch delays (ms) apart.
+    let (followers, ring): (Vec<String>, Vec<String>) = layout
+        .signals()
+        .filter(|p| p.starts_with("/latency/"))
+        .map(str::to_string)
+        .partition(|p| signals::follower_hop(s, p));
+    plant_signals.push(plot("lockstep latency [ns]", &ring, layout));
+    if !followers.is_empty() {
+        plant_signals.push(plot(
+            "followers' batch delay [ns] (observers off the ring)",
+            &followers,
+            layout,
+        ));
+    }
     let mut sections: Vec<ContainerLike> = vec![
         Grid::new(states)
             .with_name("states and estimates")

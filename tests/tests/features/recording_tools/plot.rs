@@ -525,3 +525,34 @@ fn a_state_name_of_250_characters_is_plotted_under_a_file_name_that_fits() {
         fig.title
     );
 }
+
+/// Across processes the follower Luenberger observer trails the plant in batches: its
+/// "latency" is a batch delay of milliseconds. It gets a view of its own, so that the lockstep's
+/// hops (µs) keep a readable axis.
+#[test]
+fn the_followers_batch_delay_is_plotted_apart_from_the_lockstep_hops() {
+    let s = Scratch::new("plot-latency");
+    let out = run(&s, &scenario("seed002-sine"), &["--mode", "processes"]);
+    assert!(out.status.success(), "{:?}", text(&out));
+    let r = recording::read::read(&s.join("out/seed002-sine.rrd")).unwrap();
+    let figs = figures(&r, &PlotSelection::default()).unwrap();
+    let labels = |file: &str| -> Vec<String> {
+        let (_, fig) = figs.iter().find(|(f, _)| f == file).expect(file);
+        let mut l: Vec<String> = fig.curves.iter().map(|c| c.label.clone()).collect();
+        l.sort();
+        l
+    };
+    assert_eq!(
+        labels("latency.png"),
+        [
+            "controller->plant",
+            "observer/uio->controller",
+            "plant->observer/uio",
+            "step"
+        ]
+    );
+    assert_eq!(
+        labels("latency_followers.png"),
+        ["plant->observer/luenberger"]
+    );
+}
