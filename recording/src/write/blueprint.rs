@@ -25,6 +25,24 @@ use super::layout::{Layout, VALUES_COMPONENT};
 use crate::globs::Globs;
 use crate::signals;
 
+/// The lockstep's hops on their own axis; the followers' batch delays (ms) apart.
+fn latency_views(s: &Scenario, layout: &Layout) -> Vec<ContainerLike> {
+    let (followers, ring): (Vec<String>, Vec<String>) = layout
+        .signals()
+        .filter(|p| p.starts_with("/latency/"))
+        .map(str::to_string)
+        .partition(|p| signals::follower_hop(s, p));
+    let mut views = vec![plot("lockstep latency [ns]", &ring, layout)];
+    if !followers.is_empty() {
+        views.push(plot(
+            "followers' batch delay [ns] (observers off the ring)",
+            &followers,
+            layout,
+        ));
+    }
+    views
+}
+
 /// A plot of the recorded signals matching `patterns`: each gets a visualizer that maps element
 /// `i` of its entity's values (selector `.[i]` on [`VALUES_COMPONENT`]) to the plotted scalars,
 /// with its own legend, colour and width.
@@ -218,20 +236,7 @@ pub fn blueprint(s: &Scenario, layout: &Layout) -> Blueprint {
         &["/plant/y/**".to_string()],
         layout,
     ));
-    // The lockstep's hops on their own axis; the followers' batch delays (ms) apart.
-    let (followers, ring): (Vec<String>, Vec<String>) = layout
-        .signals()
-        .filter(|p| p.starts_with("/latency/"))
-        .map(str::to_string)
-        .partition(|p| signals::follower_hop(s, p));
-    plant_signals.push(plot("lockstep latency [ns]", &ring, layout));
-    if !followers.is_empty() {
-        plant_signals.push(plot(
-            "followers' batch delay [ns] (observers off the ring)",
-            &followers,
-            layout,
-        ));
-    }
+    plant_signals.extend(latency_views(s, layout));
     let mut sections: Vec<ContainerLike> = vec![
         Grid::new(states)
             .with_name("states and estimates")
