@@ -411,15 +411,39 @@ fn log_max_error(r: &Recording, o: &str) -> Option<Series> {
     Some(out)
 }
 
+/// A readable unit for the time axis of a run of `duration` seconds, and its length in seconds:
+/// seconds up to 3 min, minutes up to 3 h, hours up to 3 days, then days.
+pub fn time_unit(duration: f64) -> (&'static str, f64) {
+    const MIN: f64 = 60.0;
+    const HOUR: f64 = 3600.0;
+    const DAY: f64 = 86_400.0;
+    if duration >= 3.0 * DAY {
+        ("days", DAY)
+    } else if duration >= 3.0 * HOUR {
+        ("h", HOUR)
+    } else if duration >= 3.0 * MIN {
+        ("min", MIN)
+    } else {
+        ("s", 1.0)
+    }
+}
+
 /// The figures of every selected view of `r`, with their file names; an error names what is
 /// wrong (a bad selection, nothing selected).
 pub fn figures(r: &Recording, selection: &PlotSelection) -> Result<Vec<(String, Figure)>, String> {
     let sel = selection.matcher()?;
     let scenario = recorded_scenario(r);
     let s = scenario.as_ref();
-    let dt = s.map(|s| s.dt);
-    let x_of = |k: i64| dt.map_or(k as f64, |dt| k as f64 * dt);
-    let x_label = if dt.is_some() { "t [s]" } else { "step" };
+    // Time in the run's own scale: a two-day run reads in hours, not in 10⁵ s.
+    let (x_label, axis) = match s {
+        Some(s) => {
+            let (unit, per) = time_unit(s.duration);
+            (format!("t [{unit}]"), Some((s.dt, per)))
+        }
+        None => ("step".to_string(), None),
+    };
+    let seconds = |k: i64| axis.map_or(k as f64, |(dt, _)| k as f64 * dt);
+    let x_of = |k: i64| axis.map_or(k as f64, |(dt, per)| k as f64 * dt / per);
     let observers = crate::signals::observers_of(r.series.keys(), s);
     // The scenario's order gives each observer its colour.
     let order: Vec<String> = s
@@ -482,8 +506,9 @@ pub fn figures(r: &Recording, selection: &PlotSelection) -> Result<Vec<(String, 
                 .steps
                 .iter()
                 .zip(&series.values)
+                .filter(|(k, _)| sel.time(seconds(**k)))
                 .map(|(&k, &v)| (x_of(k), y(v)))
-                .filter(|p| sel.time(p.0) && p.1.is_finite())
+                .filter(|p| p.1.is_finite())
                 .collect();
             if points.is_empty() {
                 continue;
@@ -501,7 +526,7 @@ pub fn figures(r: &Recording, selection: &PlotSelection) -> Result<Vec<(String, 
                 Figure {
                     title: view.title,
                     y_label: view.y_label,
-                    x_label: x_label.into(),
+                    x_label: x_label.clone(),
                     scale: view.scale,
                     x_scale: Scale::Linear,
                     curves,

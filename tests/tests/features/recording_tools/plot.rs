@@ -556,3 +556,41 @@ fn the_followers_batch_delay_is_plotted_apart_from_the_lockstep_hops() {
         ["plant->observer/luenberger"]
     );
 }
+
+/// A two-day run at dt = 60 s reads in hours, not in 10⁵ seconds; `--from`/`--to` stay in
+/// seconds.
+#[test]
+fn a_two_day_run_is_plotted_in_hours() {
+    let s = Scratch::new("plot-hours");
+    let path = s.join("slow.toml");
+    std::fs::write(
+        &path,
+        "name = \"slow\"\ndt = 60.0\nduration = 172800.0\n\n[plant]\nA = [[-0.0002]]\nB = [[0.0001]]\nC = [[1.0]]\nx0 = [1.0]\n\n[[input]]\nkind = \"constant\"\nvalue = 0.0\n\n[[observer]]\nname = \"luenberger\"\nkind = \"luenberger\"\npoles = [-0.001]\n",
+    )
+    .unwrap();
+    let out = run(&s, &path, &["--mode", "in-process"]);
+    assert!(out.status.success(), "{:?}", text(&out));
+    let r = recording::read::read(&s.join("out/slow.rrd")).unwrap();
+    let figs = figures(&r, &PlotSelection::default()).unwrap();
+    let (_, state) = figs.iter().find(|(f, _)| f.starts_with("state_1")).unwrap();
+    assert_eq!(state.x_label, "t [h]");
+    let last = state.curves[0].points.last().unwrap().0;
+    assert!((last - 2879.0 * 60.0 / 3600.0).abs() < 1e-9, "{last}");
+    // A window of the second day, in seconds as the options take it.
+    let sel = PlotSelection {
+        signals: vec!["/plant/**".into()],
+        from: Some(86_400.0),
+        to: None,
+    };
+    let figs = figures(&r, &sel).unwrap();
+    let (_, state) = figs.iter().find(|(f, _)| f.starts_with("state_1")).unwrap();
+    assert!((state.curves[0].points[0].0 - 24.0).abs() < 1e-9);
+    for (duration, unit) in [
+        (20.0, "s"),
+        (600.0, "min"),
+        (172_800.0, "h"),
+        (864_000.0, "days"),
+    ] {
+        assert_eq!(recording::plot::time_unit(duration).0, unit, "{duration}");
+    }
+}
