@@ -37,6 +37,7 @@ pub mod sampled;
 pub mod signal;
 pub mod staircase;
 pub mod subspace;
+pub mod units;
 pub mod unseen;
 pub mod van_loan;
 pub mod zeros;

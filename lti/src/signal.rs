@@ -188,7 +188,8 @@ pub enum Signal {
     },
     /// s(t) = before for t < time, after from `time` on.
     Step {
-        /// Switching time, s.
+        /// Switching time, s (or "12 h", [`crate::units`]).
+        #[serde(deserialize_with = "crate::units::de::seconds")]
         time: f64,
         /// Value before the step.
         #[serde(default)]
@@ -200,7 +201,8 @@ pub enum Signal {
     Sine {
         /// Amplitude.
         amplitude: f64,
-        /// Frequency, Hz.
+        /// Frequency, Hz (or "1/day", "0.5 Hz").
+        #[serde(deserialize_with = "crate::units::de::hertz")]
         frequency_hz: f64,
         /// Phase at t = 0, rad.
         #[serde(default)]
@@ -211,7 +213,8 @@ pub enum Signal {
     },
     /// s(t) = values[i] for times[i] ≤ t < times[i+1]; 0 before times[0].
     Piecewise {
-        /// Strictly increasing switching times, s.
+        /// Strictly increasing switching times, s (each may carry a unit).
+        #[serde(deserialize_with = "crate::units::de::seconds_vec")]
         times: Vec<f64>,
         /// The value that holds from each time on.
         values: Vec<f64>,

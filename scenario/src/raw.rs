@@ -45,7 +45,11 @@ pub struct RawScenario {
     pub name: String,
     #[serde(default)]
     pub description: String,
+    /// Sample period: seconds, or a time with its unit ("1 min", [`lti::units`]).
+    #[serde(deserialize_with = "lti::units::de::seconds")]
     pub dt: f64,
+    /// Length: seconds, or "48 h".
+    #[serde(deserialize_with = "lti::units::de::seconds")]
     pub duration: f64,
     pub plant: RawPlant,
     #[serde(default)]
@@ -70,6 +74,7 @@ pub struct RawScenario {
     pub isolated_fraction: Option<f64>,
     /// How long a component that is running (or waiting for a core) may publish nothing before
     /// the run is stopped, s (default 60; `--stall-timeout` overrides it).
+    #[serde(default, deserialize_with = "lti::units::de::seconds_opt")]
     pub stall_timeout: Option<f64>,
     /// Host name → its agent's Zenoh endpoint.
     pub hosts: Option<BTreeMap<String, String>>,
@@ -100,7 +105,9 @@ pub struct RawFault {
     pub kind: String,
     pub value: f64,
     pub profile: Option<String>,
+    #[serde(default, deserialize_with = "lti::units::de::seconds_opt")]
     pub start: Option<f64>,
+    #[serde(default, deserialize_with = "lti::units::de::seconds_opt")]
     pub end: Option<f64>,
     pub intervals: Option<Vec<Vec<f64>>>,
 }
@@ -133,6 +140,7 @@ pub struct RawDiagnoser {
     pub false_alarm: Option<f64>,
     pub calibrate: Option<RawCalibrate>,
     pub persistence: Option<i64>,
+    #[serde(default, deserialize_with = "lti::units::de::seconds_opt")]
     pub ignore_before: Option<f64>,
     /// `glr = { window, false_alarm }`: a windowed GLR test beside the evaluation.
     pub glr: Option<RawGlr>,
@@ -143,6 +151,7 @@ pub struct RawDiagnoser {
 #[serde(deny_unknown_fields)]
 pub struct RawGlr {
     /// How long an onset is tried for, s.
+    #[serde(deserialize_with = "lti::units::de::seconds")]
     pub window: f64,
     /// The bound on the false-alarm probability per sample.
     pub false_alarm: f64,
