@@ -83,3 +83,12 @@ def test_a_time_without_a_unit_we_know_is_refused_naming_its_field(tmp_path, old
     first = done.stderr.strip().splitlines()[0]
     assert "bad.toml" in first and field in first and new.split("= ")[1].strip('"') in first, first
     assert not (tmp_path / "out" / "building.rrd").exists()
+
+
+def test_the_design_gives_each_pole_as_a_time_constant_in_a_readable_unit(tmp_path):
+    (tmp_path / "h.toml").write_text(WITH_UNITS)
+    done = run(["design", str(tmp_path / "h.toml")])
+    assert done.returncode == 0, done.stderr
+    lines = [ln for ln in done.stdout.splitlines() if "time constants" in ln]
+    # Poles −0.001 and −0.002 1/s: τ = 1000 s and 500 s, read in minutes.
+    assert lines and all("16.6667 min" in ln and "8.33333 min" in ln for ln in lines), lines

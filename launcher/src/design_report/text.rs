@@ -127,6 +127,7 @@ fn observer(o: &ObserverSection, dt: f64) -> String {
             // Every list says its domain: s for the continuous poles and fixed modes (ln(z)/dt
             // for a sampled-only design), z for the sampled ones.
             text += &format!("  poles (s):        {}\n", format_list(&r.poles));
+            text += &time_constants(&r.poles);
             text += &format!(
                 "  poles (z, dt = {dt}): {}\n",
                 format_list(&r.discrete_poles)
@@ -241,6 +242,25 @@ fn controller(c: &ControllerSection) -> String {
             }
             text
         }
+    }
+}
+
+/// The poles as time constants, τ = −1/Re(p), each in a readable unit ("τ: 1 s, 0.5 s, 16.7 min"):
+/// how fast each mode of the error decays, which a pole of −0.001667 does not say at a glance.
+fn time_constants(poles: &[lti::eig::C64]) -> String {
+    let taus: Vec<String> = poles
+        .iter()
+        .filter(|p| p.re < 0.0 && p.im >= 0.0)
+        .map(|p| {
+            let tau = -1.0 / p.re;
+            let (unit, per) = recording::plot::time_unit(tau * 3.0);
+            format!("{} {unit}", sig(tau / per))
+        })
+        .collect();
+    if taus.is_empty() {
+        String::new()
+    } else {
+        format!("  time constants τ = −1/Re p: {}\n", taus.join(", "))
     }
 }
 
