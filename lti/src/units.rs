@@ -21,13 +21,14 @@ fn unit(u: &str) -> Option<f64> {
 
 const UNITS: &str = "ms, s, min, h, day(s)";
 
-fn number(s: &str, whole: &str) -> Result<f64, String> {
+/// The finite number `s` (trimmed), a part of `whole`: the error quotes both.
+pub fn number(s: &str, whole: &str) -> Result<f64, String> {
     let v: f64 = s
         .trim()
         .parse()
         .map_err(|_| format!("'{whole}': '{}' is not a number", s.trim()))?;
     if !v.is_finite() {
-        return Err(format!("'{whole}' is not finite"));
+        return Err(format!("'{whole}': '{}' is not finite", s.trim()));
     }
     Ok(v)
 }

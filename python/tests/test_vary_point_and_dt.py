@@ -21,12 +21,11 @@ import subprocess
 
 import numpy as np
 import pytest
-from scipy.linalg import expm
 
 from test_diagnosis_scipy import launcher
 from test_fmu_plant import DC_MOTOR
 from test_fmu_testfmus import fmu_dir  # noqa: F401 (a fixture)
-from test_vary_oracle import A, C, DT, DURATION, E, F_HZ, SCENARIO, X0
+from test_vary_oracle import A, DT, SCENARIO, oracle_tail_errors
 
 
 def run(args):
@@ -44,39 +43,6 @@ def write(tmp_path, name, text):
     return path
 
 
-def oracle_tail_errors(dt_plant, observers):
-    """Each observer's tail max |x − x̂| with the plant sampled at `dt_plant` (u = 0), the
-    observers' matrices as designed."""
-    n = len(A)
-    w = 2 * np.pi * F_HZ
-    aug = np.zeros((n + 2, n + 2))
-    aug[:n, :n] = A
-    aug[:n, n] = np.array(E)[:, 0]
-    aug[n, n + 1], aug[n + 1, n] = w, -w
-    phi = expm(aug * dt_plant)
-    steps = round(DURATION / dt_plant)
-    s = np.concatenate([X0, [0.0, 1.0]])
-    c = np.array(C)
-    xs = np.empty((steps, n))
-    for k in range(steps):
-        xs[k] = s[:n]
-        s = phi @ s
-    tail = steps - steps // 4
-    out = {}
-    for name, m in observers.items():
-        f, k_, p, q = (np.array(m[x]) for x in ("F", "K", "P", "Q"))
-        z = np.zeros(f.shape[0])
-        worst = 0.0
-        for k in range(steps):
-            if k > 0:
-                z = f @ z + k_ @ (c @ xs[k - 1])
-            e = xs[k] - (p @ z + q @ (c @ xs[k]))
-            if k >= tail:
-                worst = max(worst, np.max(np.abs(e)))
-        out[name] = worst
-    return out
-
-
 def test_a_plant_sampled_at_another_dt_follows_an_independent_simulation(tmp_path):
     path = write(tmp_path, "mismatch", SCENARIO)
     design = run(["design", "--json", str(path)])
@@ -89,7 +55,7 @@ def test_a_plant_sampled_at_another_dt_follows_an_independent_simulation(tmp_pat
     assert [float(r[vary]) for r in rows] == [1.0, 0.5, 0.8, 1.25, 2.0]
     errors = {}
     for r in rows:
-        want = oracle_tail_errors(DT * float(r[vary]), observers)
+        want = oracle_tail_errors(np.array(A), observers, DT * float(r[vary]))
         for name, value in want.items():
             got = float(r[f"tail max|e| {name}"])
             assert abs(got - value) <= 1e-9 * value, (r[vary], name, got, value)

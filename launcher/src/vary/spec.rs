@@ -129,16 +129,7 @@ impl Vary {
 /// Most values of one grid.
 pub const MAX_GRID: usize = 10_000;
 
-fn number(s: &str, whole: &str) -> Result<f64, String> {
-    let v: f64 = s
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{whole}': '{}' is not a number", s.trim()))?;
-    if !v.is_finite() {
-        return Err(format!("'{whole}': '{}' is not finite", s.trim()));
-    }
-    Ok(v)
-}
+use lti::units::number;
 
 /// `f(a, b)` → (a, b).
 fn two(args: &str, whole: &str) -> Result<(f64, f64), String> {
@@ -256,6 +247,13 @@ impl FromStr for Vary {
         let target = target.trim().to_string();
         let target = target.as_str();
         let values = values(rest, whole)?;
+        let vary = |place| Vary {
+            target: target.to_string(),
+            place,
+            op,
+            values: values.clone(),
+            text: text.clone(),
+        };
         for (prefix, what) in [
             (FMU_PARAMETERS, "FMU variable"),
             (PROCESS_PARAMS, "parameter"),
@@ -273,27 +271,14 @@ impl FromStr for Vary {
             } else {
                 Place::ProcessParameter(name.to_string())
             };
-            return Ok(Vary {
-                target: target.to_string(),
-                place,
-                op,
-                values,
-                text,
-            });
+            return Ok(vary(place));
         }
         let (name, index) = match target.split_once('[') {
             Some((m, idx)) => (m.trim(), Some(idx)),
             None => (target, None),
         };
-        let place = scalar_place(name, index, whole)?;
-        if let Some(place) = place {
-            return Ok(Vary {
-                target: target.to_string(),
-                place,
-                op,
-                values,
-                text,
-            });
+        if let Some(place) = scalar_place(name, index, whole)? {
+            return Ok(vary(place));
         }
         let matrix = match name {
             "A" => Matrix::A,
@@ -331,13 +316,7 @@ impl FromStr for Vary {
                 "'{whole}': a whole matrix can be scaled (*=), not set; set an entry, {name}[row,column] = …"
             ));
         }
-        Ok(Vary {
-            target: target.to_string(),
-            place: Place::Matrix(matrix, entry),
-            op,
-            values,
-            text,
-        })
+        Ok(vary(Place::Matrix(matrix, entry)))
     }
 }
 

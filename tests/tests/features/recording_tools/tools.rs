@@ -20,6 +20,16 @@ fn inspect_json(s: &Scratch, rrd: &std::path::Path) -> (serde_json::Value, Strin
     )
 }
 
+/// The observer named `name` in an inspection's JSON.
+fn observer_of<'a>(ins: &'a serde_json::Value, name: &serde_json::Value) -> &'a serde_json::Value {
+    ins["observers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|x| x["name"] == *name)
+        .unwrap()
+}
+
 #[test]
 fn inspect_recomputes_the_summary() {
     let s = Scratch::new("inspect");
@@ -30,12 +40,7 @@ fn inspect_recomputes_the_summary() {
     assert_eq!(ins["complete"], true);
     assert_eq!(ins["steps_recorded"], 20_000);
     for o in sum["observers"].as_array().unwrap() {
-        let i = ins["observers"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|x| x["name"] == o["name"])
-            .unwrap();
+        let i = observer_of(&ins, &o["name"]);
         for f in ["tail_max_abs_error", "tail_max_abs_residual"] {
             let (a, b) = (o[f].as_f64().unwrap(), i[f].as_f64().unwrap());
             assert!(
@@ -57,12 +62,7 @@ fn inspect_recomputes_the_summary() {
         let (ins, _) = inspect_json(&s, &s.join(&format!("out/{name}.rrd")));
         let mut estimated = 0;
         for o in sum["observers"].as_array().unwrap() {
-            let i = ins["observers"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .find(|x| x["name"] == o["name"])
-                .unwrap();
+            let i = observer_of(&ins, &o["name"]);
             let f = "tail_max_abs_input_error";
             assert_eq!(o[f].as_f64(), i[f].as_f64(), "{name} {}", o["name"]);
             estimated += usize::from(o[f].is_f64());
