@@ -27,6 +27,8 @@
 //! parameter C_a A_a^k B_w (and D) is below [`DECOUPLED`] of ‖C_a‖‖A_a^k‖‖B_w‖, the rule of the
 //! structure matrix ([`crate::structure::BLIND`]); its σ are then the rounding's, shown as such.
 
+use std::cell::OnceCell;
+
 use lti::Mat;
 use lti::freq::Sampled;
 use observer::LinearObserver;
@@ -54,8 +56,11 @@ pub struct ErrorSystems {
     pub w_decoupled: bool,
     /// The state z tracks, M (MΦ − FM = KC), when it exists and the observer is unbiased
     /// (PM + QC = I): the systems then have a realisation of the observer's order, ζ = z − Mx,
-    /// which gives their DC gain where the plant has an integrator.
-    m: Option<Mat>,
+    /// which gives their DC gain where the plant has an integrator. Solved on first use only (its
+    /// Kronecker system has (n·r)² entries), once.
+    m: OnceCell<Option<Mat>>,
+    phi: Mat,
+    c: Mat,
     p: Mat,
     q: Mat,
     s_cp: Mat,
@@ -116,15 +121,10 @@ impl ErrorSystems {
             (None, None)
         };
         let w_decoupled = q > 0 && markov_size(&a, &b_w, &c_e) <= DECOUPLED;
-        let m = tracked(phi, &res.f, &res.k, c).ok().filter(|m| {
-            let sylvester = (m * phi - &res.f * m - &res.k * c).norm();
-            let scale = m.norm() * (phi.norm() + res.f.norm()) + res.k.norm() * c.norm();
-            let unbiased = (&res.p * m + &res.q * c - Mat::identity(n, n)).norm();
-            sylvester <= 1e-10 * scale.max(f64::MIN_POSITIVE)
-                && unbiased <= 1e-8 * (1.0 + (&res.p * m).norm())
-        });
         ErrorSystems {
-            m,
+            m: OnceCell::new(),
+            phi: phi.clone(),
+            c: c.clone(),
             p: res.p.clone(),
             q: res.q.clone(),
             s_cp: &res.s * &res.cp,
@@ -143,10 +143,27 @@ impl ErrorSystems {
         }
     }
 
+    /// M, solved on first use: `None` when it does not exist or the observer is biased.
+    fn tracked(&self) -> Option<&Mat> {
+        self.m
+            .get_or_init(|| {
+                let (phi, c, f, k) = (&self.phi, &self.c, &self.f, &self.k);
+                let n = phi.nrows();
+                tracked(phi, f, k, c).ok().filter(|m| {
+                    let sylvester = (m * phi - f * m - k * c).norm();
+                    let scale = m.norm() * (phi.norm() + f.norm()) + k.norm() * c.norm();
+                    let unbiased = (&self.p * m + &self.q * c - Mat::identity(n, n)).norm();
+                    sylvester <= 1e-10 * scale.max(f64::MIN_POSITIVE)
+                        && unbiased <= 1e-8 * (1.0 + (&self.p * m).norm())
+                })
+            })
+            .as_ref()
+    }
+
     /// The realisations of the observer's order (ζ = z − Mx) of w → e, v → e, w → r, v → r, when
     /// M exists: the same transfers without the plant's modes, for their DC gains.
     pub fn reduced(&self) -> Option<[Option<Sampled>; 4]> {
-        let m = self.m.as_ref()?;
+        let m = self.tracked()?;
         let sys = |b: Mat, c: Mat, d: Mat| Sampled {
             a: self.f.clone(),
             b,
@@ -167,7 +184,7 @@ impl ErrorSystems {
 
     /// [`ErrorSystems::fault`] in the observer's order, when M exists.
     pub fn reduced_fault(&self, input: &FaultInput) -> Option<Sampled> {
-        let m = self.m.as_ref()?;
+        let m = self.tracked()?;
         let (b, d) = match input {
             FaultInput::State(g) => (
                 -(m * Mat::from_column_slice(g.len(), 1, g.as_slice())),

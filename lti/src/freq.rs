@@ -81,24 +81,47 @@ pub fn grid(dt: f64, lo: f64) -> Vec<f64> {
         .collect()
 }
 
+/// B, C and D as complex matrices, made once for all the frequencies of a response.
+struct Complexified {
+    b: CMat,
+    c: CMat,
+    d: CMat,
+}
+
 impl Sampled {
+    fn complexified(&self) -> Complexified {
+        let cplx = |m: &Mat| m.map(|v| C64::new(v, 0.0));
+        Complexified {
+            b: cplx(&self.b),
+            c: cplx(&self.c),
+            d: cplx(&self.d),
+        }
+    }
+
     /// G(z).
     pub fn at(&self, z: C64) -> Option<CMat> {
+        self.at_with(z, &self.complexified())
+    }
+
+    fn at_with(&self, z: C64, k: &Complexified) -> Option<CMat> {
         let r = self.a.nrows();
-        let cplx = |m: &Mat| m.map(|v| C64::new(v, 0.0));
         let za = CMat::from_fn(r, r, |i, j| {
             let a = C64::new(-self.a[(i, j)], 0.0);
             if i == j { a + z } else { a }
         });
-        let x = solve(&za, &cplx(&self.b))?;
-        Some(cplx(&self.c) * x + cplx(&self.d))
+        let x = solve(&za, &k.b)?;
+        Some(&k.c * x + &k.d)
     }
 
     /// (σ_max, σ_min) of G(e^{jωΔt}): its largest and smallest of min(rows, columns) singular
     /// values; ∞ at a pole on the unit circle.
     pub fn sigma(&self, omega: f64) -> (f64, f64) {
+        self.sigma_with(omega, &self.complexified())
+    }
+
+    fn sigma_with(&self, omega: f64, k: &Complexified) -> (f64, f64) {
         let z = C64::from_polar(1.0, omega * self.dt);
-        match self.at(z) {
+        match self.at_with(z, k) {
             Some(g) => {
                 let s = singular_values(&g);
                 (
@@ -123,16 +146,22 @@ impl Sampled {
 
     /// The response on `omega` (ascending, within 0 … π/Δt).
     pub fn response(&self, omega: &[f64]) -> Response {
-        self.response_with_dc(omega, None)
+        self.response_with_dc(omega, || None)
     }
 
-    /// [`Sampled::response`], the DC gain from `same` when this realisation has none at z = 1: a
-    /// realisation of the same transfer without the pole at 1 that cancels from it (an observer's
-    /// error system in its own coordinates, where the plant's integrator is not a state).
-    pub fn response_with_dc(&self, omega: &[f64], same: Option<&Sampled>) -> Response {
+    /// [`Sampled::response`], the DC gain from `same` when this realisation has none at z = 1:
+    /// that of a realisation of the same transfer without the pole at 1 that cancels from it (an
+    /// observer's error system in its own coordinates, where the plant's integrator is not a
+    /// state), asked for only then.
+    pub fn response_with_dc(
+        &self,
+        omega: &[f64],
+        same: impl FnOnce() -> Option<Sampled>,
+    ) -> Response {
+        let k = self.complexified();
         let (sigma_max, sigma_min): (Vec<f64>, Vec<f64>) =
-            omega.iter().map(|&w| self.sigma(w)).unzip();
-        let dc = self.dc().or_else(|| same.and_then(Sampled::dc));
+            omega.iter().map(|&w| self.sigma_with(w, &k)).unzip();
+        let dc = self.dc().or_else(|| same().as_ref().and_then(Sampled::dc));
         let dc_sigma_max = dc.as_ref().map(|g| {
             crate::linalg::svd::singular_values(g)
                 .first()
@@ -143,7 +172,7 @@ impl Sampled {
         if let Some(i) = (0..omega.len()).max_by(|&i, &j| sigma_max[i].total_cmp(&sigma_max[j]))
             && sigma_max[i] > hinf
         {
-            let (w, s) = self.refine(omega, i);
+            let (w, s) = self.refine(omega, i, sigma_max[i], &k);
             (hinf, hinf_omega) = (s, w);
         }
         Response {
@@ -161,17 +190,17 @@ impl Sampled {
         }
     }
 
-    /// The peak of σ_max near grid point i: golden-section search on log ω between its
-    /// neighbours; (ω, σ_max) of the best point seen, the grid's own included.
-    fn refine(&self, omega: &[f64], i: usize) -> (f64, f64) {
+    /// The peak of σ_max near grid point i (where it is `at_i`): golden-section search on log ω
+    /// between its neighbours; (ω, σ_max) of the best point seen, the grid's own included.
+    fn refine(&self, omega: &[f64], i: usize, at_i: f64, k: &Complexified) -> (f64, f64) {
         let lo = omega[i.saturating_sub(1)].ln();
         let hi = omega[(i + 1).min(omega.len() - 1)].ln();
-        let f = |l: f64| self.sigma(l.exp()).0;
+        let f = |l: f64| self.sigma_with(l.exp(), k).0;
         let g = (5f64.sqrt() - 1.0) / 2.0;
         let (mut a, mut b) = (lo, hi);
         let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
         let (mut fc, mut fd) = (f(c), f(d));
-        let mut best = (omega[i], self.sigma(omega[i]).0);
+        let mut best = (omega[i], at_i);
         for _ in 0..60 {
             if fc > fd {
                 b = d;

@@ -208,6 +208,12 @@ fn sentence(name: &str, (min, median, max, n): (f64, f64, f64, usize)) -> String
         pct(max)
     );
     let times = format!("(median of {n} repetition(s); range {min:.2} – {max:.2}×)");
+    // Which mode a ratio's name speaks of, as the sentence says it.
+    let m = if name.starts_with("in-process") {
+        "in one process"
+    } else {
+        "across processes"
+    };
     let rec = |with: bool| {
         if with {
             "with recording"
@@ -240,11 +246,6 @@ fn sentence(name: &str, (min, median, max, n): (f64, f64, f64, usize)) -> String
         }
         "in-process: share of steps/s recording costs"
         | "processes: share of steps/s recording costs" => {
-            let m = if name.starts_with("in-process") {
-                "in one process"
-            } else {
-                "across processes"
-            };
             format!(
                 "{m}, recording costs {} of the steps per second a run makes without it {over}\n",
                 pct(median)
@@ -260,11 +261,6 @@ fn sentence(name: &str, (min, median, max, n): (f64, f64, f64, usize)) -> String
         }
         "in-process (recording): write rate / disk's"
         | "processes (recording): write rate / disk's" => {
-            let m = if name.starts_with("in-process") {
-                "in one process"
-            } else {
-                "across processes"
-            };
             format!(
                 "{m}, the recording is written at {} of the rate a dd-like write makes into the same folder {over}\n",
                 pct(median)
@@ -272,11 +268,6 @@ fn sentence(name: &str, (min, median, max, n): (f64, f64, f64, usize)) -> String
         }
         "in-process (recording): GB per 10^7 steps"
         | "processes (recording): GB per 10^7 steps" => {
-            let m = if name.starts_with("in-process") {
-                "in one process"
-            } else {
-                "across processes"
-            };
             format!(
                 "{m}, a 10⁷-step run of this loop writes {median:.2} GB at this run's bytes per step (median of {n} repetition(s); range {min:.2} – {max:.2} GB)\n"
             )

@@ -105,21 +105,22 @@ pub fn freq(s: &Scenario, r: &DesignReport) -> FreqReport {
     let systems = made
         .into_iter()
         .map(|(name, e, faults)| {
-            let [rw_e, rv_e, rw_r, rv_r] = e.reduced().unwrap_or([None, None, None, None]);
-            let resp = |sys: &lti::freq::Sampled, same: &Option<lti::freq::Sampled>| {
-                sys.response_with_dc(&omega, same.as_ref())
+            // The DC gain from the observer's own coordinates, asked for only where the plant's
+            // integrator leaves the joint realisation without one.
+            let resp = |sys: &lti::freq::Sampled, which: usize| {
+                sys.response_with_dc(&omega, || e.reduced().and_then(|r| r[which].clone()))
             };
             Responses {
                 name,
-                w_e: e.w_e.as_ref().map(|sys| resp(sys, &rw_e)),
-                v_e: resp(&e.v_e, &rv_e),
-                w_r: e.w_r.as_ref().map(|sys| resp(sys, &rw_r)),
-                v_r: resp(&e.v_r, &rv_r),
+                w_e: e.w_e.as_ref().map(|sys| resp(sys, 0)),
+                v_e: resp(&e.v_e, 1),
+                w_r: e.w_r.as_ref().map(|sys| resp(sys, 2)),
+                v_r: resp(&e.v_r, 3),
                 w_decoupled: e.w_decoupled,
                 faults: faults
                     .into_iter()
                     .map(|(label, sys, noise, input)| {
-                        let resp = sys.response_with_dc(&omega, e.reduced_fault(&input).as_ref());
+                        let resp = sys.response_with_dc(&omega, || e.reduced_fault(&input));
                         let fnr = noise
                             .filter(|&n| n > 0.0)
                             .and_then(|n| resp.dc_sigma_max.map(|d| d / n));
