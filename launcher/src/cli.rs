@@ -286,6 +286,10 @@ pub struct BenchArgs {
     /// Repetitions (each: the floor, then every configuration); ratios are given as medians.
     #[arg(long, default_value_t = 1)]
     pub repeat: usize,
+    /// Each repetition also runs a 32-sensor plant with and without a 32-member bank, for a bank
+    /// member's cost in each mode (on) or not (off).
+    #[arg(long, value_enum, default_value = "on")]
+    pub bank: OnOff,
     /// Instead: how a step's cost grows with the model, for random stable plants of these
     /// sizes with a UIO and a Luenberger observer in closed loop (e.g. 3,10,30).
     #[arg(long, value_name = "N[,N…]", value_delimiter = ',')]

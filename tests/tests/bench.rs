@@ -148,3 +148,47 @@ fn bench_gives_a_recordings_write_rate_against_the_disks_in_the_same_run() {
     let left: Vec<_> = std::fs::read_dir(&tmp).unwrap().flatten().collect();
     assert!(left.is_empty(), "left behind: {left:?}");
 }
+
+/// Every repetition also runs a 32-sensor plant with and without a 32-member bank in each mode:
+/// a member's cost per step is the two runs' difference in time per step over 32, and the
+/// printed ratio is the cost across processes over the cost in one process.
+#[test]
+fn bench_gives_a_bank_members_cost_in_each_mode_and_their_ratio() {
+    let s = Scratch::new("bench-bank");
+    let out = launcher(&s)
+        .args(["bench", "--steps", "3000", "--recording", "off", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{:?}", text(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let banks = v["banks"].as_array().unwrap();
+    assert_eq!(banks.len(), 1, "{v}");
+    let rep = banks[0].as_array().unwrap();
+    assert_eq!(rep.len(), 4, "{rep:?}");
+    let cost = |mode: &str| {
+        let sps = |members: u64| {
+            rep.iter()
+                .find(|r| r["mode"] == mode && r["members"] == members)
+                .unwrap()["steps_per_s"]
+                .as_f64()
+                .unwrap()
+        };
+        (1e6 / sps(32) - 1e6 / sps(0)) / 32.0
+    };
+    let (i, p) = (cost("in-process"), cost("processes"));
+    // The costs themselves are not asserted: on a loaded machine a 3000-step run across
+    // processes without the bank can be the slower one.
+    for (name, c) in [
+        ("bank member (in-process), µs per step", i),
+        ("bank member (processes), µs per step", p),
+    ] {
+        let got = v["ratios"][name]["median"].as_f64().unwrap();
+        assert!((got - c).abs() <= 1e-9 * c.abs(), "{name}: {got} {c}");
+    }
+    let r = &v["ratios"]["bank member: processes / in-process, cost per step"];
+    assert_eq!(r["repetitions"], 1, "{v}");
+    assert!(
+        (r["median"].as_f64().unwrap() - p / i).abs() <= 1e-9 * (p / i).abs(),
+        "{r} against {p} / {i}"
+    );
+}

@@ -4,10 +4,13 @@
 //! the multi-process figures are given as ratios. Every repetition runs the floor and then each
 //! configuration, so that the machine's drift falls on both sides of a ratio alike. With
 //! recording, each repetition also measures the disk's own write rate into the recordings'
-//! folder ([`disk`]), and each recorded run its bytes per step and write rate against it.
+//! folder ([`disk`]), and each recorded run its bytes per step and write rate against it. With
+//! `bank`, each repetition ends with a bank member's cost in each mode ([`bank`]).
 
+pub mod bank;
 pub mod disk;
 pub mod floor;
+pub mod measure;
 pub mod states;
 
 use std::path::Path;
@@ -17,7 +20,8 @@ use serde::Serialize;
 
 use crate::error::LaunchError;
 use crate::plan::plan;
-use crate::run::{Mode, Options, Stop, run};
+use crate::run::Mode;
+use measure::measure;
 use recording::write::Percentiles;
 use scenario::Scenario;
 
@@ -41,7 +45,18 @@ pub struct BenchRun {
     pub write_bytes_per_s: Option<f64>,
 }
 
-/// Runs the benchmark on `scenario` (seed002-sine) for `steps` steps, `repeat` times over.
+/// The benchmark's runs: seed 002's, and per repetition the bank's ([`bank`]).
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct Bench {
+    /// Seed 002's runs, each repetition opening with its floor (or disk) run.
+    pub runs: Vec<BenchRun>,
+    /// Per repetition, the bank runs (empty without `bank`).
+    pub banks: Vec<Vec<bank::BankRun>>,
+}
+
+/// Runs the benchmark on `scenario` (seed002-sine) for `steps` steps, `repeat` times over; with
+/// `with_bank`, each repetition also measures a bank member's cost (recorded if any run is).
+#[allow(clippy::too_many_arguments)]
 pub fn bench(
     scenario: &Path,
     steps: u64,
@@ -50,7 +65,8 @@ pub fn bench(
     modes: &[Mode],
     recording: &[bool],
     repeat: usize,
-) -> Result<Vec<BenchRun>, LaunchError> {
+    with_bank: bool,
+) -> Result<Bench, LaunchError> {
     let mut s = Scenario::load(scenario)?;
     s.steps = steps;
     s.duration = steps as f64 * s.dt;
@@ -59,86 +75,71 @@ pub fn bench(
     let tmp = std::env::temp_dir().join(format!("uio-bench-{}", std::process::id()));
     let lay = crate::run::configs(&s, &p).layout;
     let mut out = Vec::new();
-    for _ in 0..repeat.max(1) {
-        if modes.contains(&Mode::Processes) {
-            let f = floor::floor(steps, [lay.len(), lay.n, lay.l], wait, pin)?;
-            out.push(BenchRun {
-                mode: "floor".into(),
-                recording: false,
-                steps,
-                steps_per_s: f.steps_per_s,
-                step_ns: f.inner.step_ns,
-                bytes_per_step: None,
-                write_bytes_per_s: None,
-            });
-        }
-        if recording.contains(&true) {
-            out.push(BenchRun {
-                mode: "disk".into(),
-                recording: false,
-                steps: 0,
-                steps_per_s: 0.0,
-                step_ns: Percentiles::default(),
-                bytes_per_step: None,
-                write_bytes_per_s: Some(disk::write_rate(&tmp)?),
-            });
-        }
-        for &mode in modes {
-            for &record in recording {
-                let start = std::time::Instant::now();
-                let o = measure(&s, &p, &tmp, mode, wait, record, pin)?;
-                if let Some(rrd) = &o.rrd {
-                    disk::sync(rrd)?;
-                }
-                let whole = start.elapsed().as_secs_f64();
-                let bytes = o
-                    .rrd
-                    .as_ref()
-                    .and_then(|r| std::fs::metadata(r).ok())
-                    .map(|m| m.len() as f64);
+    let mut banks = Vec::new();
+    // Every repetition's files go into `tmp`, removed whether the runs end or fail.
+    let result = (|| {
+        for _ in 0..repeat.max(1) {
+            if modes.contains(&Mode::Processes) {
+                let f = floor::floor(steps, [lay.len(), lay.n, lay.l], wait, pin)?;
                 out.push(BenchRun {
-                    mode: mode.name().into(),
-                    recording: record,
-                    steps: o.summary.steps,
-                    steps_per_s: o.summary.steps_per_s,
-                    step_ns: o.summary.latency_ns.step,
-                    bytes_per_step: bytes.map(|b| b / o.summary.steps.max(1) as f64),
-                    write_bytes_per_s: bytes.map(|b| b / whole.max(1e-9)),
+                    mode: "floor".into(),
+                    recording: false,
+                    steps,
+                    steps_per_s: f.steps_per_s,
+                    step_ns: f.inner.step_ns,
+                    bytes_per_step: None,
+                    write_bytes_per_s: None,
                 });
             }
+            if recording.contains(&true) {
+                out.push(BenchRun {
+                    mode: "disk".into(),
+                    recording: false,
+                    steps: 0,
+                    steps_per_s: 0.0,
+                    step_ns: Percentiles::default(),
+                    bytes_per_step: None,
+                    write_bytes_per_s: Some(disk::write_rate(&tmp)?),
+                });
+            }
+            for &mode in modes {
+                for &record in recording {
+                    let start = std::time::Instant::now();
+                    let o = measure(&s, &p, &tmp, mode, wait, record, pin)?;
+                    if let Some(rrd) = &o.rrd {
+                        disk::sync(rrd)?;
+                    }
+                    let whole = start.elapsed().as_secs_f64();
+                    let bytes = o
+                        .rrd
+                        .as_ref()
+                        .and_then(|r| std::fs::metadata(r).ok())
+                        .map(|m| m.len() as f64);
+                    out.push(BenchRun {
+                        mode: mode.name().into(),
+                        recording: record,
+                        steps: o.summary.steps,
+                        steps_per_s: o.summary.steps_per_s,
+                        step_ns: o.summary.latency_ns.step,
+                        bytes_per_step: bytes.map(|b| b / o.summary.steps.max(1) as f64),
+                        write_bytes_per_s: bytes.map(|b| b / whole.max(1e-9)),
+                    });
+                }
+            }
+            if with_bank {
+                let record = recording.contains(&true);
+                banks.push(bank::runs(steps, wait, pin, modes, record, &tmp)?);
+            }
         }
-    }
+        Ok(())
+    })();
     let _ = std::fs::remove_dir_all(&tmp);
-    Ok(out)
+    result.map(|()| Bench { runs: out, banks })
 }
 
-/// One benchmark run of `s` (outputs overwritten in `tmp`, no progress bar, no pacing); a run
-/// that stops early is an error.
-pub(crate) fn measure(
-    s: &Scenario,
-    p: &crate::plan::Plan,
-    tmp: &Path,
-    mode: Mode,
-    wait: Wait,
-    record: bool,
-    pin: bool,
-) -> Result<crate::run::Outcome, LaunchError> {
-    let opts = Options {
-        pin,
-        ..Options::quiet(tmp, mode, wait, record)
-    };
-    let o = run(s, p, &opts)?;
-    if o.stop != Stop::Completed {
-        return Err(LaunchError::Component(format!(
-            "{}: benchmark run stopped: {:?}",
-            s.name, o.stop
-        )));
-    }
-    Ok(o)
-}
-
-/// The printed table.
-pub fn table(runs: &[BenchRun], wait: Wait) -> String {
+/// The printed table: seed 002's runs, the bank's, and every ratio as a sentence.
+pub fn table(bench: &Bench, wait: Wait) -> String {
+    let runs = &bench.runs;
     let mut t = format!(
         "seed002 closed loop (plant, 2 observers, controller), wait = {wait}; floor: bare 3-process ring, same transport and payloads\n"
     );
@@ -192,7 +193,8 @@ pub fn table(runs: &[BenchRun], wait: Wait) -> String {
             opt(r.bytes_per_step, 1.0)
         );
     }
-    for (name, v) in ratios(runs) {
+    t += &bank::table(&bench.banks);
+    for (name, v) in ratios(bench) {
         t += &sentence(&name, v);
     }
     t
@@ -266,6 +268,11 @@ fn sentence(name: &str, (min, median, max, n): (f64, f64, f64, usize)) -> String
                 pct(median)
             )
         }
+        "bank member: processes / in-process, cost per step" => {
+            format!(
+                "a bank member's step costs {median:.2}× across processes what it costs in one process {times}\n"
+            )
+        }
         "in-process (recording): GB per 10^7 steps"
         | "processes (recording): GB per 10^7 steps" => {
             format!(
@@ -277,8 +284,9 @@ fn sentence(name: &str, (min, median, max, n): (f64, f64, f64, usize)) -> String
 }
 
 /// Ratios per repetition (a repetition starts at each floor run — without one at each disk run —
-/// or is the whole list), as (name, (min, median, max, count)).
-pub fn ratios(runs: &[BenchRun]) -> Vec<(String, (f64, f64, f64, usize))> {
+/// or is the whole list), and the bank's, as (name, (min, median, max, count)).
+pub fn ratios(bench: &Bench) -> Vec<(String, (f64, f64, f64, usize))> {
+    let runs = &bench.runs[..];
     let mut reps: Vec<&[BenchRun]> = Vec::new();
     // A repetition opens with its floor run, or (one mode in one process) its disk run.
     let opening = |mode: &str| -> Vec<usize> {
@@ -353,6 +361,7 @@ pub fn ratios(runs: &[BenchRun]) -> Vec<(String, (f64, f64, f64, usize))> {
             }
         }
     }
+    named.extend(bank::ratios(&bench.banks));
     named
         .into_iter()
         .map(|(n, mut v)| {
@@ -390,7 +399,10 @@ mod sentence_tests {
             run("in-process", false, 10.0, None),
             run("in-process", true, 5.0, Some(400.0)),
         ];
-        let r = ratios(&runs);
+        let r = ratios(&super::Bench {
+            runs: runs.to_vec(),
+            banks: Vec::new(),
+        });
         let get = |name: &str| r.iter().find(|(n, _)| n == name).unwrap().1;
         assert_eq!(
             get("in-process (recording): write rate / disk's"),

@@ -162,7 +162,7 @@ pub fn states(
         let design_s = t.elapsed().as_secs_f64();
         for &mode in modes {
             for &record in recording {
-                let o = super::measure(&s, &p, &tmp, mode, wait, record, pin)?;
+                let o = super::measure::measure(&s, &p, &tmp, mode, wait, record, pin)?;
                 let bytes = o
                     .rrd
                     .as_ref()

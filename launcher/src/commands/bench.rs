@@ -36,7 +36,7 @@ pub fn command(a: BenchArgs) -> Result<ExitCode, LaunchError> {
         }
         return Ok(ExitCode::SUCCESS);
     }
-    let runs = launcher::bench::bench(
+    let bench = launcher::bench::bench(
         &shipped::dir().join("seed002-sine.toml"),
         a.steps,
         wait,
@@ -44,9 +44,10 @@ pub fn command(a: BenchArgs) -> Result<ExitCode, LaunchError> {
         &modes,
         &rec,
         a.repeat,
+        a.bank == OnOff::On,
     )?;
     if a.json {
-        let ratios: serde_json::Map<_, _> = launcher::bench::ratios(&runs)
+        let ratios: serde_json::Map<_, _> = launcher::bench::ratios(&bench)
             .into_iter()
             .map(|(n, v)| {
                 let figures = serde_json::json!({
@@ -55,13 +56,14 @@ pub fn command(a: BenchArgs) -> Result<ExitCode, LaunchError> {
                 (n, figures)
             })
             .collect();
-        let json = serde_json::json!({ "runs": runs, "ratios": ratios });
+        let json =
+            serde_json::json!({ "runs": bench.runs, "banks": bench.banks, "ratios": ratios });
         println!(
             "{}",
             serde_json::to_string_pretty(&json).expect("serialises")
         );
     } else {
-        print!("{}", launcher::bench::table(&runs, wait));
+        print!("{}", launcher::bench::table(&bench, wait));
     }
     Ok(ExitCode::SUCCESS)
 }
