@@ -2,7 +2,9 @@
 //! the errors of all observers on a log10 axis (the only view where a UIO's 1e−15 error and a
 //! Luenberger observer's 1e−1 have readable numbers side by side), each observer's errors and
 //! residuals on their own axes, then the signals driving the plant, and latency. It opens on
-//! the `sim_time` timeline, paused, so every plot shows the whole run at once. Plots sit two
+//! the `sim_time` timeline, paused, and every plot shows the whole run at once (its time axis
+//! set so by [`super::whole_run`]: the viewer's own default for a run over 60 s is 60 s of it),
+//! ticked in the viewer's duration format (+12h, +1d 12h for a two-day run). Plots sit two
 //! to a row, and the time panel is open while the blueprint panel is closed: the viewer labels
 //! a duration axis only where a plot is wide enough (≈ 60 px a label), and four plots to a row
 //! left it a lone "+0s".

@@ -12,6 +12,7 @@ mod rrd;
 mod select;
 pub mod tail;
 mod what;
+mod whole_run;
 
 pub use crate::nan::nan_max;
 pub use blueprint::blueprint;

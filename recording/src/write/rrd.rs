@@ -292,15 +292,14 @@ impl RrdSink {
                 }),
             );
         }
-        make(&layout)
-            .send(
-                &self.rec,
-                BlueprintActivation {
-                    make_active: true,
-                    make_default: true,
-                },
-            )
-            .map_err(|e| e.to_string())
+        super::whole_run::send(
+            &make(&layout),
+            &self.rec,
+            BlueprintActivation {
+                make_active: true,
+                make_default: true,
+            },
+        )
     }
 
     /// Logs entity `e`'s statics: the signal behind each element, and its line.
