@@ -361,11 +361,12 @@ pub struct PlotArgs {
     /// segment, `**` across segments); repeat for several.
     #[arg(long = "signals", value_name = "GLOB")]
     pub signals: Vec<String>,
-    /// Start of the time window, s (steps for a recording without its scenario).
-    #[arg(long, value_name = "T", allow_negative_numbers = true)]
+    /// Start of the time window: s, or with a unit ("24 h"; steps for a recording without its
+    /// scenario).
+    #[arg(long, value_name = "T", allow_negative_numbers = true, value_parser = time_arg)]
     pub from: Option<f64>,
-    /// End of the time window, s.
-    #[arg(long, value_name = "T", allow_negative_numbers = true)]
+    /// End of the time window: s, or with a unit ("36 h").
+    #[arg(long, value_name = "T", allow_negative_numbers = true, value_parser = time_arg)]
     pub to: Option<f64>,
     /// A run at an operating point in deviations from it (x − x_op, u − u_op, …) instead of
     /// the plant's own units.
@@ -437,4 +438,9 @@ pub struct ComponentArgs {
     /// The component's own arguments.
     #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
     pub args: Vec<String>,
+}
+
+/// A time on the command line: seconds, or with its unit ("24 h", [`lti::units::seconds`]).
+fn time_arg(text: &str) -> Result<f64, String> {
+    lti::units::seconds(text)
 }

@@ -93,6 +93,10 @@ pub struct Summary {
     pub steps: u64,
     /// Steps the scenario asks for.
     pub steps_planned: u64,
+    /// The scenario's `tail`, s (null: the default, the last quarter of the steps completed).
+    pub tail_s: Option<f64>,
+    /// The first step of the tail the figures were taken over (null: fewer than 4 steps).
+    pub tail_from_step: Option<u64>,
     /// Wall-clock time of the run, s.
     pub wall_s: f64,
     /// steps / wall_s.
@@ -202,6 +206,8 @@ impl Summary {
             duration: s.duration,
             steps: m.steps,
             steps_planned: s.steps,
+            tail_s: s.tail,
+            tail_from_step: m.tail_start(),
             wall_s,
             steps_per_s: m.steps as f64 / wall_s.max(1e-9),
             observers,
@@ -373,10 +379,14 @@ impl Summary {
             self.wall_s,
             sig(self.steps_per_s.round())
         );
-        let tail = if self.steps < self.steps_planned {
-            "tail of the steps completed"
-        } else {
-            "tail: last quarter"
+        let tail = match (self.steps < self.steps_planned, self.tail_s) {
+            (true, None) => "tail: last quarter of the steps completed".to_string(),
+            (true, Some(t)) => format!(
+                "tail: last {} of the steps completed",
+                lti::units::readable(t)
+            ),
+            (false, None) => "tail: last quarter".to_string(),
+            (false, Some(t)) => format!("tail: last {}", lti::units::readable(t)),
         };
         t += &format!(
             "  {:<14} {:<16} {:>14} {:>14}   ({tail})\n",

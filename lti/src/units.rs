@@ -6,6 +6,40 @@
 //! The serde helpers in [`de`] accept either form for a field; the value kept is always the
 //! number in seconds (Hz), so everything downstream — and the configurations the components
 //! receive — is unchanged.
+//!
+//! A scenario-wide `time_unit = "h"` makes a bare number of a simulated time mean hours
+//! ([`with_bare_unit`]): `dt = 1` is an hour's step. Frequencies named in Hz (`frequency_hz`)
+//! and wall-clock limits ([`de::wall_seconds_opt`]) keep their own unit.
+
+use std::cell::Cell;
+
+thread_local! {
+    /// Seconds per bare number of a simulated time while a scenario is read (1: seconds).
+    static BARE: Cell<f64> = const { Cell::new(1.0) };
+}
+
+/// Runs `f` with a bare number of a simulated time meaning `unit` ("h", "min", …; [`seconds`]'s
+/// units), on this thread; `None` keeps seconds. An unknown unit is the error, naming the units.
+pub fn with_bare_unit<T>(unit_name: Option<&str>, f: impl FnOnce() -> T) -> Result<T, String> {
+    let per = match unit_name {
+        None => 1.0,
+        Some(u) => unit(u.trim())
+            .ok_or_else(|| format!("'{u}' is not a time unit (give one of {UNITS}, e.g. \"h\")"))?,
+    };
+    struct Reset(f64);
+    impl Drop for Reset {
+        fn drop(&mut self) {
+            BARE.with(|b| b.set(self.0));
+        }
+    }
+    let _reset = Reset(BARE.with(|b| b.replace(per)));
+    Ok(f())
+}
+
+/// Seconds per bare number of a simulated time, as [`with_bare_unit`] set it.
+fn bare() -> f64 {
+    BARE.with(Cell::get)
+}
 
 /// Seconds per unit, for the units a time may carry.
 fn unit(u: &str) -> Option<f64> {
@@ -33,14 +67,15 @@ pub fn number(s: &str, whole: &str) -> Result<f64, String> {
     Ok(v)
 }
 
-/// A time in seconds from `"<number> <unit>"` (a bare number is seconds).
+/// A time in seconds from `"<number> <unit>"` (a bare number is seconds, or the unit
+/// [`with_bare_unit`] set).
 pub fn seconds(text: &str) -> Result<f64, String> {
     let t = text.trim();
     let split = t
         .find(|c: char| c.is_ascii_alphabetic() && c != 'e' && c != 'E')
         .or_else(|| t.rfind(' '));
     let Some(at) = split else {
-        return number(t, text);
+        return Ok(number(t, text)? * bare());
     };
     let (n, u) = t.split_at(at);
     let per = unit(u.trim()).ok_or_else(|| {
@@ -50,6 +85,26 @@ pub fn seconds(text: &str) -> Result<f64, String> {
         )
     })?;
     Ok(number(n, text)? * per)
+}
+
+/// A time as a reader says it: in s up to 3 min, min up to 3 h, h up to 3 days, then days
+/// (`"12 h"`, `"90 s"`, `"3.5 days"`), to 4 significant digits.
+pub fn readable(seconds: f64) -> String {
+    let (unit, per) = match seconds.abs() {
+        t if t >= 3.0 * 86_400.0 => ("days", 86_400.0),
+        t if t >= 3.0 * 3_600.0 => ("h", 3_600.0),
+        t if t >= 180.0 => ("min", 60.0),
+        _ => ("s", 1.0),
+    };
+    let v = seconds / per;
+    let digits = (3 - v.abs().log10().floor() as i32).max(0) as usize;
+    let text = format!("{v:.digits$}");
+    let text = if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        text
+    };
+    format!("{text} {unit}")
 }
 
 /// A frequency in Hz from `"<number> Hz"`, `"<number>/<unit>"` or `"1/<unit>"` (a bare number is Hz).
@@ -93,9 +148,23 @@ pub mod de {
         }
     }
 
-    /// A time: seconds, or `"48 h"`.
+    /// A simulated time: seconds (or the scenario's `time_unit`), or `"48 h"`.
     pub fn seconds<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
-        value(d, super::seconds)
+        match Written::deserialize(d)? {
+            Written::Number(v) => Ok(v * super::bare()),
+            Written::Text(t) => super::seconds(&t).map_err(D::Error::custom),
+        }
+    }
+
+    /// An optional wall-clock time: seconds whatever the scenario's `time_unit`, or `"2 min"`.
+    pub fn wall_seconds_opt<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+        #[derive(Deserialize)]
+        struct Wrap(#[serde(deserialize_with = "wall")] f64);
+        fn wall<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+            let seconds = |t: &str| super::with_bare_unit(None, || super::seconds(t))?;
+            value(d, seconds)
+        }
+        Ok(Option::<Wrap>::deserialize(d)?.map(|w| w.0))
     }
 
     /// An optional time.
@@ -115,6 +184,15 @@ pub mod de {
             .collect())
     }
 
+    /// Optional lists of times (`[[on, off], …]`).
+    pub fn seconds_pairs_opt<'de, D: Deserializer<'de>>(
+        d: D,
+    ) -> Result<Option<Vec<Vec<f64>>>, D::Error> {
+        #[derive(Deserialize)]
+        struct Wrap(#[serde(deserialize_with = "seconds_vec")] Vec<f64>);
+        Ok(Option::<Vec<Wrap>>::deserialize(d)?.map(|v| v.into_iter().map(|w| w.0).collect()))
+    }
+
     /// A frequency: Hz, or `"1/day"`, `"0.5 Hz"`.
     pub fn hertz<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
         value(d, super::hertz)
@@ -124,6 +202,47 @@ pub mod de {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A readable time reads back as the time it says, in the unit the run's length picks.
+    #[test]
+    fn a_readable_time_reads_back_as_itself() {
+        for (t, want) in [
+            (43_200.0, "12 h"),
+            (90.0, "90 s"),
+            (216_000.0, "60 h"),
+            (302_400.0, "3.5 days"),
+            (0.25, "0.25 s"),
+            (600.0, "10 min"),
+            (172_800.0, "48 h"),
+        ] {
+            let text = readable(t);
+            assert_eq!(text, want);
+            assert!((seconds(&text).unwrap() - t).abs() <= 1e-9 * t, "{text}");
+        }
+    }
+
+    /// Under a time unit a bare time is in it, a written unit stays itself, a frequency in Hz
+    /// stays Hz, and the unit ends with the reading (also when it fails).
+    #[test]
+    fn a_bare_time_is_in_the_time_unit_while_it_is_set() {
+        let read = with_bare_unit(Some("h"), || {
+            (
+                seconds("2").unwrap(),
+                seconds("30 min").unwrap(),
+                hertz("1").unwrap(),
+            )
+        })
+        .unwrap();
+        assert_eq!(read, (7200.0, 1800.0, 1.0));
+        assert_eq!(seconds("2").unwrap(), 2.0);
+        assert!(
+            with_bare_unit(Some("fortnight"), || ())
+                .unwrap_err()
+                .contains("fortnight")
+        );
+        let _ = std::panic::catch_unwind(|| with_bare_unit(Some("min"), || panic!("inside")));
+        assert_eq!(seconds("2").unwrap(), 2.0);
+    }
 
     #[test]
     fn times_and_frequencies_read_as_written() {

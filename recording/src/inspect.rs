@@ -122,10 +122,13 @@ pub fn inspect(file: &str, r: &Recording) -> Inspection {
             }
         })
         .collect();
-    // The tail as the run defined it: the last quarter of the steps it completed.
-    let tail_start =
-        crate::write::tail::tail_start(steps_completed, steps_planned.unwrap_or(steps_completed))
-            .map(|s| s as i64);
+    // The tail as the run defined it: its `tail`, else the last quarter of the steps it completed.
+    let tail_start = crate::write::tail::tail_start(
+        steps_completed,
+        steps_planned.unwrap_or(steps_completed),
+        scenario.as_ref().and_then(|s| s.tail_steps()),
+    )
+    .map(|s| s as i64);
     let tail_max = |prefix: &str| -> Option<f64> {
         let start = tail_start?;
         Some(

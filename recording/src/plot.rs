@@ -437,7 +437,11 @@ pub fn figures(r: &Recording, selection: &PlotSelection) -> Result<Vec<(String, 
     // Time in the run's own scale: a two-day run reads in hours, not in 10⁵ s.
     let (x_label, axis) = match s {
         Some(s) => {
-            let (unit, per) = time_unit(s.duration);
+            let (unit, per) = match s.time_unit.as_deref() {
+                // The scenario's own unit, validated when it was read.
+                Some(u) => (u, lti::units::seconds(&format!("1 {u}")).unwrap_or(1.0)),
+                None => time_unit(s.duration),
+            };
             (format!("t [{unit}]"), Some((s.dt, per)))
         }
         None => ("step".to_string(), None),

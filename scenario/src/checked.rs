@@ -78,6 +78,11 @@ pub struct Scenario {
     /// How long a component that is running or runnable may publish nothing before the run is
     /// stopped, s (`stall_timeout`, default [`limits::STALL_TIMEOUT`]; `--stall-timeout`).
     pub stall_timeout: f64,
+    /// `tail`: the length of the stretch at the run's end over which the tail figures are taken,
+    /// s (`None`: the last quarter of the steps; [`Scenario::tail_steps`]).
+    pub tail: Option<f64>,
+    /// `time_unit`: what a bare time meant in the file ("h"), and the unit its plots use.
+    pub time_unit: Option<String>,
     /// Banks of residual generators.
     pub diagnosers: Vec<diagnosis::DiagnoserSpec>,
 }

@@ -36,6 +36,19 @@ pub use raw::RawExpect;
 pub use replay_plant::{REPLAY_PLANT_PROGRAM, replay_has_states};
 pub use untrusted::{MAX_SCENARIO_BYTES, quoted};
 impl Scenario {
+    /// The tail's length in steps, where `tail` is set: round(tail / duration · steps), at least
+    /// one (so a run whose dt a sweep changed keeps the tail's seconds). `None`: the default,
+    /// the last quarter of the steps completed.
+    pub fn tail_steps(&self) -> Option<u64> {
+        let t = self.tail?;
+        let share = if self.duration > 0.0 {
+            t / self.duration
+        } else {
+            1.0
+        };
+        Some(((share * self.steps as f64).round() as u64).clamp(1, self.steps.max(1)))
+    }
+
     /// The observer processes of a run across processes: each the indices of the observers it
     /// steps ([`observer_processes`]).
     pub fn observer_processes(&self) -> Vec<ObserverProcess> {

@@ -74,8 +74,15 @@ pub struct RawScenario {
     pub isolated_fraction: Option<f64>,
     /// How long a component that is running (or waiting for a core) may publish nothing before
     /// the run is stopped, s (default 60; `--stall-timeout` overrides it).
-    #[serde(default, deserialize_with = "lti::units::de::seconds_opt")]
+    #[serde(default, deserialize_with = "lti::units::de::wall_seconds_opt")]
     pub stall_timeout: Option<f64>,
+    /// The unit of a bare number of a simulated time ("h": `dt = 1` is an hour; read before
+    /// the rest, [`lti::units::with_bare_unit`]); also the plots' time unit.
+    pub time_unit: Option<String>,
+    /// The stretch at the run's end its tail figures are taken over: seconds, or "12 h"
+    /// (default: the last quarter of the steps).
+    #[serde(default, deserialize_with = "lti::units::de::seconds_opt")]
+    pub tail: Option<f64>,
     /// Host name → its agent's Zenoh endpoint.
     pub hosts: Option<BTreeMap<String, String>>,
 }
@@ -109,6 +116,8 @@ pub struct RawFault {
     pub start: Option<f64>,
     #[serde(default, deserialize_with = "lti::units::de::seconds_opt")]
     pub end: Option<f64>,
+    /// `[[on, off], …]`: seconds, or times with their units (`[["6 h", "7 h"]]`).
+    #[serde(default, deserialize_with = "lti::units::de::seconds_pairs_opt")]
     pub intervals: Option<Vec<Vec<f64>>>,
 }
 

@@ -162,7 +162,13 @@ fn metrics_for(
     layout: PlantLayout,
     estimates: &[Option<&InputEstimator>],
 ) -> Metrics {
-    let mut metrics = Metrics::new(layout, s.model.c.clone(), s.observers.len(), s.steps);
+    let mut metrics = Metrics::new(
+        layout,
+        s.model.c.clone(),
+        s.observers.len(),
+        s.steps,
+        s.tail_steps(),
+    );
     if let Some(op) = &s.operating_point {
         metrics.residual_offset(op.output_offset(&s.model.c));
     }

@@ -49,8 +49,10 @@ pub struct Metrics {
     layout: PlantLayout,
     c: Mat,
     planned: u64,
-    /// First step of the tail of a run that completes: [K − ⌊K/4⌋, K).
+    /// First step of the tail of a run that completes: [K − ⌊K/4⌋, K), or [K − L, K).
     planned_tail: u64,
+    /// The tail's length L where the scenario sets it.
+    tail: Option<u64>,
     /// Per observer, max |e| and max |r| from `planned_tail` on: exact for a completed run.
     exact: Vec<[f64; 2]>,
     /// Per observer, block maxima of max_i |e_i| and max_j |r_j| (the tail of an early stop).
@@ -75,8 +77,15 @@ pub struct Metrics {
 }
 
 impl Metrics {
-    /// For a run of `steps` steps with `observers` observers.
-    pub fn new(layout: PlantLayout, c: Mat, observers: usize, steps: u64) -> Self {
+    /// For a run of `steps` steps with `observers` observers, whose tail is its last `tail`
+    /// steps (`None`: its last quarter; [`super::tail`]).
+    pub fn new(
+        layout: PlantLayout,
+        c: Mat,
+        observers: usize,
+        steps: u64,
+        tail: Option<u64>,
+    ) -> Self {
         let mut differences = Vec::new();
         for a in 0..observers {
             for b in a + 1..observers {
@@ -87,7 +96,8 @@ impl Metrics {
             layout,
             c,
             planned: steps,
-            planned_tail: steps - steps / 4,
+            planned_tail: tail_start(steps, steps, tail).unwrap_or(steps),
+            tail,
             exact: vec![[0.0; 2]; observers],
             blocks: (0..observers)
                 .map(|_| [BlockMax::new(steps), BlockMax::new(steps)])
@@ -142,7 +152,7 @@ impl Metrics {
 
     /// The first step of the tail of the steps completed so far.
     pub fn tail_start(&self) -> Option<u64> {
-        tail_start(self.steps, self.planned)
+        tail_start(self.steps, self.planned, self.tail)
     }
 
     /// Sets each observer's tail figures from the steps completed; call once the run has ended.
@@ -291,15 +301,15 @@ mod tests {
         row.plant[layout.x()][0] = 1.0;
         row.plant[layout.y()][0] = 2.5;
         row.xhat[0][0] = 1.0;
-        let mut without = Metrics::new(layout, c.clone(), 1, 4);
+        let mut without = Metrics::new(layout, c.clone(), 1, 4, None);
         without.push(&row);
         assert_eq!(without.residual[0], [0.5]);
-        let mut with = Metrics::new(layout, c.clone(), 1, 4);
+        let mut with = Metrics::new(layout, c.clone(), 1, 4, None);
         with.residual_offset(op.output_offset(&c));
         with.push(&row);
         assert_eq!(with.residual[0], [0.0]);
         // A linear output map leaves y − C x̂ untouched (c_r = 0 is not applied).
-        let mut linear = Metrics::new(layout, c, 1, 4);
+        let mut linear = Metrics::new(layout, c, 1, 4, None);
         linear.residual_offset(vec![0.0]);
         assert!(linear.c_r.is_none());
     }

@@ -1,5 +1,6 @@
-//! The tail of a run: its last quarter of steps, where transients have died out and the figures
-//! of merit (tail max|e|, tail max|r|) are taken.
+//! The tail of a run: its last quarter of steps, or the stretch at its end its scenario's
+//! `tail` sets (L steps in place of ⌊K/4⌋ below), where transients have died out and the
+//! figures of merit (tail max|e|, tail max|r|) are taken.
 //!
 //! A run that completed all its K planned steps has the tail [K − ⌊K/4⌋, K), exactly (its
 //! maxima are kept from that step on as it runs). A run that stopped early after K' steps has
@@ -19,14 +20,15 @@ pub fn block_len(planned: u64) -> u64 {
     planned.div_ceil(MAX_BLOCKS).next_power_of_two().max(1)
 }
 
-/// The first step of the tail of a run that completed `completed` of `planned` steps, or `None`
-/// when it completed fewer than 4.
-pub fn tail_start(completed: u64, planned: u64) -> Option<u64> {
-    let quarter = completed / 4;
-    if quarter == 0 {
+/// The first step of the tail of a run that completed `completed` of `planned` steps: its last
+/// `len` steps (all of them if fewer), or without `len` its last quarter; `None` when that is
+/// no step (a quarter of fewer than 4).
+pub fn tail_start(completed: u64, planned: u64, len: Option<u64>) -> Option<u64> {
+    let len = len.map_or(completed / 4, |l| l.min(completed));
+    if len == 0 {
         return None;
     }
-    let start = completed - quarter;
+    let start = completed - len;
     if completed >= planned {
         Some(start)
     } else {
@@ -75,19 +77,29 @@ mod tests {
 
     #[test]
     fn completed_run_has_exact_last_quarter() {
-        assert_eq!(tail_start(20_000, 20_000), Some(15_000));
-        assert_eq!(tail_start(7, 7), Some(6));
-        assert_eq!(tail_start(3, 10), None);
+        assert_eq!(tail_start(20_000, 20_000, None), Some(15_000));
+        assert_eq!(tail_start(7, 7, None), Some(6));
+        assert_eq!(tail_start(3, 10, None), None);
+    }
+
+    /// A set tail is the last L steps of those completed, all of them if fewer, and exact for a
+    /// completed run.
+    #[test]
+    fn a_set_tail_takes_its_last_steps() {
+        assert_eq!(tail_start(20_000, 20_000, Some(720)), Some(19_280));
+        assert_eq!(tail_start(3, 10, Some(720)), Some(0));
+        assert_eq!(tail_start(2_880, 2_880, Some(2_880)), Some(0));
+        assert_eq!(tail_start(100, 100, Some(0)), None);
     }
 
     #[test]
     fn early_stop_takes_last_quarter_of_completed_steps() {
-        assert_eq!(tail_start(1_000, 20_000), Some(750));
+        assert_eq!(tail_start(1_000, 20_000, None), Some(750));
         // Beyond MAX_BLOCKS planned steps the start is rounded down to a block.
         let planned = 10 * MAX_BLOCKS;
         let b = block_len(planned);
         assert_eq!(b, 16);
-        assert_eq!(tail_start(1_003, planned), Some(753 - 753 % 16));
+        assert_eq!(tail_start(1_003, planned, None), Some(753 - 753 % 16));
     }
 
     #[test]

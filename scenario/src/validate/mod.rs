@@ -35,7 +35,34 @@ pub(super) fn parse(path: &Path, text: &str, files: bool) -> Result<Scenario, Sc
         field: String::new(),
         reason: format!("malformed TOML: {}", first_line(e.message())),
     })?;
-    let raw: RawScenario = serde_path_to_error::deserialize(de).map_err(|e| {
+    // `time_unit` first: it is what every bare time of the rest means.
+    #[derive(serde::Deserialize)]
+    struct TimeUnit {
+        time_unit: Option<toml::Value>,
+    }
+    let unit = match toml::from_str::<TimeUnit>(text)
+        .ok()
+        .and_then(|u| u.time_unit)
+    {
+        None => None,
+        Some(toml::Value::String(u)) => Some(u),
+        Some(v) => {
+            return Err(error(Bad {
+                field: "time_unit".into(),
+                reason: format!("{v} is not a time unit (a string: \"h\", \"min\", \"days\")"),
+            }));
+        }
+    };
+    let read = lti::units::with_bare_unit(unit.as_deref(), || {
+        serde_path_to_error::deserialize::<_, RawScenario>(de)
+    })
+    .map_err(|reason| {
+        error(Bad {
+            field: "time_unit".into(),
+            reason,
+        })
+    })?;
+    let raw: RawScenario = read.map_err(|e| {
         let field = one_based(&e.path().to_string());
         let field = if field == "." { String::new() } else { field };
         let mut reason = first_line(e.inner().message()).to_string();
@@ -112,6 +139,7 @@ fn build(raw: RawScenario, dir: Option<&Path>) -> Result<Scenario, Bad> {
     let truth = true_plant::true_plant(&raw, &plant, dt, steps, dir)?;
     let (mut observers, seen) = observers::observers(&raw, &plant.model, truth.noise.as_ref())?;
     let (isolated_fraction, stall_timeout) = run::settings(&raw)?;
+    let tail = run::tail(&raw, dt, duration)?;
     let mut taken = seen.clone();
     let diagnosers = crate::fault_diagnosis::diagnosers(
         &raw.diagnoser,
@@ -161,6 +189,8 @@ fn build(raw: RawScenario, dir: Option<&Path>) -> Result<Scenario, Bad> {
         seed: raw.seed.unwrap_or(0),
         isolated_fraction,
         stall_timeout,
+        tail,
+        time_unit: raw.time_unit,
         noise: truth.noise,
         ff: plant.ff,
         faults: truth.faults,

@@ -38,6 +38,20 @@ pub(super) fn timing(raw: &RawScenario) -> Result<(f64, f64, u64), Bad> {
     Ok((dt, duration, steps))
 }
 
+/// `tail`: a stretch of the run, at least one step of dt and at most the whole run.
+pub(super) fn tail(raw: &RawScenario, dt: f64, duration: f64) -> Result<Option<f64>, Bad> {
+    match raw.tail {
+        None => Ok(None),
+        Some(t) if t.is_finite() && t <= duration && (t / dt).round() >= 1.0 => Ok(Some(t)),
+        Some(t) => Err(bad(
+            "tail",
+            format!(
+                "{t} s must be at least one step (dt = {dt} s) and at most the run's duration ({duration} s)"
+            ),
+        )),
+    }
+}
+
 /// `isolated_fraction` (default 0.9) and `stall_timeout`.
 pub(super) fn settings(raw: &RawScenario) -> Result<(f64, f64), Bad> {
     let isolated_fraction = match raw.isolated_fraction {

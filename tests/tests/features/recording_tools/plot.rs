@@ -557,8 +557,29 @@ fn the_followers_batch_delay_is_plotted_apart_from_the_lockstep_hops() {
     );
 }
 
-/// A two-day run at dt = 60 s reads in hours, not in 10⁵ seconds; `--from`/`--to` stay in
-/// seconds.
+/// A scenario written with `time_unit = "min"` is plotted in minutes, whatever its length.
+#[test]
+fn a_run_in_its_own_time_unit_is_plotted_in_it() {
+    let s = Scratch::new("plot-minutes");
+    let path = s.join("slow.toml");
+    std::fs::write(
+        &path,
+        "name = \"slow\"\ntime_unit = \"min\"\ndt = 1\nduration = 2880\n\n[plant]\nA = [[-0.0002]]\nB = [[0.0001]]\nC = [[1.0]]\nx0 = [1.0]\n\n[[input]]\nkind = \"constant\"\nvalue = 0.0\n\n[[observer]]\nname = \"luenberger\"\nkind = \"luenberger\"\npoles = [-0.001]\n",
+    )
+    .unwrap();
+    let out = run(&s, &path, &["--mode", "in-process"]);
+    assert!(out.status.success(), "{:?}", text(&out));
+    let r = recording::read::read(&s.join("out/slow.rrd")).unwrap();
+    let figs = figures(&r, &PlotSelection::default()).unwrap();
+    let (_, state) = figs.iter().find(|(f, _)| f.starts_with("state_1")).unwrap();
+    assert_eq!(state.x_label, "t [min]");
+    // Step 2879 of a minute each.
+    let last = state.curves[0].points.last().unwrap().0;
+    assert!((last - 2879.0).abs() < 1e-9, "{last}");
+}
+
+/// A two-day run at dt = 60 s reads in hours, not in 10⁵ seconds; `--from`/`--to` take seconds
+/// (or a time with its unit, `python/tests/test_time_units.py`).
 #[test]
 fn a_two_day_run_is_plotted_in_hours() {
     let s = Scratch::new("plot-hours");
