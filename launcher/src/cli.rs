@@ -440,7 +440,10 @@ pub struct ComponentArgs {
     pub args: Vec<String>,
 }
 
-/// A time on the command line: seconds, or with its unit ("24 h", [`lti::units::seconds`]).
+/// A time on the command line: seconds, or with its unit ("24 h", [`lti::units::seconds`]). A
+/// bare number is taken as written, NaN too: the window's own check names what is wrong with it.
 fn time_arg(text: &str) -> Result<f64, String> {
-    lti::units::seconds(text)
+    text.trim()
+        .parse::<f64>()
+        .or_else(|_| lti::units::seconds(text))
 }

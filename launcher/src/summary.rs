@@ -370,12 +370,13 @@ impl Summary {
         let mut t = String::new();
         let us = |ns: u64| format!("{:.1} µs", ns as f64 / 1000.0);
         t += &format!(
-            "{} ({}, {} of {} steps of {} s, {:.2} s wall, {} steps/s)\n",
+            "{} ({}, {} of {} steps of {} s = {}, {:.2} s wall, {} steps/s)\n",
             self.scenario,
             self.mode,
             self.steps,
             self.steps_planned,
             self.dt,
+            lti::units::readable(self.steps as f64 * self.dt),
             self.wall_s,
             sig(self.steps_per_s.round())
         );

@@ -154,11 +154,13 @@ pub fn inspect(file: &str, r: &Recording) -> Inspection {
             name: n,
         })
         .collect();
+    // Back to the ns they were timed in (µs recorded: ns / 1000, exact to round again).
+    let per = r.latency_ns_per_value();
     let percentiles = |path: &str| {
         let mut h = histogram();
         if let Some(s) = r.series.get(path) {
             for &v in &s.values {
-                h.saturating_record((v as u64).max(1));
+                h.saturating_record(((v * per).round() as u64).max(1));
             }
         }
         Latency::percentiles(&h)

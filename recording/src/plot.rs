@@ -493,13 +493,14 @@ pub fn figures(r: &Recording, selection: &PlotSelection) -> Result<Vec<(String, 
                 },
             };
             let latency = path.starts_with("/latency/");
+            let us_per_value = r.latency_ns_per_value() * 1e-3;
             // J spans decades (rounding before a fault, its size after): on a log axis, 0 at the floor.
             let threshold = path.starts_with("/diagnosis/") && path.contains("/threshold/");
             let evaluation =
                 threshold || (path.starts_with("/diagnosis/") && path.contains("/evaluation/"));
             let y = |v: f64| {
                 if latency {
-                    (v * 1e-3).max(LATENCY_FLOOR_US).log10()
+                    (v * us_per_value).max(LATENCY_FLOOR_US).log10()
                 } else if evaluation {
                     signals::log10_floored(v)
                 } else {

@@ -55,6 +55,28 @@ pub struct Recording {
     /// How many steps the run completed, as its writer stored it when it closed the file (none
     /// for a killed writer's file).
     pub steps_completed: Option<u64>,
+    /// The `latency_unit` property: "µs" ([`crate::write::LATENCY_UNIT`]); none in recordings
+    /// written before it, whose latencies are ns.
+    pub latency_unit: Option<String>,
+}
+
+impl Recording {
+    /// Nanoseconds per recorded `/latency/…` value: 1000 for µs, 1 for the ns of older files.
+    pub fn latency_ns_per_value(&self) -> f64 {
+        match self.latency_unit.as_deref() {
+            Some("µs") => 1000.0,
+            _ => 1.0,
+        }
+    }
+
+    /// The unit of the recorded `/latency/…` values, as a label writes it.
+    pub fn latency_label_unit(&self) -> &str {
+        if self.latency_ns_per_value() == 1000.0 {
+            "µs"
+        } else {
+            "ns"
+        }
+    }
 }
 
 /// Why a file could not be read at all.
@@ -128,6 +150,8 @@ pub fn read(path: &Path) -> Result<Recording, ReadError> {
                         stored_digest = Some(s);
                     } else if path.starts_with("/__properties") && path.ends_with("/steps") {
                         rec.steps_completed = s.trim().parse().ok();
+                    } else if path.starts_with("/__properties") && path.ends_with("/latency_unit") {
+                        rec.latency_unit = Some(s.trim().to_string());
                     } else if path.starts_with("/__properties") && path.ends_with("/layout") {
                         match s.trim().parse::<u32>() {
                             Ok(v) if (1..=crate::write::LAYOUT).contains(&v) => {}

@@ -380,9 +380,9 @@ impl Session {
         };
         let k = end.step.saturating_sub(1);
         sink.row(ch.latency, k, k as f64 * self.dt);
-        sink.push(ch.step_latency, step_ns as f64);
+        sink.push(ch.step_latency, us(step_ns));
         for &(i, ns) in self.pending_hops.iter().chain(late.as_ref()) {
-            sink.push(ch.hops[i], ns as f64);
+            sink.push(ch.hops[i], us(ns));
         }
         sink.flush_full().map_err(LaunchError::Component)
     }
@@ -403,7 +403,7 @@ impl Session {
         }
         if let (Some((sink, _)), Some((g, id))) = (&mut self.sink, self.overrun) {
             sink.row(g, k, k as f64 * self.dt);
-            sink.push(id, late as f64);
+            sink.push(id, us(late));
         }
         Ok(())
     }
@@ -531,9 +531,9 @@ impl Session {
         // row k (in-process: step k itself, which has no hops).
         if let Some((ks, ns)) = step_ns {
             sink.row(ch.latency, ks, ks as f64 * self.dt);
-            sink.push(ch.step_latency, ns as f64);
+            sink.push(ch.step_latency, us(ns));
             for &(i, ns) in hops {
-                sink.push(ch.hops[i], ns as f64);
+                sink.push(ch.hops[i], us(ns));
             }
         }
         sink.flush_full().map_err(LaunchError::Component)
@@ -568,4 +568,10 @@ impl Session {
             realtime,
         })
     }
+}
+
+/// A latency as recorded: µs ([`recording::write::LATENCY_UNIT`]), from the ns it was timed in.
+#[inline]
+fn us(ns: u64) -> f64 {
+    ns as f64 / 1000.0
 }

@@ -104,7 +104,7 @@ pub fn name_and_label(
                 .cloned()
                 .unwrap_or_else(|| member.to_string())
         };
-        let label = format!("{name} [ns]");
+        let label = format!("{name} [{}]", r.latency_label_unit());
         return (name, label);
     }
     match signals::named(s, &path) {

@@ -34,10 +34,10 @@ fn latency_views(s: &Scenario, layout: &Layout) -> Vec<ContainerLike> {
         .filter(|p| p.starts_with("/latency/"))
         .map(str::to_string)
         .partition(|p| signals::follower_hop(s, p));
-    let mut views = vec![plot("lockstep latency [ns]", &ring, layout)];
+    let mut views = vec![plot("lockstep latency [µs]", &ring, layout)];
     if !followers.is_empty() {
         views.push(plot(
-            "followers' batch delay [ns] (observers off the ring)",
+            "followers' batch delay [µs] (observers off the ring)",
             &followers,
             layout,
         ));

@@ -26,6 +26,11 @@ pub use what::InputEstimate;
 
 use lockstep::{Header, PlantLayout};
 
+/// The unit of every `/latency/…` value a recording holds, stored as its `latency_unit`
+/// property: µs, so that the viewer's latency axes read 3.4, not 3 400 (recordings without the
+/// property hold ns; [`crate::read::Recording::latency_ns_per_value`]).
+pub const LATENCY_UNIT: &str = "µs";
+
 /// One step of a run, as every component published it.
 #[derive(Debug, Clone, Default)]
 pub struct StepRow {

@@ -136,6 +136,11 @@ impl RrdSink {
         rec.set_sink(Box::new(sink));
         rec.send_property("layout", &TextDocument::new(LAYOUT.to_string()))
             .map_err(|e| e.to_string())?;
+        rec.send_property(
+            "latency_unit",
+            &TextDocument::new(super::LATENCY_UNIT.to_string()),
+        )
+        .map_err(|e| e.to_string())?;
         let scenario_text = format!("```toml\n{scenario_toml}\n```");
         let scenario_digest = digest::of_text(&scenario_text);
         rec.log_static("scenario", &TextDocument::from_markdown(scenario_text))

@@ -370,7 +370,7 @@ fn names_and_units_label_plots_and_csv_headers() {
         1,
         "{latency}"
     );
-    assert!(cols.contains(&"step_latency [ns]"), "{latency}");
+    assert!(cols.contains(&"step_latency [µs]"), "{latency}");
     // Plots: titles, axis labels and legends carry the names and units.
     let r = read(&rrd).unwrap();
     let figs = figures(&r, &PlotSelection::default()).unwrap();

@@ -52,6 +52,11 @@ fn inspect_recomputes_the_summary() {
     }
     assert_eq!(sum["latency_ns"]["step"], ins["latency_ns"]["step"]);
     assert_eq!(sum["latency_ns"]["hops"], ins["latency_ns"]["hops"]);
+    // Recorded in µs (so the viewer's latency axes read µs), timed in ns: inspect's percentiles
+    // above are the recorded values × 1000, equal to the run's own.
+    let r = recording::read::read(&s.join("out/seed002-sine.rrd")).unwrap();
+    assert_eq!(r.latency_unit.as_deref(), Some("µs"));
+    assert_eq!(r.latency_ns_per_value(), 1000.0);
     // ŵ's figure too, from the recorded ŵ and w at the same steps: the same numbers, bit for
     // bit, for every observer that estimates w and none for the others.
     for name in ["seed002-sine", "dc-motor-load-torque"] {
