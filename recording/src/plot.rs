@@ -428,6 +428,15 @@ pub fn time_unit(duration: f64) -> (&'static str, f64) {
     }
 }
 
+/// The time axis's unit for the run of `s`, and its length in seconds: the scenario's own
+/// `time_unit` (validated when it was read), else [`time_unit`] by the run's length.
+fn axis_unit(s: &scenario::Scenario) -> (&str, f64) {
+    match s.time_unit.as_deref() {
+        Some(u) => (u, lti::units::seconds(&format!("1 {u}")).unwrap_or(1.0)),
+        None => time_unit(s.duration),
+    }
+}
+
 /// The figures of every selected view of `r`, with their file names; an error names what is
 /// wrong (a bad selection, nothing selected).
 pub fn figures(r: &Recording, selection: &PlotSelection) -> Result<Vec<(String, Figure)>, String> {
@@ -437,11 +446,7 @@ pub fn figures(r: &Recording, selection: &PlotSelection) -> Result<Vec<(String, 
     // Time in the run's own scale: a two-day run reads in hours, not in 10⁵ s.
     let (x_label, axis) = match s {
         Some(s) => {
-            let (unit, per) = match s.time_unit.as_deref() {
-                // The scenario's own unit, validated when it was read.
-                Some(u) => (u, lti::units::seconds(&format!("1 {u}")).unwrap_or(1.0)),
-                None => time_unit(s.duration),
-            };
+            let (unit, per) = axis_unit(s);
             (format!("t [{unit}]"), Some((s.dt, per)))
         }
         None => ("step".to_string(), None),
