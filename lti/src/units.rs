@@ -13,20 +13,63 @@
 
 use std::cell::Cell;
 
+/// A unit of time as an exact decimal number of seconds, factor · 10^exp10 (1 ms = 1·10⁻³ s,
+/// 1 h = 3600 s), so that "18 ms" is the double nearest 0.018 — the sample time 18 · 0.001 s the
+/// sample checks compare in decimal — not 18 × 0.001 in binary (0.018000000000000002).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Per {
+    factor: u32,
+    exp10: i32,
+}
+
+impl Per {
+    const SECOND: Per = Per {
+        factor: 1,
+        exp10: 0,
+    };
+
+    /// Seconds per unit, as a double.
+    fn seconds(self) -> f64 {
+        self.factor as f64 * 10f64.powi(self.exp10)
+    }
+
+    /// `v` units in seconds: the decimal product of `v`'s shortest digits and the unit, rounded
+    /// once to the nearest double.
+    fn of(self, v: f64) -> f64 {
+        if self == Per::SECOND || !v.is_finite() || v == 0.0 {
+            return v;
+        }
+        // `{:e}` writes the shortest digits that read back as v: "1.8e1", "-2.5e-3".
+        let text = format!("{v:e}");
+        let (mantissa, exp) = text.split_once('e').expect("{:e} has an exponent");
+        let exp: i32 = exp.parse().expect("{:e}'s exponent is an integer");
+        let (sign, mantissa) = match mantissa.strip_prefix('-') {
+            Some(m) => ("-", m),
+            None => ("", mantissa),
+        };
+        let fraction = mantissa.split_once('.').map_or(0, |(_, f)| f.len()) as i32;
+        let digits: u128 = mantissa.replace('.', "").parse().expect("digits");
+        let product = digits * self.factor as u128;
+        format!("{sign}{product}e{}", exp - fraction + self.exp10)
+            .parse()
+            .expect("a decimal reads as a double")
+    }
+}
+
 thread_local! {
-    /// Seconds per bare number of a simulated time while a scenario is read (1: seconds).
-    static BARE: Cell<f64> = const { Cell::new(1.0) };
+    /// The unit of a bare number of a simulated time while a scenario is read (s by default).
+    static BARE: Cell<Per> = const { Cell::new(Per::SECOND) };
 }
 
 /// Runs `f` with a bare number of a simulated time meaning `unit` ("h", "min", …; [`seconds`]'s
 /// units), on this thread; `None` keeps seconds. An unknown unit is the error, naming the units.
 pub fn with_bare_unit<T>(unit_name: Option<&str>, f: impl FnOnce() -> T) -> Result<T, String> {
     let per = match unit_name {
-        None => 1.0,
+        None => Per::SECOND,
         Some(u) => unit(u.trim())
             .ok_or_else(|| format!("'{u}' is not a time unit (give one of {UNITS}, e.g. \"h\")"))?,
     };
-    struct Reset(f64);
+    struct Reset(Per);
     impl Drop for Reset {
         fn drop(&mut self) {
             BARE.with(|b| b.set(self.0));
@@ -36,21 +79,22 @@ pub fn with_bare_unit<T>(unit_name: Option<&str>, f: impl FnOnce() -> T) -> Resu
     Ok(f())
 }
 
-/// Seconds per bare number of a simulated time, as [`with_bare_unit`] set it.
-fn bare() -> f64 {
-    BARE.with(Cell::get)
+/// A bare number of a simulated time in seconds, in the unit [`with_bare_unit`] set.
+fn bare(v: f64) -> f64 {
+    BARE.with(Cell::get).of(v)
 }
 
-/// Seconds per unit, for the units a time may carry.
-fn unit(u: &str) -> Option<f64> {
-    Some(match u {
-        "ms" => 1e-3,
-        "s" => 1.0,
-        "min" => 60.0,
-        "h" => 3600.0,
-        "day" | "days" => 86_400.0,
+/// The units a time may carry.
+fn unit(u: &str) -> Option<Per> {
+    let (factor, exp10) = match u {
+        "ms" => (1, -3),
+        "s" => (1, 0),
+        "min" => (60, 0),
+        "h" => (3600, 0),
+        "day" | "days" => (86_400, 0),
         _ => return None,
-    })
+    };
+    Some(Per { factor, exp10 })
 }
 
 const UNITS: &str = "ms, s, min, h, day(s)";
@@ -75,7 +119,7 @@ pub fn seconds(text: &str) -> Result<f64, String> {
         .find(|c: char| c.is_ascii_alphabetic() && c != 'e' && c != 'E')
         .or_else(|| t.rfind(' '));
     let Some(at) = split else {
-        return Ok(number(t, text)? * bare());
+        return Ok(bare(number(t, text)?));
     };
     let (n, u) = t.split_at(at);
     let per = unit(u.trim()).ok_or_else(|| {
@@ -84,7 +128,7 @@ pub fn seconds(text: &str) -> Result<f64, String> {
             u.trim()
         )
     })?;
-    Ok(number(n, text)? * per)
+    Ok(per.of(number(n, text)?))
 }
 
 /// A time as a reader says it: in s up to 3 min, min up to 3 h, h up to 3 days, then days
@@ -117,7 +161,7 @@ pub fn hertz(text: &str) -> Result<f64, String> {
                 u.trim()
             )
         })?;
-        return Ok(number(n, text)? / per);
+        return Ok(number(n, text)? / per.seconds());
     }
     match t.strip_suffix("Hz") {
         Some(n) => number(n, text),
@@ -151,7 +195,7 @@ pub mod de {
     /// A simulated time: seconds (or the scenario's `time_unit`), or `"48 h"`.
     pub fn seconds<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
         match Written::deserialize(d)? {
-            Written::Number(v) => Ok(v * super::bare()),
+            Written::Number(v) => Ok(super::bare(v)),
             Written::Text(t) => super::seconds(&t).map_err(D::Error::custom),
         }
     }
@@ -242,6 +286,28 @@ mod tests {
         );
         let _ = std::panic::catch_unwind(|| with_bare_unit(Some("min"), || panic!("inside")));
         assert_eq!(seconds("2").unwrap(), 2.0);
+    }
+
+    /// A time with a unit is the double nearest its exact decimal value in seconds (what the
+    /// sample checks compare), not the binary product: "18 ms" is 0.018, not 0.018000000000000002.
+    #[test]
+    fn a_time_with_a_unit_is_its_exact_decimal_value() {
+        for (text, want) in [
+            ("18 ms", "0.018"),
+            ("0.1 h", "360"),
+            ("1.7 min", "102"),
+            ("3e-2 ms", "3e-5"),
+            ("-2.5 days", "-216000"),
+            ("0.3 ms", "0.0003"),
+        ] {
+            assert_eq!(
+                seconds(text).unwrap(),
+                want.parse::<f64>().unwrap(),
+                "{text}"
+            );
+        }
+        assert_eq!(0.018_f64, "0.018".parse::<f64>().unwrap());
+        assert_ne!(18.0 * 1e-3, 0.018, "the binary product this avoids");
     }
 
     #[test]
