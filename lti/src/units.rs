@@ -141,6 +141,9 @@ pub fn readable(seconds: f64) -> String {
         _ => ("s", 1.0),
     };
     let v = seconds / per;
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v} {unit}");
+    }
     let digits = (3 - v.abs().log10().floor() as i32).max(0) as usize;
     let text = format!("{v:.digits$}");
     let text = if text.contains('.') {
@@ -258,10 +261,11 @@ mod tests {
             (0.25, "0.25 s"),
             (600.0, "10 min"),
             (172_800.0, "48 h"),
+            (0.0, "0 s"),
         ] {
             let text = readable(t);
             assert_eq!(text, want);
-            assert!((seconds(&text).unwrap() - t).abs() <= 1e-9 * t, "{text}");
+            assert!((seconds(&text).unwrap() - t).abs() <= 1e-9 * t.abs(), "{text}");
         }
     }
 
