@@ -265,7 +265,10 @@ mod tests {
         ] {
             let text = readable(t);
             assert_eq!(text, want);
-            assert!((seconds(&text).unwrap() - t).abs() <= 1e-9 * t.abs(), "{text}");
+            assert!(
+                (seconds(&text).unwrap() - t).abs() <= 1e-9 * t.abs(),
+                "{text}"
+            );
         }
     }
 

@@ -199,15 +199,17 @@ pub fn reference_named(s: &Scenario, k: usize) -> Named {
     }
 }
 
-/// Whether the latency entity at `path` is a follower's: an observer the controller does not
-/// read trails the plant in batches (`lockstep::FOLLOWER_LAG`), so its "hop" is a batch delay
+/// Whether the latency entity at `path` is a follower's: an observer off the ring (one the
+/// controller does not read; in open loop, all but the first) trails the plant in batches (`lockstep::FOLLOWER_LAG`), so its "hop" is a batch delay
 /// of milliseconds, not a lockstep hop of microseconds, and is shown apart from them.
 pub fn follower_hop(s: &Scenario, path: &str) -> bool {
-    let Some(c) = &s.controller else {
-        return false;
+    // The ring's observer: the controller's, in open loop the first (as the launcher places it).
+    let ring = match &s.controller {
+        Some(c) => Some(c.observer.as_str()),
+        None => s.observers.first().map(|o| o.name.as_str()),
     };
     path.strip_prefix("/latency/plant_to_observer_")
-        .is_some_and(|o| o != c.observer.replace('/', "_"))
+        .is_some_and(|o| ring.map(|r| r.replace('/', "_")).as_deref() != Some(o))
 }
 
 /// u's name: `u<k>`, or "<input name> (u)" when the inputs are named.

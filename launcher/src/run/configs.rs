@@ -37,11 +37,17 @@ pub struct Configs {
 /// 5 ms batches at ~8 µs).
 pub const FOLLOWER_SLEEP_US: u32 = 5000;
 
-/// In closed loop, observers the controller does not read are off the critical path.
+/// Observers the controller does not read are off the critical path: in closed loop every one
+/// but the controller's; in open loop, where the plant reads no estimate, every one but the
+/// first. That one keeps the plant in step with the ring, so that the launcher, which reads
+/// every sample but paces no one, cannot fall more than its buffer
+/// ([`lockstep::RECORDER_BUFFER`]) behind a plant only followers would hold back
+/// ([`lockstep::FOLLOWER_LAG`] steps ahead of them).
 pub fn is_follower(s: &Scenario, observer: &str) -> bool {
-    s.controller
-        .as_ref()
-        .is_some_and(|c| c.observer != observer)
+    match &s.controller {
+        Some(c) => c.observer != observer,
+        None => s.observers.first().is_some_and(|o| o.name != observer),
+    }
 }
 
 /// The plant's noise: the scenario's covariances and seed; a run with only noise-burst faults

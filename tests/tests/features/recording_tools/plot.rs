@@ -528,7 +528,7 @@ fn a_state_name_of_250_characters_is_plotted_under_a_file_name_that_fits() {
 
 /// Across processes the follower Luenberger observer trails the plant in batches: its
 /// "latency" is a batch delay of milliseconds. It gets a view of its own, so that the lockstep's
-/// hops (µs) keep a readable axis.
+/// hops (µs) keep a readable axis. In open loop every observer but the first is such a follower.
 #[test]
 fn the_followers_batch_delay_is_plotted_apart_from_the_lockstep_hops() {
     let s = Scratch::new("plot-latency");
@@ -554,6 +554,27 @@ fn the_followers_batch_delay_is_plotted_apart_from_the_lockstep_hops() {
     assert_eq!(
         labels("latency_followers.png"),
         ["plant->observer/luenberger"]
+    );
+    // In open loop the plant reads no estimate: the first observer keeps it in step, and every
+    // other trails it.
+    let out = run(
+        &s,
+        &scenario("dc-motor-load-torque"),
+        &["--mode", "processes"],
+    );
+    assert!(out.status.success(), "{:?}", text(&out));
+    let r = recording::read::read(&s.join("out/dc-motor-load-torque.rrd")).unwrap();
+    let figs = figures(&r, &PlotSelection::default()).unwrap();
+    let labels = |file: &str| -> Vec<String> {
+        let (_, fig) = figs.iter().find(|(f, _)| f == file).expect(file);
+        let mut l: Vec<String> = fig.curves.iter().map(|c| c.label.clone()).collect();
+        l.sort();
+        l
+    };
+    assert_eq!(labels("latency.png"), ["plant->observer/uio", "step"]);
+    assert_eq!(
+        labels("latency_followers.png"),
+        ["plant->observer/hui-zak", "plant->observer/luenberger"]
     );
 }
 

@@ -219,7 +219,8 @@ fn plot_draws_one_png_per_view() {
         .collect();
     files.sort();
     // 4 states, max |e| of both observers, error and residual for 2 observers, the UIO's ŵ,
-    // unknown inputs, inputs, outputs, latency.
+    // unknown inputs, inputs, outputs, latency (the second observer, off the ring in open loop,
+    // apart).
     let expected = [
         "error_dgo-uio.png",
         "error_luenberger.png",
@@ -227,6 +228,7 @@ fn plot_draws_one_png_per_view() {
         "input_estimate_dgo-uio.png",
         "inputs.png",
         "latency.png",
+        "latency_followers.png",
         "outputs.png",
         "residual_dgo-uio.png",
         "residual_luenberger.png",
