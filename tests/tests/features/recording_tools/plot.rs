@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use recording::plot::{PlotSelection, Scale, figures};
+use recording::plot::{Figure, PlotSelection, Scale, figures};
 use tests::*;
 
 /// The plot rectangle of a PNG (left, top, right, bottom): the y axis is the longest vertical
@@ -578,20 +578,27 @@ fn the_followers_batch_delay_is_plotted_apart_from_the_lockstep_hops() {
     );
 }
 
+/// A one-state plant run in one process for the timing lines `head` (dt, duration, a
+/// `time_unit`): its recording and its figures.
+fn slow_run(s: &Scratch, head: &str) -> (recording::read::Recording, Vec<(String, Figure)>) {
+    let path = s.join("slow.toml");
+    std::fs::write(
+        &path,
+        format!("name = \"slow\"\n{head}\n[plant]\nA = [[-0.0002]]\nB = [[0.0001]]\nC = [[1.0]]\nx0 = [1.0]\n\n[[input]]\nkind = \"constant\"\nvalue = 0.0\n\n[[observer]]\nname = \"luenberger\"\nkind = \"luenberger\"\npoles = [-0.001]\n"),
+    )
+    .unwrap();
+    let out = run(s, &path, &["--mode", "in-process"]);
+    assert!(out.status.success(), "{:?}", text(&out));
+    let r = recording::read::read(&s.join("out/slow.rrd")).unwrap();
+    let figs = figures(&r, &PlotSelection::default()).unwrap();
+    (r, figs)
+}
+
 /// A scenario written with `time_unit = "min"` is plotted in minutes, whatever its length.
 #[test]
 fn a_run_in_its_own_time_unit_is_plotted_in_it() {
     let s = Scratch::new("plot-minutes");
-    let path = s.join("slow.toml");
-    std::fs::write(
-        &path,
-        "name = \"slow\"\ntime_unit = \"min\"\ndt = 1\nduration = 2880\n\n[plant]\nA = [[-0.0002]]\nB = [[0.0001]]\nC = [[1.0]]\nx0 = [1.0]\n\n[[input]]\nkind = \"constant\"\nvalue = 0.0\n\n[[observer]]\nname = \"luenberger\"\nkind = \"luenberger\"\npoles = [-0.001]\n",
-    )
-    .unwrap();
-    let out = run(&s, &path, &["--mode", "in-process"]);
-    assert!(out.status.success(), "{:?}", text(&out));
-    let r = recording::read::read(&s.join("out/slow.rrd")).unwrap();
-    let figs = figures(&r, &PlotSelection::default()).unwrap();
+    let (_, figs) = slow_run(&s, "time_unit = \"min\"\ndt = 1\nduration = 2880\n");
     let (_, state) = figs.iter().find(|(f, _)| f.starts_with("state_1")).unwrap();
     assert_eq!(state.x_label, "t [min]");
     // Step 2879 of a minute each.
@@ -604,16 +611,7 @@ fn a_run_in_its_own_time_unit_is_plotted_in_it() {
 #[test]
 fn a_two_day_run_is_plotted_in_hours() {
     let s = Scratch::new("plot-hours");
-    let path = s.join("slow.toml");
-    std::fs::write(
-        &path,
-        "name = \"slow\"\ndt = 60.0\nduration = 172800.0\n\n[plant]\nA = [[-0.0002]]\nB = [[0.0001]]\nC = [[1.0]]\nx0 = [1.0]\n\n[[input]]\nkind = \"constant\"\nvalue = 0.0\n\n[[observer]]\nname = \"luenberger\"\nkind = \"luenberger\"\npoles = [-0.001]\n",
-    )
-    .unwrap();
-    let out = run(&s, &path, &["--mode", "in-process"]);
-    assert!(out.status.success(), "{:?}", text(&out));
-    let r = recording::read::read(&s.join("out/slow.rrd")).unwrap();
-    let figs = figures(&r, &PlotSelection::default()).unwrap();
+    let (r, figs) = slow_run(&s, "dt = 60.0\nduration = 172800.0\n");
     let (_, state) = figs.iter().find(|(f, _)| f.starts_with("state_1")).unwrap();
     assert_eq!(state.x_label, "t [h]");
     let last = state.curves[0].points.last().unwrap().0;
