@@ -131,15 +131,26 @@ pub fn seconds(text: &str) -> Result<f64, String> {
     Ok(per.of(number(n, text)?))
 }
 
-/// A time as a reader says it: in s up to 3 min, min up to 3 h, h up to 3 days, then days
-/// (`"12 h"`, `"90 s"`, `"3.5 days"`), to 4 significant digits.
-pub fn readable(seconds: f64) -> String {
-    let (unit, per) = match seconds.abs() {
+/// The unit a reader takes for a time of `seconds`, and its length in seconds: s up to 3 min,
+/// min up to 3 h, h up to 3 days, then days (a plot's axis, a run's length, a time constant).
+pub fn scale(seconds: f64) -> (&'static str, f64) {
+    match seconds.abs() {
         t if t >= 3.0 * 86_400.0 => ("days", 86_400.0),
         t if t >= 3.0 * 3_600.0 => ("h", 3_600.0),
         t if t >= 180.0 => ("min", 60.0),
         _ => ("s", 1.0),
-    };
+    }
+}
+
+/// Seconds in one `unit` ("h", "min", …, [`seconds`]'s units), or `None` for another word.
+pub fn unit_seconds(unit_name: &str) -> Option<f64> {
+    unit(unit_name.trim()).map(Per::seconds)
+}
+
+/// A time as a reader says it, in the unit [`scale`] picks (`"12 h"`, `"90 s"`, `"3.5 days"`),
+/// to 4 significant digits.
+pub fn readable(seconds: f64) -> String {
+    let (unit, per) = scale(seconds);
     let v = seconds / per;
     if v == 0.0 || !v.is_finite() {
         return format!("{v} {unit}");

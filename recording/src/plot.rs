@@ -411,29 +411,13 @@ fn log_max_error(r: &Recording, o: &str) -> Option<Series> {
     Some(out)
 }
 
-/// A readable unit for the time axis of a run of `duration` seconds, and its length in seconds:
-/// seconds up to 3 min, minutes up to 3 h, hours up to 3 days, then days.
-pub fn time_unit(duration: f64) -> (&'static str, f64) {
-    const MIN: f64 = 60.0;
-    const HOUR: f64 = 3600.0;
-    const DAY: f64 = 86_400.0;
-    if duration >= 3.0 * DAY {
-        ("days", DAY)
-    } else if duration >= 3.0 * HOUR {
-        ("h", HOUR)
-    } else if duration >= 3.0 * MIN {
-        ("min", MIN)
-    } else {
-        ("s", 1.0)
-    }
-}
-
 /// The time axis's unit for the run of `s`, and its length in seconds: the scenario's own
-/// `time_unit` (validated when it was read), else [`time_unit`] by the run's length.
+/// `time_unit` (validated when it was read), else the one its length reads in
+/// ([`lti::units::scale`]: a two-day run in hours).
 fn axis_unit(s: &scenario::Scenario) -> (&str, f64) {
     match s.time_unit.as_deref() {
-        Some(u) => (u, lti::units::seconds(&format!("1 {u}")).unwrap_or(1.0)),
-        None => time_unit(s.duration),
+        Some(u) => (u, lti::units::unit_seconds(u).unwrap_or(1.0)),
+        None => lti::units::scale(s.duration),
     }
 }
 

@@ -61,20 +61,20 @@ pub struct Recording {
 }
 
 impl Recording {
-    /// Nanoseconds per recorded `/latency/…` value: 1000 for µs, 1 for the ns of older files.
-    pub fn latency_ns_per_value(&self) -> f64 {
+    /// The unit of the recorded `/latency/…` values, as a label writes it: µs, or the ns of
+    /// files written before the property.
+    pub fn latency_label_unit(&self) -> &str {
         match self.latency_unit.as_deref() {
-            Some("µs") => 1000.0,
-            _ => 1.0,
+            Some("µs") => "µs",
+            _ => "ns",
         }
     }
 
-    /// The unit of the recorded `/latency/…` values, as a label writes it.
-    pub fn latency_label_unit(&self) -> &str {
-        if self.latency_ns_per_value() == 1000.0 {
-            "µs"
-        } else {
-            "ns"
+    /// Nanoseconds per recorded `/latency/…` value: 1000 for µs, 1 for ns.
+    pub fn latency_ns_per_value(&self) -> f64 {
+        match self.latency_label_unit() {
+            "µs" => 1000.0,
+            _ => 1.0,
         }
     }
 }

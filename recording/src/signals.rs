@@ -203,13 +203,9 @@ pub fn reference_named(s: &Scenario, k: usize) -> Named {
 /// controller does not read; in open loop, all but the first) trails the plant in batches (`lockstep::FOLLOWER_LAG`), so its "hop" is a batch delay
 /// of milliseconds, not a lockstep hop of microseconds, and is shown apart from them.
 pub fn follower_hop(s: &Scenario, path: &str) -> bool {
-    // The ring's observer: the controller's, in open loop the first (as the launcher places it).
-    let ring = match &s.controller {
-        Some(c) => Some(c.observer.as_str()),
-        None => s.observers.first().map(|o| o.name.as_str()),
-    };
+    let ring = s.ring_observer().map(|r| r.replace('/', "_"));
     path.strip_prefix("/latency/plant_to_observer_")
-        .is_some_and(|o| ring.map(|r| r.replace('/', "_")).as_deref() != Some(o))
+        .is_some_and(|o| ring.as_deref() != Some(o))
 }
 
 /// u's name: `u<k>`, or "<input name> (u)" when the inputs are named.

@@ -36,6 +36,16 @@ pub use raw::RawExpect;
 pub use replay_plant::{REPLAY_PLANT_PROGRAM, replay_has_states};
 pub use untrusted::{MAX_SCENARIO_BYTES, quoted};
 impl Scenario {
+    /// The observer on the lockstep ring across processes, the one the plant waits for each
+    /// step: the controller's, in open loop the first. Every other trails the plant in batches
+    /// (a follower, PROTOCOL.md §5).
+    pub fn ring_observer(&self) -> Option<&str> {
+        match &self.controller {
+            Some(c) => Some(c.observer.as_str()),
+            None => self.observers.first().map(|o| o.name.as_str()),
+        }
+    }
+
     /// The tail's length in steps, where `tail` is set: round(tail / duration · steps), at least
     /// one (so a run whose dt a sweep changed keeps the tail's seconds). `None`: the default,
     /// the last quarter of the steps completed.

@@ -109,25 +109,26 @@ pub fn runs(
     Ok(out)
 }
 
-/// A member's cost per step in `mode`, µs, in one repetition's runs (with and without the bank).
-pub fn cost_per_member_us(rep: &[BankRun], mode: &str) -> Option<f64> {
+/// One repetition's runs in `mode`: with the bank and without it.
+fn pair<'a>(rep: &'a [BankRun], mode: &str) -> Option<(&'a BankRun, &'a BankRun)> {
     let get = |bank: bool| {
         rep.iter()
             .find(|r| r.mode == mode && (r.members > 0) == bank)
     };
-    let (with, without) = (get(true)?, get(false)?);
+    Some((get(true)?, get(false)?))
+}
+
+/// A member's cost per step in `mode`, µs, in one repetition's runs (with and without the bank).
+pub fn cost_per_member_us(rep: &[BankRun], mode: &str) -> Option<f64> {
+    let (with, without) = pair(rep, mode)?;
     let per_step = |r: &BankRun| 1e6 / r.steps_per_s.max(1e-9);
     Some((per_step(with) - per_step(without)) / with.members as f64)
 }
 
 /// Per repetition, each mode's cost per member (µs) and the ratio across processes / in one
-/// process, as named lists of values.
-pub fn ratios(banks: &[Vec<BankRun>]) -> Vec<(String, Vec<f64>)> {
-    let mut named: Vec<(String, Vec<f64>)> = Vec::new();
-    let mut add = |name: &str, v: f64| match named.iter_mut().find(|(n, _)| n == name) {
-        Some((_, list)) => list.push(v),
-        None => named.push((name.into(), vec![v])),
-    };
+/// process, each handed to `add` by name.
+pub fn ratios(banks: &[Vec<BankRun>], mut add: impl FnMut(String, f64)) {
+    let mut add = |name: &str, v: f64| add(name.into(), v);
     for rep in banks {
         let (i, p) = (
             cost_per_member_us(rep, "in-process"),
@@ -143,7 +144,6 @@ pub fn ratios(banks: &[Vec<BankRun>]) -> Vec<(String, Vec<f64>)> {
             add("bank member: processes / in-process, cost per step", p / i);
         }
     }
-    named
 }
 
 /// The bank runs as rows: mode, steps/s with the bank and without, a member's cost.
@@ -161,13 +161,7 @@ pub fn table(banks: &[Vec<BankRun>]) -> String {
     );
     for rep in banks {
         for mode in ["in-process", "processes"] {
-            let get = |bank: bool| {
-                rep.iter()
-                    .find(|r| r.mode == mode && (r.members > 0) == bank)
-            };
-            if let (Some(w), Some(n), Some(c)) =
-                (get(true), get(false), cost_per_member_us(rep, mode))
-            {
+            if let (Some((w, n)), Some(c)) = (pair(rep, mode), cost_per_member_us(rep, mode)) {
                 t += &format!(
                     "{:<12} {:>16.0} {:>14.0} {:>20.3}\n",
                     mode, w.steps_per_s, n.steps_per_s, c

@@ -361,7 +361,7 @@ pub fn ratios(bench: &Bench) -> Vec<(String, (f64, f64, f64, usize))> {
             }
         }
     }
-    named.extend(bank::ratios(&bench.banks));
+    bank::ratios(&bench.banks, &mut add);
     named
         .into_iter()
         .map(|(n, mut v)| {

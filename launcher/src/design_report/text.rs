@@ -253,7 +253,7 @@ fn time_constants(poles: &[lti::eig::C64]) -> String {
         .filter(|p| p.re < 0.0 && p.im >= 0.0)
         .map(|p| {
             let tau = -1.0 / p.re;
-            let (unit, per) = recording::plot::time_unit(tau * 3.0);
+            let (unit, per) = lti::units::scale(tau * 3.0);
             format!("{} {unit}", sig(tau / per))
         })
         .collect();

@@ -44,10 +44,7 @@ pub const FOLLOWER_SLEEP_US: u32 = 5000;
 /// ([`lockstep::RECORDER_BUFFER`]) behind a plant only followers would hold back
 /// ([`lockstep::FOLLOWER_LAG`] steps ahead of them).
 pub fn is_follower(s: &Scenario, observer: &str) -> bool {
-    match &s.controller {
-        Some(c) => c.observer != observer,
-        None => s.observers.first().is_some_and(|o| o.name != observer),
-    }
+    s.ring_observer().is_some_and(|r| r != observer)
 }
 
 /// The plant's noise: the scenario's covariances and seed; a run with only noise-burst faults

@@ -526,24 +526,30 @@ fn a_state_name_of_250_characters_is_plotted_under_a_file_name_that_fits() {
     );
 }
 
+/// The sorted legends of the latency views (`latency.png`, `latency_followers.png`) of shipped
+/// scenario `name` run across processes.
+fn latency_legends(s: &Scratch, name: &str) -> [Vec<String>; 2] {
+    let out = run(s, &scenario(name), &["--mode", "processes"]);
+    assert!(out.status.success(), "{:?}", text(&out));
+    let r = recording::read::read(&s.join(&format!("out/{name}.rrd"))).unwrap();
+    let figs = figures(&r, &PlotSelection::default()).unwrap();
+    ["latency.png", "latency_followers.png"].map(|file| {
+        let (_, fig) = figs.iter().find(|(f, _)| f == file).expect(file);
+        let mut l: Vec<String> = fig.curves.iter().map(|c| c.label.clone()).collect();
+        l.sort();
+        l
+    })
+}
+
 /// Across processes the follower Luenberger observer trails the plant in batches: its
 /// "latency" is a batch delay of milliseconds. It gets a view of its own, so that the lockstep's
 /// hops (µs) keep a readable axis. In open loop every observer but the first is such a follower.
 #[test]
 fn the_followers_batch_delay_is_plotted_apart_from_the_lockstep_hops() {
     let s = Scratch::new("plot-latency");
-    let out = run(&s, &scenario("seed002-sine"), &["--mode", "processes"]);
-    assert!(out.status.success(), "{:?}", text(&out));
-    let r = recording::read::read(&s.join("out/seed002-sine.rrd")).unwrap();
-    let figs = figures(&r, &PlotSelection::default()).unwrap();
-    let labels = |file: &str| -> Vec<String> {
-        let (_, fig) = figs.iter().find(|(f, _)| f == file).expect(file);
-        let mut l: Vec<String> = fig.curves.iter().map(|c| c.label.clone()).collect();
-        l.sort();
-        l
-    };
+    let [ring, followers] = latency_legends(&s, "seed002-sine");
     assert_eq!(
-        labels("latency.png"),
+        ring,
         [
             "controller->plant",
             "observer/uio->controller",
@@ -551,29 +557,13 @@ fn the_followers_batch_delay_is_plotted_apart_from_the_lockstep_hops() {
             "step"
         ]
     );
-    assert_eq!(
-        labels("latency_followers.png"),
-        ["plant->observer/luenberger"]
-    );
+    assert_eq!(followers, ["plant->observer/luenberger"]);
     // In open loop the plant reads no estimate: the first observer keeps it in step, and every
     // other trails it.
-    let out = run(
-        &s,
-        &scenario("dc-motor-load-torque"),
-        &["--mode", "processes"],
-    );
-    assert!(out.status.success(), "{:?}", text(&out));
-    let r = recording::read::read(&s.join("out/dc-motor-load-torque.rrd")).unwrap();
-    let figs = figures(&r, &PlotSelection::default()).unwrap();
-    let labels = |file: &str| -> Vec<String> {
-        let (_, fig) = figs.iter().find(|(f, _)| f == file).expect(file);
-        let mut l: Vec<String> = fig.curves.iter().map(|c| c.label.clone()).collect();
-        l.sort();
-        l
-    };
-    assert_eq!(labels("latency.png"), ["plant->observer/uio", "step"]);
+    let [ring, followers] = latency_legends(&s, "dc-motor-load-torque");
+    assert_eq!(ring, ["plant->observer/uio", "step"]);
     assert_eq!(
-        labels("latency_followers.png"),
+        followers,
         ["plant->observer/hui-zak", "plant->observer/luenberger"]
     );
 }
@@ -631,6 +621,6 @@ fn a_two_day_run_is_plotted_in_hours() {
         (172_800.0, "h"),
         (864_000.0, "days"),
     ] {
-        assert_eq!(recording::plot::time_unit(duration).0, unit, "{duration}");
+        assert_eq!(lti::units::scale(duration).0, unit, "{duration}");
     }
 }
